@@ -1,0 +1,22 @@
+#version 450
+// Particle view: one camera-facing quad per particle (6 vertices, no vertex buffer).
+layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };    // binding 0: xyz, w = radius
+layout(std430, binding = 1) readonly buffer Col { vec4 color[]; };  // binding 1: rgba
+layout(push_constant) uniform Push {
+    mat4 view_proj;
+    vec4 right;  // camera right in world space, w = radius scale
+    vec4 up;     // camera up in world space
+} pc;
+layout(location = 0) out vec2 uv;
+layout(location = 1) out vec4 col;
+const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
+                               vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
+void main() {
+    vec4 p = pos[gl_InstanceIndex];
+    vec2 c = corners[gl_VertexIndex];
+    float r = p.w * pc.right.w;
+    vec3 world = p.xyz + (c.x * pc.right.xyz + c.y * pc.up.xyz) * r;
+    gl_Position = pc.view_proj * vec4(world, 1.0);
+    uv = c;
+    col = color[gl_InstanceIndex];
+}

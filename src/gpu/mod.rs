@@ -1,0 +1,18 @@
+//! Vulkan core. Knows no algorithm: context, devices, memory, shaders, pipelines,
+//! timestamps, frames in flight and the headless render target.
+pub mod context;
+pub mod device;
+pub mod frames;
+pub mod memory;
+pub mod pipeline;
+pub mod profiler;
+pub mod shader;
+pub mod target;
+
+pub use context::{Context, ContextOptions};
+pub use device::{list_devices, DeviceInfo};
+pub use frames::FrameLoop;
+pub use memory::{Buffer, Image, MemoryLocation};
+pub use pipeline::{ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline};
+pub use profiler::{FrameTiming, Profiler};
+pub use target::ColorTarget;

@@ -1,0 +1,245 @@
+//! Headless render target: colour + depth images, a readback buffer per frame slot, PNG out.
+use super::memory::{subresource, Buffer, Image, MemoryLocation};
+use super::Context;
+use crate::error::{Error, Result};
+use ash::vk;
+use std::path::Path;
+
+pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+pub struct ColorTarget {
+    pub color: Image,
+    pub depth: Image,
+    readbacks: Vec<Buffer>,
+}
+
+fn image_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    (src_stage, src_access, old): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
+    (dst_stage, dst_access, new): (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout),
+) {
+    let b = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
+        .old_layout(old)
+        .new_layout(new)
+        .image(image)
+        .subresource_range(subresource(aspect))];
+    let dep = vk::DependencyInfo::default().image_memory_barriers(&b);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+impl ColorTarget {
+    pub fn new(ctx: &Context, width: u32, height: u32, slots: usize) -> Result<Self> {
+        let color = ctx.create_image(
+            "color target",
+            width,
+            height,
+            COLOR_FORMAT,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT
+                | vk::ImageUsageFlags::TRANSFER_SRC
+                | vk::ImageUsageFlags::STORAGE,
+        )?;
+        let depth = ctx.create_image(
+            "depth target",
+            width,
+            height,
+            DEPTH_FORMAT,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        )?;
+        let mut readbacks = Vec::new();
+        for _ in 0..slots {
+            readbacks.push(ctx.create_buffer(
+                "frame readback",
+                width as u64 * height as u64 * 4,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+        }
+        Ok(Self {
+            color,
+            depth,
+            readbacks,
+        })
+    }
+
+    pub fn width(&self) -> u32 {
+        self.color.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.color.height
+    }
+
+    /// Begin dynamic rendering, clearing colour to `clear` and depth to 1.
+    pub fn begin_rendering(&self, ctx: &Context, cmd: vk::CommandBuffer, clear: [f32; 4]) {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        // The previous frame's copy-out read the image: wait for it before overwriting.
+        image_barrier(
+            ctx,
+            cmd,
+            self.color.raw,
+            vk::ImageAspectFlags::COLOR,
+            (
+                S::ALL_COMMANDS,
+                A::MEMORY_READ | A::MEMORY_WRITE,
+                L::UNDEFINED,
+            ),
+            (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+        );
+        image_barrier(
+            ctx,
+            cmd,
+            self.depth.raw,
+            vk::ImageAspectFlags::DEPTH,
+            (
+                S::LATE_FRAGMENT_TESTS,
+                A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                L::UNDEFINED,
+            ),
+            (
+                S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+                A::DEPTH_STENCIL_ATTACHMENT_WRITE | A::DEPTH_STENCIL_ATTACHMENT_READ,
+                L::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+        );
+        let color = [vk::RenderingAttachmentInfo::default()
+            .image_view(self.color.view)
+            .image_layout(L::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                color: vk::ClearColorValue { float32: clear },
+            })];
+        let depth = vk::RenderingAttachmentInfo::default()
+            .image_view(self.depth.view)
+            .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 1.0,
+                    stencil: 0,
+                },
+            });
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent: vk::Extent2D {
+                width: self.width(),
+                height: self.height(),
+            },
+        };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&color)
+            .depth_attachment(&depth);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: self.width() as f32,
+            height: self.height() as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        unsafe {
+            ctx.device.cmd_begin_rendering(cmd, &info);
+            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+        }
+    }
+
+    pub fn end_rendering(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+    }
+
+    /// Copy the colour image into this slot's readback buffer (after rendering).
+    pub fn copy_out(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        image_barrier(
+            ctx,
+            cmd,
+            self.color.raw,
+            vk::ImageAspectFlags::COLOR,
+            (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
+        );
+        let region = vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: self.width(),
+                height: self.height(),
+                depth: 1,
+            },
+        };
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.color.raw,
+                L::TRANSFER_SRC_OPTIMAL,
+                self.readbacks[slot].raw,
+                &[region],
+            )
+        };
+        let b = [vk::MemoryBarrier2::default()
+            .src_stage_mask(S::COPY)
+            .src_access_mask(A::TRANSFER_WRITE)
+            .dst_stage_mask(S::HOST)
+            .dst_access_mask(A::HOST_READ)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&b);
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    /// RGBA8 pixels of the frame last copied out of `slot` (valid after its fence).
+    pub fn pixels(&self, slot: usize) -> &[u8] {
+        self.readbacks[slot].mapped().expect("readback is mapped")
+    }
+
+    pub fn save_png(&self, slot: usize, path: &Path) -> Result<()> {
+        save_rgba(path, self.width(), self.height(), self.pixels(slot))
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        ctx.destroy_image(&mut self.color);
+        ctx.destroy_image(&mut self.depth);
+        for b in &mut self.readbacks {
+            ctx.destroy_buffer(b);
+        }
+    }
+}
+
+/// Write RGBA8 pixels as a PNG.
+pub fn save_rgba(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    let img =
+        image::RgbaImage::from_raw(width, height, rgba.to_vec()).ok_or_else(|| Error::Image {
+            path: path.display().to_string(),
+            message: "pixel count does not match the size".into(),
+        })?;
+    img.save(path).map_err(|e| Error::Image {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })
+}

@@ -1,0 +1,11 @@
+//! fluidform: a Rust + Vulkan research testbed for liquid characters.
+//! See README.md for the command line and outputs.
+pub mod config;
+pub mod error;
+pub mod gpu;
+pub mod render;
+pub mod report;
+pub mod run;
+pub mod scene;
+
+pub use error::{Error, Result};

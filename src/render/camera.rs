@@ -1,0 +1,52 @@
+//! A look-at perspective camera producing Vulkan clip space (y down, depth 0..1).
+use glam::{Mat4, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_deg: f32,
+    pub aspect: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    pub fn look_at(eye: Vec3, target: Vec3, fov_y_deg: f32, aspect: f32) -> Self {
+        Self {
+            eye,
+            target,
+            up: Vec3::Y,
+            fov_y_deg,
+            aspect,
+            near: 0.01,
+            far: 100.0,
+        }
+    }
+
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.eye, self.target, self.up)
+    }
+
+    pub fn proj(&self) -> Mat4 {
+        let mut p = Mat4::perspective_rh(
+            self.fov_y_deg.to_radians(),
+            self.aspect,
+            self.near,
+            self.far,
+        );
+        p.y_axis.y = -p.y_axis.y; // Vulkan's clip-space y points down
+        p
+    }
+
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj() * self.view()
+    }
+
+    /// Camera right and up axes in world space.
+    pub fn axes(&self) -> (Vec3, Vec3) {
+        let v = self.view();
+        (v.row(0).truncate(), v.row(1).truncate())
+    }
+}
