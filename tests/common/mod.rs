@@ -1,0 +1,34 @@
+//! Shared test helpers: every test opens its device with the validation layer on and
+//! ends with `finish`, which fails on any validation error.
+#![allow(dead_code)]
+use fluidform::gpu::{Context, ContextOptions};
+
+pub fn ctx() -> Context {
+    Context::new(&ContextOptions {
+        device: std::env::var("FLUIDFORM_TEST_DEVICE").ok(),
+        validation: true,
+    })
+    .expect("open a Vulkan device with validation (run scripts/setup.sh)")
+}
+
+pub fn finish(ctx: &Context) {
+    let (errors, _) = ctx.validation_counts();
+    assert_eq!(
+        errors,
+        0,
+        "validation errors: {:#?}",
+        ctx.validation_messages()
+    );
+    assert!(
+        ctx.memory_bytes().is_empty(),
+        "GPU objects leaked: {:?}",
+        ctx.memory_bytes()
+    );
+}
+
+/// Seeded pseudo-random u32s.
+pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    (0..n).map(|_| rng.random()).collect()
+}
