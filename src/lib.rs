@@ -3,6 +3,7 @@
 pub mod config;
 pub mod error;
 pub mod gpu;
+pub mod primitives;
 pub mod render;
 pub mod report;
 pub mod run;

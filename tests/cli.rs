@@ -27,7 +27,15 @@ fn devices_lists_lavapipe_with_features() {
     let o = fluidform(&["devices", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let d = &v.as_array().unwrap()[0];
-    for key in ["name", "type", "driver", "api", "timestamp_period_ns", "subgroup_size", "missing"] {
+    for key in [
+        "name",
+        "type",
+        "driver",
+        "api",
+        "timestamp_period_ns",
+        "subgroup_size",
+        "missing",
+    ] {
         assert!(d.get(key).is_some(), "missing {key} in {d}");
     }
 }
@@ -37,8 +45,18 @@ fn run_writes_frames_timings_and_summary() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let o = fluidform(&[
-        "run", "--frames", "3", "--out", out.to_str().unwrap(), "--validation",
-        "--width", "160", "--height", "120", "--particles", "500",
+        "run",
+        "--frames",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+        "--validation",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--particles",
+        "500",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     for f in 0..3 {
@@ -73,7 +91,11 @@ fn run_writes_frames_timings_and_summary() {
     assert_eq!(s["config"]["particles"], 500);
     for pass in ["simulate", "draw", "readback"] {
         let p = &s["pass_ms"][pass];
-        let (lo, med, hi) = (p["min"].as_f64().unwrap(), p["median"].as_f64().unwrap(), p["max"].as_f64().unwrap());
+        let (lo, med, hi) = (
+            p["min"].as_f64().unwrap(),
+            p["median"].as_f64().unwrap(),
+            p["max"].as_f64().unwrap(),
+        );
         assert!(0.0 <= lo && lo <= med && med <= hi, "{pass}: {p}");
     }
     let fm = s["frame_ms"]["median"].as_f64().unwrap();
@@ -88,18 +110,40 @@ fn unknown_switch_value_is_a_clear_error() {
     let o = fluidform(&["run", "--frames", "1", "--sort", "quick"]);
     assert!(!o.status.success());
     let t = text(&o);
-    assert!(t.contains("invalid value 'quick'") && t.contains("odd-even"), "{t}");
+    assert!(
+        t.contains("invalid value 'quick'") && t.contains("odd-even"),
+        "{t}"
+    );
 }
 
 #[test]
 fn missing_device_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let o = fluidform(&["run", "--frames", "1", "--device", "no-such-gpu", "--out", dir.path().to_str().unwrap()]);
+    let o = fluidform(&[
+        "run",
+        "--frames",
+        "1",
+        "--device",
+        "no-such-gpu",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     let t = text(&o);
-    assert!(t.contains("no Vulkan device found matching --device 'no-such-gpu'"), "{t}");
+    assert!(
+        t.contains("no Vulkan device found matching --device 'no-such-gpu'"),
+        "{t}"
+    );
     assert!(t.contains("llvmpipe"), "the error lists the devices: {t}");
-    let o = fluidform(&["run", "--frames", "1", "--device", "7", "--out", dir.path().to_str().unwrap()]);
+    let o = fluidform(&[
+        "run",
+        "--frames",
+        "1",
+        "--device",
+        "7",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     assert!(!text(&o).contains("panicked"), "{}", text(&o));
 }
@@ -109,11 +153,23 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path().to_str().unwrap();
     for (args, needle) in [
-        (vec!["run", "--frames", "1", "--out", d, "--material", "glass"], "--material is not implemented yet"),
-        (vec!["run", "--frames", "1", "--out", d, "--scene", "nope"], "unknown scene 'nope'"),
+        (
+            vec!["run", "--frames", "1", "--out", d, "--material", "glass"],
+            "--material is not implemented yet",
+        ),
+        (
+            vec!["run", "--frames", "1", "--out", d, "--scene", "nope"],
+            "unknown scene 'nope'",
+        ),
         (vec!["run", "--frames", "0", "--out", d], "--frames"),
-        (vec!["run", "--frames", "1", "--out", d, "--width", "0"], "--width"),
-        (vec!["run", "--frames", "1", "--out", d, "--particles", "0"], "--particles"),
+        (
+            vec!["run", "--frames", "1", "--out", d, "--width", "0"],
+            "--width",
+        ),
+        (
+            vec!["run", "--frames", "1", "--out", d, "--particles", "0"],
+            "--particles",
+        ),
         (vec!["experiment", "table2"], "not implemented yet"),
     ] {
         let o = fluidform(&args);

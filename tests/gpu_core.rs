@@ -29,7 +29,10 @@ fn validation_layer_reports_misuse() {
     if let Ok(b) = unsafe { ctx.device.create_buffer(&info, None) } {
         unsafe { ctx.device.destroy_buffer(b, None) };
     }
-    assert!(ctx.validation_counts().0 >= 1, "validation did not report a zero-sized buffer");
+    assert!(
+        ctx.validation_counts().0 >= 1,
+        "validation did not report a zero-sized buffer"
+    );
 }
 
 #[repr(C)]
@@ -66,7 +69,10 @@ fn compute_round_trip_matches_cpu_exactly() {
         ctx.upload(&mut bx, 0, &x).unwrap();
         ctx.upload(&mut by, 0, &y).unwrap();
         ctx.upload(&mut bu, 0, &u).unwrap();
-        let push = SaxpyPush { a: 2.0, n: n as u32 };
+        let push = SaxpyPush {
+            a: 2.0,
+            n: n as u32,
+        };
         ctx.one_shot(|cmd| p.dispatch(&ctx, cmd, &[&bx, &by, &bu], &push, n as u64))
             .unwrap();
         let gy: Vec<f32> = ctx.read_all(&by).unwrap();
@@ -116,7 +122,10 @@ fn orbits_step_matches_cpu_reference() {
     let gpos: Vec<[f32; 4]> = ctx.read_all(&gpu.pos).unwrap();
     for (i, (g, c)) in gpos.iter().zip(&pos).enumerate() {
         for k in 0..3 {
-            assert!((g[k] - c[k]).abs() < 1e-4, "particle {i} axis {k}: {g:?} vs {c:?}");
+            assert!(
+                (g[k] - c[k]).abs() < 1e-4,
+                "particle {i} axis {k}: {g:?} vs {c:?}"
+            );
             assert!(g[k].abs() <= 1.0, "particle {i} left the box");
         }
     }
@@ -132,9 +141,18 @@ fn graphics_round_trip_matches_expected_pixels() {
     let (w, h) = (128u32, 96u32);
     // Two discs in clip space (identity view-projection): red at (-0.5, -0.5) radius 0.25,
     // green at (0.5, 0.25) radius 0.125. Vulkan clip y points down the image.
-    let discs = [([-0.5f32, -0.5], 0.25f32, [1.0f32, 0.0, 0.0]), ([0.5, 0.25], 0.125, [0.0, 1.0, 0.0])];
-    let pos: Vec<[f32; 4]> = discs.iter().map(|(c, r, _)| [c[0], c[1], 0.5, *r]).collect();
-    let col: Vec<[f32; 4]> = discs.iter().map(|(_, _, c)| [c[0], c[1], c[2], 1.0]).collect();
+    let discs = [
+        ([-0.5f32, -0.5], 0.25f32, [1.0f32, 0.0, 0.0]),
+        ([0.5, 0.25], 0.125, [0.0, 1.0, 0.0]),
+    ];
+    let pos: Vec<[f32; 4]> = discs
+        .iter()
+        .map(|(c, r, _)| [c[0], c[1], 0.5, *r])
+        .collect();
+    let col: Vec<[f32; 4]> = discs
+        .iter()
+        .map(|(_, _, c)| [c[0], c[1], c[2], 1.0])
+        .collect();
     let mut bpos = ctx.storage_buffer("pos", 32).unwrap();
     let mut bcol = ctx.storage_buffer("col", 32).unwrap();
     ctx.upload(&mut bpos, 0, &pos).unwrap();
@@ -184,7 +202,11 @@ fn graphics_round_trip_matches_expected_pixels() {
             if ambiguous {
                 continue;
             }
-            if expected[2] == 255 { outside += 1 } else { inside += 1 }
+            if expected[2] == 255 {
+                outside += 1
+            } else {
+                inside += 1
+            }
             for k in 0..4 {
                 assert!(
                     (p[k] as i32 - expected[k] as i32).abs() <= 2,
@@ -193,11 +215,18 @@ fn graphics_round_trip_matches_expected_pixels() {
             }
         }
     }
-    assert!(inside > 100 && outside > 1000, "inside {inside}, outside {outside}");
+    assert!(
+        inside > 100 && outside > 1000,
+        "inside {inside}, outside {outside}"
+    );
     // Orientation: clip y = -0.5 is the upper half of the image.
     let red_row = (0.25 * h as f32) as u32;
     let i = ((red_row * w + w / 4) * 4) as usize;
-    assert!(px[i] > 200 && px[i + 2] == 0, "red disc not at top-left: {:?}", &px[i..i + 4]);
+    assert!(
+        px[i] > 200 && px[i + 2] == 0,
+        "red disc not at top-left: {:?}",
+        &px[i..i + 4]
+    );
     view.destroy(&ctx);
     target.destroy(&ctx);
     ctx.destroy_buffer(&mut bpos);
@@ -230,7 +259,10 @@ fn profiler_scopes_present_and_nested_inside_frame() {
         ctx.upload(b, 0, &vec![1u32; n as usize]).unwrap();
     }
     let mut frames = FrameLoop::new(&ctx, 2, 8).unwrap();
-    let push = SaxpyPush { a: 0.5, n: n as u32 };
+    let push = SaxpyPush {
+        a: 0.5,
+        n: n as u32,
+    };
     let mut done = Vec::new();
     frames
         .run(
@@ -251,7 +283,11 @@ fn profiler_scopes_present_and_nested_inside_frame() {
             },
         )
         .unwrap();
-    assert_eq!(done, (0..7).collect::<Vec<_>>(), "every frame retired once, in order");
+    assert_eq!(
+        done,
+        (0..7).collect::<Vec<_>>(),
+        "every frame retired once, in order"
+    );
     let t = &frames.profiler.results;
     assert_eq!(t.len(), 7);
     for ft in t {
@@ -262,7 +298,11 @@ fn profiler_scopes_present_and_nested_inside_frame() {
             assert!(*ms >= 0.0 && ms.is_finite(), "{name}: {ms}");
         }
         assert!(ft.frame_ms > 0.0, "frame {}: {}", ft.frame, ft.frame_ms);
-        assert!(sum <= ft.frame_ms * 1.0001 + 1e-6, "passes {sum} ms > frame {} ms", ft.frame_ms);
+        assert!(
+            sum <= ft.frame_ms * 1.0001 + 1e-6,
+            "passes {sum} ms > frame {} ms",
+            ft.frame_ms
+        );
     }
     frames.destroy(&ctx);
     for b in &mut bufs {
@@ -280,7 +320,11 @@ fn shader_error_names_file_and_line() {
         .compile_source("test/broken.comp", src, shaderc::ShaderKind::Compute, &[])
         .unwrap_err();
     match &e {
-        Error::Shader { file, line, message } => {
+        Error::Shader {
+            file,
+            line,
+            message,
+        } => {
             assert_eq!(file, "glsl/test/broken.comp");
             assert_eq!(*line, 5);
             assert!(message.contains("undefined_thing"), "{message}");

@@ -1,0 +1,16 @@
+#version 450
+// Counting sort pass 1 (seed 002): count keys per cell with atomicAdd; each element keeps
+// the returned in-cell rank. Keys >= cells are clamped to the last cell and counted in
+// counts[cells] so the output is still a permutation and the misuse is reported.
+#include "common/index.glsl"
+layout(std430, binding = 0) readonly buffer Keys { uint keys[]; };  // binding 0: cell keys
+layout(std430, binding = 1) buffer Counts { uint counts[]; };       // binding 1: cells + 1
+layout(std430, binding = 2) writeonly buffer Rank { uint rank[]; }; // binding 2: in-cell rank
+layout(push_constant) uniform Push { uint n; uint cells; } pc;
+void main() {
+    uint i = global_id();
+    if (i >= pc.n) return;
+    uint k = keys[i];
+    if (k >= pc.cells) { atomicAdd(counts[pc.cells], 1u); k = pc.cells - 1u; }
+    rank[i] = atomicAdd(counts[k], 1u);
+}

@@ -1,0 +1,171 @@
+//! Atomic-grid counting sort (seed 002): count per cell with atomicAdd (each element keeps
+//! its in-cell rank), exclusive prefix sum of the counts gives cell starts, scatter to
+//! start + rank. O(N + cells); order inside a cell is arbitrary.
+use super::scan::{ScanKind, ScanPass, ScanScratch};
+use crate::error::{Error, Result};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct CountPush {
+    n: u32,
+    cells: u32,
+}
+
+pub struct CountingSort {
+    count: ComputePipeline,
+    scatter: ComputePipeline,
+}
+
+/// Buffers for up to `capacity` elements and `cells` cells.
+pub struct CountingBuffers {
+    /// Per-cell counts; counts[cells] counts out-of-range keys.
+    pub counts: Buffer,
+    /// Exclusive scan of counts: the first sorted slot of each cell.
+    pub starts: Buffer,
+    pub rank: Buffer,
+    pub scan: ScanScratch,
+    pub cells: u32,
+    pub capacity: u64,
+}
+
+impl CountingBuffers {
+    pub fn new(ctx: &Context, scan: &ScanPass, capacity: u64, cells: u32) -> Result<Self> {
+        if cells == 0 {
+            return Err(Error::Param("counting sort needs at least one cell".into()));
+        }
+        Ok(Self {
+            counts: ctx.storage_buffer("cell counts", (cells as u64 + 1) * 4)?,
+            starts: ctx.storage_buffer("cell starts", cells as u64 * 4)?,
+            rank: ctx.storage_buffer("in-cell rank", capacity * 4)?,
+            scan: scan.scratch(ctx, cells as u64)?,
+            cells,
+            capacity,
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        ctx.destroy_buffer(&mut self.counts);
+        ctx.destroy_buffer(&mut self.starts);
+        ctx.destroy_buffer(&mut self.rank);
+        self.scan.destroy(ctx);
+    }
+}
+
+impl CountingSort {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let desc = |name, shader, buffers| ComputeDesc {
+            name,
+            shader,
+            defines: &[],
+            local_size: 256,
+            spec: &[],
+            buffers,
+            push_size: 8,
+        };
+        Ok(Self {
+            count: ComputePipeline::new(ctx, &desc("count", "primitives/count.comp", 3))?,
+            scatter: ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp", 6))?,
+        })
+    }
+
+    /// Record the sort of `n` keys (< cells) with their values into sorted_keys/sorted_vals.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scan: &ScanPass,
+        b: &CountingBuffers,
+        keys: &Buffer,
+        vals: &Buffer,
+        sorted_keys: &Buffer,
+        sorted_vals: &Buffer,
+        n: u64,
+    ) -> Result<()> {
+        if n > b.capacity {
+            return Err(Error::Param(format!(
+                "counting sort of {n} elements exceeds capacity {}",
+                b.capacity
+            )));
+        }
+        let push = CountPush {
+            n: n as u32,
+            cells: b.cells,
+        };
+        unsafe {
+            ctx.device
+                .cmd_fill_buffer(cmd, b.counts.raw, 0, vk::WHOLE_SIZE, 0)
+        };
+        ctx.barrier(cmd);
+        self.count
+            .dispatch(ctx, cmd, &[keys, &b.counts, &b.rank], &push, n);
+        ctx.compute_barrier(cmd);
+        scan.record(
+            ctx,
+            cmd,
+            &b.counts,
+            &b.starts,
+            b.cells as u64,
+            ScanKind::Exclusive,
+            &b.scan,
+        )?;
+        ctx.compute_barrier(cmd);
+        self.scatter.dispatch(
+            ctx,
+            cmd,
+            &[keys, &b.rank, &b.starts, vals, sorted_keys, sorted_vals],
+            &push,
+            n,
+        );
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.count.destroy(ctx);
+        self.scatter.destroy(ctx);
+    }
+}
+
+/// dst[i] = src[perm[i]] for vec4 attributes.
+pub struct GatherPass {
+    pipeline: ComputePipeline,
+}
+
+impl GatherPass {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        Ok(Self {
+            pipeline: ComputePipeline::new(
+                ctx,
+                &ComputeDesc {
+                    name: "gather",
+                    shader: "primitives/gather.comp",
+                    defines: &[],
+                    local_size: 256,
+                    spec: &[],
+                    buffers: 3,
+                    push_size: 4,
+                },
+            )?,
+        })
+    }
+
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        perm: &Buffer,
+        src: &Buffer,
+        dst: &Buffer,
+        n: u32,
+    ) {
+        self.pipeline
+            .dispatch(ctx, cmd, &[perm, src, dst], &n, n as u64);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}

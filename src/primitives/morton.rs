@@ -1,0 +1,67 @@
+//! 30-bit Morton codes (10 bits per axis) of positions relative to a GPU-side box.
+use crate::error::Result;
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use ash::vk;
+
+pub struct MortonPass {
+    pipeline: ComputePipeline,
+}
+
+impl MortonPass {
+    pub const NAME: &'static str = "morton";
+
+    pub fn new(ctx: &Context) -> Result<Self> {
+        Ok(Self {
+            pipeline: ComputePipeline::new(
+                ctx,
+                &ComputeDesc {
+                    name: Self::NAME,
+                    shader: "primitives/morton.comp",
+                    defines: &[],
+                    local_size: 256,
+                    spec: &[],
+                    buffers: 4,
+                    push_size: 4,
+                },
+            )?,
+        })
+    }
+
+    /// keys[i] = Morton code of pos[i] in `bounds` (two vec4), vals[i] = i.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pos: &Buffer,
+        bounds: &Buffer,
+        keys: &Buffer,
+        vals: &Buffer,
+        n: u32,
+    ) {
+        self.pipeline
+            .dispatch(ctx, cmd, &[pos, bounds, keys, vals], &n, n as u64);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}
+
+/// CPU Morton code: the same quantisation as glsl/primitives/morton.glsl.
+pub fn morton_code(q: [u32; 3]) -> u32 {
+    fn expand(v: u32) -> u32 {
+        let mut v = v & 0x3ff;
+        v = (v | (v << 16)) & 0x0300_00ff;
+        v = (v | (v << 8)) & 0x0300_f00f;
+        v = (v | (v << 4)) & 0x030c_30c3;
+        v = (v | (v << 2)) & 0x0924_9249;
+        v
+    }
+    (expand(q[0]) << 2) | (expand(q[1]) << 1) | expand(q[2])
+}
+
+/// Lattice coordinate along one axis, in f64 (the test's reference).
+pub fn morton_axis(p: f32, lo: f32, hi: f32) -> f64 {
+    let ext = ((hi - lo) as f64).max(1e-30);
+    ((p as f64 - lo as f64) / ext * 1024.0).clamp(0.0, 1023.0)
+}
