@@ -14,5 +14,5 @@ pub use device::{list_devices, DeviceInfo};
 pub use frames::FrameLoop;
 pub use memory::{Buffer, Image, MemoryLocation};
 pub use pipeline::{ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline};
-pub use profiler::{FrameTiming, Profiler};
+pub use profiler::{FrameTiming, Labels, Profiler, Scopes};
 pub use target::ColorTarget;

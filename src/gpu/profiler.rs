@@ -31,6 +31,33 @@ pub struct Profiler {
     pub results: Vec<FrameTiming>,
 }
 
+/// Where passes report their named scopes: the profiler (label + timestamps) or
+/// `Labels` (debug labels only, for one-shot work and tests).
+pub trait Scopes {
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str);
+    fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer);
+}
+
+pub struct Labels;
+
+impl Scopes for Labels {
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
+        ctx.begin_label(cmd, name);
+    }
+    fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        ctx.end_label(cmd);
+    }
+}
+
+impl Scopes for Profiler {
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
+        Profiler::begin(self, ctx, cmd, name)
+    }
+    fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        Profiler::end(self, ctx, cmd)
+    }
+}
+
 /// Name of the scope that spans a whole frame.
 pub const FRAME_SCOPE: &str = "frame";
 

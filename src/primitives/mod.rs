@@ -4,5 +4,6 @@ pub mod bounds;
 pub mod counting;
 pub mod cpu;
 pub mod morton;
+pub mod neighbors;
 pub mod scan;
 pub mod sort;

@@ -1,0 +1,20 @@
+#version 450
+// Neighbour search, step 1 for grid and hash: each particle's cell key; value = index.
+#include "common/index.glsl"
+#include "nb_common.glsl"
+#define NB_CELL_ONLY
+#include "neighbors.glsl"
+layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };     // binding 0: positions
+layout(std430, binding = 1) writeonly buffer Keys { uint keys[]; };  // binding 1: cell keys
+layout(std430, binding = 2) writeonly buffer Vals { uint vals[]; };  // binding 2: indices
+void main() {
+    uint i = global_id();
+    if (i >= pc.n) return;
+    vec3 p = pos[i].xyz;
+#if NB_STRATEGY == NB_GRID
+    keys[i] = nb_grid_id(nb_grid_cell(p));
+#else
+    keys[i] = nb_hash(nb_cell_of(p));
+#endif
+    vals[i] = i;
+}

@@ -1,0 +1,32 @@
+#version 450
+// Neighbour lists: every j != i within radius of sorted particle i (indices are sorted
+// slots). counts[i] is the true count even when the list (max_neighbors) overflows;
+// visited[i] counts the candidates examined.
+#include "common/index.glsl"
+#include "nb_common.glsl"
+#define NB_B_KEYS 1
+#define NB_B_START 2
+#define NB_B_END 3
+#define NB_B_BOX 4
+#include "neighbors.glsl"
+layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };        // binding 0: sorted positions
+layout(std430, binding = 5) writeonly buffer Cnt { uint counts[]; };    // binding 5
+layout(std430, binding = 6) writeonly buffer List { uint list[]; };     // binding 6
+layout(std430, binding = 7) writeonly buffer Vis { uint visited[]; };   // binding 7
+void main() {
+    uint i = global_id();
+    if (i >= pc.n) return;
+    vec3 p = pos[i].xyz;
+    float r2 = pc.radius * pc.radius;
+    uint c = 0u, seen = 0u;
+    NB_BEGIN(p, pc.radius, j)
+        seen++;
+        vec3 d = pos[j].xyz - p;
+        if (j != i && dot(d, d) <= r2) {
+            if (c < pc.max_neighbors) list[i * pc.max_neighbors + c] = j;
+            c++;
+        }
+    NB_END
+    counts[i] = c;
+    visited[i] = seen;
+}

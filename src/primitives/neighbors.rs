@@ -1,0 +1,448 @@
+//! Fixed-radius neighbour search, `--neighbors morton|grid|hash` (with `--sort`):
+//! - grid: uniform-grid cell keys, counting sort (seed 002) by default;
+//! - hash: hashed cell keys (Teschner) sorted by a network sort (Le Grand's baseline);
+//! - morton: Morton codes in the GPU-reduced bounding box, odd-even sort, and a per-query
+//!   code range from the query box's corners (seed 000).
+//! Build: keys -> sort -> reorder positions -> cell ranges. Query: lists per particle.
+//! Other passes (SPH) iterate neighbours with glsl/primitives/neighbors.glsl and the
+//! same bindings via `defines()` and `cell_buffers()`.
+use super::bounds::{BoundsBuffers, BoundsPass};
+use super::counting::{CountingBuffers, CountingSort, GatherPass};
+use super::morton::MortonPass;
+use super::scan::{ScanPass, ScanVariant};
+use super::sort::{Network, NetworkSort};
+use crate::config::{Neighbors, SortAlgo};
+use crate::error::{Error, Result};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Scopes};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+
+/// A uniform grid: origin, cell size (>= search radius) and cell counts per axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSpec {
+    pub origin: [f32; 3],
+    pub cell: f32,
+    pub dims: [u32; 3],
+}
+
+/// Most grid cells a `grid` search may use.
+pub const MAX_CELLS: u64 = 1 << 26;
+
+impl GridSpec {
+    /// The grid of cells of size `cell` covering the box [lo, hi].
+    pub fn covering(lo: [f32; 3], hi: [f32; 3], cell: f32) -> Result<Self> {
+        if !(cell > 0.0 && cell.is_finite()) {
+            return Err(Error::Param(format!(
+                "grid cell size must be positive, got {cell}"
+            )));
+        }
+        let mut dims = [1u32; 3];
+        for k in 0..3 {
+            let ext = hi[k] - lo[k];
+            if !(ext >= 0.0 && ext.is_finite()) {
+                return Err(Error::Param(format!("invalid grid box {lo:?}..{hi:?}")));
+            }
+            dims[k] = ((ext / cell).ceil() as u64).clamp(1, 1 << 20) as u32;
+        }
+        let g = Self {
+            origin: lo,
+            cell,
+            dims,
+        };
+        if g.cells() > MAX_CELLS {
+            return Err(Error::Param(format!(
+                "a grid of {}x{}x{} cells exceeds {MAX_CELLS}: raise the cell size (radius)",
+                dims[0], dims[1], dims[2]
+            )));
+        }
+        Ok(g)
+    }
+
+    pub fn cells(&self) -> u64 {
+        self.dims.iter().map(|&d| d as u64).product()
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct NeighborPush {
+    pub origin_cell: [f32; 4],
+    pub dims: [u32; 4],
+    pub radius: f32,
+    pub n: u32,
+    pub max_neighbors: u32,
+    pub pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<NeighborPush>() == 48);
+
+/// The default sort of each strategy.
+pub fn default_sort(strategy: Neighbors) -> SortAlgo {
+    match strategy {
+        Neighbors::Grid => SortAlgo::Counting,
+        Neighbors::Hash => SortAlgo::Bitonic,
+        Neighbors::Morton => SortAlgo::OddEven,
+    }
+}
+
+enum Sorter {
+    Network(NetworkSort),
+    Counting(CountingSort),
+}
+
+/// Pipelines of one strategy + sort.
+pub struct NeighborSearch {
+    pub strategy: Neighbors,
+    pub sort: SortAlgo,
+    scan: ScanPass,
+    sorter: Sorter,
+    keys: Option<ComputePipeline>,
+    bounds: Option<BoundsPass>,
+    morton: Option<MortonPass>,
+    ranges: ComputePipeline,
+    gather: GatherPass,
+    query: ComputePipeline,
+}
+
+/// Sized buffers for up to `capacity` particles.
+pub struct NeighborBuffers {
+    keys: Buffer,
+    vals: Buffer,
+    /// Keys in sorted order (cell ids, hashes or Morton codes).
+    pub sorted_keys: Buffer,
+    /// Sorted slot -> original particle index.
+    pub perm: Buffer,
+    /// Positions in sorted order.
+    pub sorted_pos: Buffer,
+    starts: Buffer,
+    ends: Buffer,
+    counting: Option<CountingBuffers>,
+    bounds: Option<BoundsBuffers>,
+    /// Query results (sorted order): neighbour count, list, candidates visited.
+    pub counts: Buffer,
+    pub list: Buffer,
+    pub visited: Buffer,
+    pub capacity: u64,
+    pub table: u32,
+    pub max_neighbors: u32,
+}
+
+impl NeighborBuffers {
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [
+            &mut self.keys,
+            &mut self.vals,
+            &mut self.sorted_keys,
+            &mut self.perm,
+            &mut self.sorted_pos,
+            &mut self.starts,
+            &mut self.ends,
+            &mut self.counts,
+            &mut self.list,
+            &mut self.visited,
+        ] {
+            ctx.destroy_buffer(b);
+        }
+        if let Some(c) = &mut self.counting {
+            c.destroy(ctx);
+        }
+        if let Some(b) = &mut self.bounds {
+            b.destroy(ctx);
+        }
+    }
+
+    /// Cell buffers for neighbors.glsl: (starts, ends-or-counts).
+    pub fn cell_buffers(&self) -> (&Buffer, &Buffer) {
+        match &self.counting {
+            Some(c) => (&c.starts, &c.counts),
+            None => (&self.starts, &self.ends),
+        }
+    }
+
+    /// The bounding box buffer for morton (a dummy for the others).
+    pub fn box_buffer(&self) -> &Buffer {
+        self.bounds
+            .as_ref()
+            .map(|b| &b.result)
+            .unwrap_or(&self.starts)
+    }
+}
+
+impl NeighborSearch {
+    pub fn new(ctx: &Context, strategy: Neighbors, sort: Option<SortAlgo>) -> Result<Self> {
+        let sort = sort.unwrap_or(default_sort(strategy));
+        if strategy == Neighbors::Morton && sort == SortAlgo::Counting {
+            return Err(Error::Param(
+                "--neighbors morton sorts 30-bit codes: use --sort odd-even or bitonic (counting needs bounded cell keys)".into(),
+            ));
+        }
+        let scan = ScanPass::new(ctx, ScanVariant::Auto)?;
+        let sorter = match sort {
+            SortAlgo::Counting => Sorter::Counting(CountingSort::new(ctx)?),
+            SortAlgo::OddEven => Sorter::Network(NetworkSort::new(ctx, Network::OddEven)?),
+            SortAlgo::Bitonic => Sorter::Network(NetworkSort::new(ctx, Network::Bitonic)?),
+        };
+        let defines = Self::defines_for(strategy, sort);
+        let push_size = std::mem::size_of::<NeighborPush>() as u32;
+        let desc = |name, shader, buffers, push_size| ComputeDesc {
+            name,
+            shader,
+            defines: &defines,
+            local_size: 128,
+            spec: &[],
+            buffers,
+            push_size,
+        };
+        let morton = strategy == Neighbors::Morton;
+        Ok(Self {
+            strategy,
+            sort,
+            scan,
+            sorter,
+            keys: if morton {
+                None
+            } else {
+                Some(ComputePipeline::new(
+                    ctx,
+                    &desc("cell keys", "primitives/nb_keys.comp", 3, push_size),
+                )?)
+            },
+            bounds: if morton {
+                Some(BoundsPass::new(ctx)?)
+            } else {
+                None
+            },
+            morton: if morton {
+                Some(MortonPass::new(ctx)?)
+            } else {
+                None
+            },
+            ranges: ComputePipeline::new(
+                ctx,
+                &desc("cell ranges", "primitives/nb_ranges.comp", 3, 4),
+            )?,
+            gather: GatherPass::new(ctx)?,
+            query: ComputePipeline::new(
+                ctx,
+                &desc("neighbor query", "primitives/nb_query.comp", 8, push_size),
+            )?,
+        })
+    }
+
+    fn defines_for(strategy: Neighbors, sort: SortAlgo) -> Vec<(&'static str, String)> {
+        let s = match strategy {
+            Neighbors::Grid => 0,
+            Neighbors::Hash => 1,
+            Neighbors::Morton => 2,
+        };
+        vec![
+            ("NB_STRATEGY", s.to_string()),
+            (
+                "NB_CELL_COUNTS",
+                ((sort == SortAlgo::Counting) as u32).to_string(),
+            ),
+        ]
+    }
+
+    /// Defines for shaders that include neighbors.glsl.
+    pub fn defines(&self) -> Vec<(&'static str, String)> {
+        Self::defines_for(self.strategy, self.sort)
+    }
+
+    pub fn buffers(
+        &self,
+        ctx: &Context,
+        capacity: u64,
+        grid: &GridSpec,
+        max_neighbors: u32,
+    ) -> Result<NeighborBuffers> {
+        let cap = capacity.max(1);
+        let table = (cap.next_power_of_two()).min(1 << 26) as u32;
+        let cells = match self.strategy {
+            Neighbors::Grid => grid.cells(),
+            Neighbors::Hash => table as u64,
+            Neighbors::Morton => 1,
+        };
+        let list_bytes = cap * max_neighbors.max(1) as u64 * 4;
+        Ok(NeighborBuffers {
+            keys: ctx.storage_buffer("nb keys", cap * 4)?,
+            vals: ctx.storage_buffer("nb values", cap * 4)?,
+            sorted_keys: ctx.storage_buffer("nb sorted keys", cap * 4)?,
+            perm: ctx.storage_buffer("nb permutation", cap * 4)?,
+            sorted_pos: ctx.storage_buffer("nb sorted positions", cap * 16)?,
+            starts: ctx.storage_buffer("nb cell starts", cells * 4)?,
+            ends: ctx.storage_buffer("nb cell ends", cells * 4)?,
+            counting: match self.sort {
+                SortAlgo::Counting => {
+                    Some(CountingBuffers::new(ctx, &self.scan, cap, cells as u32)?)
+                }
+                _ => None,
+            },
+            bounds: match self.strategy {
+                Neighbors::Morton => Some(BoundsBuffers::new(ctx, cap)?),
+                _ => None,
+            },
+            counts: ctx.storage_buffer("nb counts", cap * 4)?,
+            list: ctx.storage_buffer("nb lists", list_bytes)?,
+            visited: ctx.storage_buffer("nb visited", cap * 4)?,
+            capacity,
+            table,
+            max_neighbors,
+        })
+    }
+
+    pub fn push(&self, b: &NeighborBuffers, grid: &GridSpec, radius: f32, n: u32) -> NeighborPush {
+        NeighborPush {
+            origin_cell: [grid.origin[0], grid.origin[1], grid.origin[2], grid.cell],
+            dims: [grid.dims[0], grid.dims[1], grid.dims[2], b.table],
+            radius,
+            n,
+            max_neighbors: b.max_neighbors,
+            pad: 0,
+        }
+    }
+
+    /// Record keys, sort, reordered positions and cell ranges for `n` positions (vec4).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_build(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        b: &NeighborBuffers,
+        pos: &Buffer,
+        n: u32,
+        grid: &GridSpec,
+    ) -> Result<()> {
+        if n as u64 > b.capacity {
+            return Err(Error::Param(format!(
+                "neighbour search of {n} particles exceeds capacity {}",
+                b.capacity
+            )));
+        }
+        let push = self.push(b, grid, grid.cell, n);
+        // Keys into (keys, vals) for counting, straight into the sorted arrays otherwise.
+        let counting = matches!(self.sorter, Sorter::Counting(_));
+        let (kd, vd) = if counting {
+            (&b.keys, &b.vals)
+        } else {
+            (&b.sorted_keys, &b.perm)
+        };
+        scopes.begin(ctx, cmd, "keys");
+        if let (Some(bounds), Some(morton), Some(bb)) = (&self.bounds, &self.morton, &b.bounds) {
+            bounds.record(ctx, cmd, pos, n as u64, bb)?;
+            ctx.compute_barrier(cmd);
+            morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
+        } else if let Some(keys) = &self.keys {
+            keys.dispatch(ctx, cmd, &[pos, kd, vd], &push, n as u64);
+        }
+        scopes.end(ctx, cmd);
+        ctx.compute_barrier(cmd);
+        scopes.begin(ctx, cmd, "sort");
+        match &self.sorter {
+            Sorter::Counting(c) => {
+                let cb = b.counting.as_ref().expect("counting buffers");
+                c.record(
+                    ctx,
+                    cmd,
+                    &self.scan,
+                    cb,
+                    &b.keys,
+                    &b.vals,
+                    &b.sorted_keys,
+                    &b.perm,
+                    n as u64,
+                )?;
+            }
+            Sorter::Network(s) => {
+                s.record(ctx, cmd, &b.sorted_keys, &b.perm, n as u64)?;
+            }
+        }
+        scopes.end(ctx, cmd);
+        ctx.compute_barrier(cmd);
+        scopes.begin(ctx, cmd, "reorder");
+        self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
+        scopes.end(ctx, cmd);
+        if !counting && self.strategy != Neighbors::Morton {
+            scopes.begin(ctx, cmd, "ranges");
+            unsafe {
+                ctx.device
+                    .cmd_fill_buffer(cmd, b.starts.raw, 0, vk::WHOLE_SIZE, 0);
+                ctx.device
+                    .cmd_fill_buffer(cmd, b.ends.raw, 0, vk::WHOLE_SIZE, 0);
+            }
+            ctx.barrier(cmd);
+            self.ranges.dispatch(
+                ctx,
+                cmd,
+                &[&b.sorted_keys, &b.starts, &b.ends],
+                &n,
+                n as u64,
+            );
+            scopes.end(ctx, cmd);
+        }
+        ctx.barrier(cmd);
+        Ok(())
+    }
+
+    /// Record the neighbour lists of all `n` particles within `radius` (<= grid.cell for
+    /// grid and hash).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_query(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        b: &NeighborBuffers,
+        n: u32,
+        grid: &GridSpec,
+        radius: f32,
+    ) -> Result<()> {
+        if self.strategy != Neighbors::Morton && radius > grid.cell {
+            return Err(Error::Param(format!(
+                "search radius {radius} exceeds the grid cell {}",
+                grid.cell
+            )));
+        }
+        let push = self.push(b, grid, radius, n);
+        let (starts, ends) = b.cell_buffers();
+        scopes.begin(ctx, cmd, "query");
+        self.query.dispatch(
+            ctx,
+            cmd,
+            &[
+                &b.sorted_pos,
+                &b.sorted_keys,
+                starts,
+                ends,
+                b.box_buffer(),
+                &b.counts,
+                &b.list,
+                &b.visited,
+            ],
+            &push,
+            n as u64,
+        );
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.scan.destroy(ctx);
+        match &mut self.sorter {
+            Sorter::Counting(c) => c.destroy(ctx),
+            Sorter::Network(s) => s.destroy(ctx),
+        }
+        if let Some(k) = &mut self.keys {
+            k.destroy(ctx);
+        }
+        if let Some(b) = &mut self.bounds {
+            b.destroy(ctx);
+        }
+        if let Some(m) = &mut self.morton {
+            m.destroy(ctx);
+        }
+        self.ranges.destroy(ctx);
+        self.gather.destroy(ctx);
+        self.query.destroy(ctx);
+    }
+}
