@@ -1,5 +1,6 @@
 //! fluidform: a Rust + Vulkan research testbed for liquid characters.
 //! See README.md for the command line and outputs.
+pub mod bench;
 pub mod config;
 pub mod error;
 pub mod gpu;

@@ -40,11 +40,18 @@ enum Command {
         #[command(flatten)]
         switches: Switches,
     },
-    /// Benchmark an algorithm (sort, scan, neighbors, sph, render)
+    /// Benchmark an algorithm: scan, sort, neighbors (sph and render arrive later).
+    /// Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
         what: String,
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
+        /// Timed repetitions per configuration
+        #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..))]
+        frames: u64,
+        /// Untimed warm-up repetitions
+        #[arg(long, default_value_t = 5)]
+        warmup: u64,
         #[command(flatten)]
         switches: Switches,
     },
@@ -83,8 +90,23 @@ fn main() -> Result<()> {
             print_summary(&r.summary, &out);
             Ok(())
         }
-        Command::Bench { what, .. } => {
-            bail!("bench '{what}' is not implemented yet: benchmarks arrive with the GPU primitives (issue 3) and later issues")
+        Command::Bench {
+            what,
+            out,
+            frames,
+            warmup,
+            switches,
+        } => {
+            let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
+                what,
+                out: out.clone(),
+                frames,
+                warmup,
+                switches,
+            })?;
+            print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
+            eprintln!("{} configurations; wrote {}", rows.len(), out.display());
+            Ok(())
         }
         Command::Experiment { name, .. } => {
             bail!("experiment '{name}' is not implemented yet: experiments arrive with the papers' tables")

@@ -1,4 +1,4 @@
-// Workgroup-wide reduce and exclusive scan of one u32 per invocation.
+// Workgroup-wide exclusive scan of one u32 per invocation.
 // SUBGROUP=1: subgroup arithmetic plus one shared slot per subgroup;
 // SUBGROUP=0: a shared-memory Hillis-Steele scan (devices without subgroup arithmetic).
 // Both assume invocations are numbered in subgroup order (gl_LocalInvocationIndex).
@@ -7,29 +7,33 @@
 #if SUBGROUP
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
 shared uint wg_sums[gl_WorkGroupSize.x];
+shared uint wg_total;
 
+// The first subgroup scans the subgroup totals in chunks of its own width, so each
+// invocation does O(1) work whatever the subgroup size. Call at most once per invocation.
 uint wg_exclusive_scan(uint v, out uint total) {
     uint incl = subgroupInclusiveAdd(v);
-    uint sg_total = subgroupAdd(v);
-    if (subgroupElect()) wg_sums[gl_SubgroupID] = sg_total;
+    uint last = subgroupBallotFindMSB(subgroupBallot(true));
+    if (gl_SubgroupInvocationID == last) wg_sums[gl_SubgroupID] = incl;
     barrier();
-    uint before = 0;
-    total = 0;
-    for (uint s = 0; s < gl_NumSubgroups; ++s) {
-        uint t = wg_sums[s];
-        before += s < gl_SubgroupID ? t : 0u;
-        total += t;
+    if (gl_SubgroupID == 0u) {
+        uint carry = 0u;
+        for (uint base = 0u; base < gl_NumSubgroups; base += gl_SubgroupSize) {
+            uint i = base + gl_SubgroupInvocationID;
+            uint x = i < gl_NumSubgroups ? wg_sums[i] : 0u;
+            uint ex = subgroupExclusiveAdd(x);
+            if (i < gl_NumSubgroups) wg_sums[i] = carry + ex;
+            carry += subgroupAdd(x);
+        }
+        if (subgroupElect()) wg_total = carry;
     }
     barrier();
-    return before + incl - v;
+    total = wg_total;
+    return wg_sums[gl_SubgroupID] + incl - v;
 }
 
-uint wg_reduce(uint v) {
-    uint total;
-    wg_exclusive_scan(v, total);
-    return total;
-}
 #else
 shared uint wg_sums[2 * gl_WorkGroupSize.x];
 
@@ -52,10 +56,5 @@ uint wg_exclusive_scan(uint v, out uint total) {
     return incl - v;
 }
 
-uint wg_reduce(uint v) {
-    uint total;
-    wg_exclusive_scan(v, total);
-    return total;
-}
 #endif
 #endif

@@ -1,16 +1,23 @@
-//! Prefix sum of u32, reduce-then-scan: (1) each block of WG*ITEMS elements is summed,
-//! (2) the block sums are scanned recursively, (3) each block is scanned in shared memory
-//! with its offset added. 3N memory traffic, O(N) work, any N: arrays longer than one
-//! storage-buffer binding (maxStorageBufferRange) are processed in bound segments.
+//! Prefix sum of u32, work-efficient and multi-level, for any N:
+//! - level pass 1: each invocation sums a chunk of CHUNK contiguous elements (128-bit
+//!   loads, no barriers); the chunk sums are the next level, scanned recursively;
+//! - level pass 2: each invocation scans its chunk serially from its offset;
+//! - the top level (at most WG * IPT elements) is one workgroup: a workgroup scan with
+//!   subgroup arithmetic where the device has it, shared memory where it has not.
+//! About 3N memory traffic. Arrays longer than one storage-buffer binding
+//! (maxStorageBufferRange) are processed in bound segments.
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
 pub const WG: u32 = 256;
-pub const ITEMS: u32 = 8;
-/// Elements per block.
-pub const BLOCK: u64 = (WG * ITEMS) as u64;
+/// Elements per invocation of a level pass.
+pub const CHUNK: u32 = 64;
+/// Elements per invocation of the top-level workgroup scan.
+pub const IPT: u32 = 16;
+/// Most elements the top level scans in one workgroup.
+pub const BLOCK: u64 = (WG * IPT) as u64;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScanKind {
@@ -18,7 +25,7 @@ pub enum ScanKind {
     Inclusive,
 }
 
-/// Which workgroup scan the shaders use.
+/// Which workgroup scan the top level uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScanVariant {
     /// Subgroup arithmetic where the device has it, else shared memory.
@@ -31,21 +38,22 @@ pub enum ScanVariant {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct ScanPush {
     n: u32,
-    block_base: u32,
+    /// Index of this segment's first chunk in the chunk sums.
+    base: u32,
     flags: u32,
 }
 const _: () = assert!(std::mem::size_of::<ScanPush>() == 12);
 const INCLUSIVE: u32 = 1;
-const HAS_OFFSETS: u32 = 2;
 
 /// Pipelines (size-independent).
 pub struct ScanPass {
-    reduce: ComputePipeline,
-    block: ComputePipeline,
+    chunk_reduce: ComputePipeline,
+    chunk_down: ComputePipeline,
+    top: ComputePipeline,
     pub uses_subgroups: bool,
 }
 
-/// Per-level block-sum buffers for arrays of up to `capacity` elements.
+/// Per-level chunk-sum buffers for arrays of up to `capacity` elements.
 pub struct ScanScratch {
     levels: Vec<Buffer>,
     pub capacity: u64,
@@ -60,6 +68,14 @@ impl ScanScratch {
 
     pub fn bytes(&self) -> u64 {
         self.levels.iter().map(|b| b.size).sum()
+    }
+}
+
+fn range(b: vk::Buffer, start: u64, len: u64) -> vk::DescriptorBufferInfo {
+    vk::DescriptorBufferInfo {
+        buffer: b,
+        offset: start * 4,
+        range: len * 4,
     }
 }
 
@@ -78,22 +94,29 @@ impl ScanPass {
                 true
             }
         };
-        let defines = [("SUBGROUP", (subgroup as u32).to_string())];
-        let desc = |name, shader, buffers| ComputeDesc {
-            name,
-            shader,
-            defines: &defines,
-            local_size: WG,
-            spec: &[ITEMS],
-            buffers,
-            push_size: std::mem::size_of::<ScanPush>() as u32,
+        let defines = [
+            ("SUBGROUP", (subgroup as u32).to_string()),
+            ("IPT", format!("{IPT}u")),
+            ("CHUNK", format!("{CHUNK}u")),
+        ];
+        let pipeline = |name, shader| {
+            ComputePipeline::new(
+                ctx,
+                &ComputeDesc {
+                    name,
+                    shader,
+                    defines: &defines,
+                    local_size: WG,
+                    spec: &[],
+                    buffers: 5,
+                    push_size: std::mem::size_of::<ScanPush>() as u32,
+                },
+            )
         };
         Ok(Self {
-            reduce: ComputePipeline::new(
-                ctx,
-                &desc("scan reduce", "primitives/scan_reduce.comp", 2),
-            )?,
-            block: ComputePipeline::new(ctx, &desc("scan block", "primitives/scan_block.comp", 3))?,
+            chunk_reduce: pipeline("scan chunk sums", "primitives/scan_chunk_reduce.comp")?,
+            chunk_down: pipeline("scan chunks", "primitives/scan_chunk_down.comp")?,
+            top: pipeline("scan top", "primitives/scan_block.comp")?,
             uses_subgroups: subgroup,
         })
     }
@@ -102,13 +125,14 @@ impl ScanPass {
         let mut levels = Vec::new();
         let mut n = capacity;
         while n > BLOCK {
-            n = n.div_ceil(BLOCK);
-            levels.push(ctx.storage_buffer(&format!("scan block sums {}", levels.len()), n * 4)?);
+            n = n.div_ceil(CHUNK as u64);
+            levels.push(ctx.storage_buffer(&format!("scan chunk sums {}", levels.len()), n * 4)?);
         }
         Ok(ScanScratch { levels, capacity })
     }
 
     /// Record a scan of `n` u32 from `input` into `output` (may be the same buffer).
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &Context,
@@ -160,70 +184,59 @@ impl ScanPass {
         } else {
             0
         };
-        // Segment length: the most whole blocks one binding may cover.
-        let seg = (ctx.max_storage_range() / 4 / BLOCK).max(1) * BLOCK;
-        let range = |b: vk::Buffer, start: u64, len: u64| vk::DescriptorBufferInfo {
-            buffer: b,
-            offset: start * 4,
-            range: len * 4,
-        };
-        let whole = |b: vk::Buffer| vk::DescriptorBufferInfo {
-            buffer: b,
-            offset: 0,
-            range: vk::WHOLE_SIZE,
-        };
-        let segments = (0..n.div_ceil(seg)).map(|s| (s * seg, seg.min(n - s * seg)));
         if n <= BLOCK {
             let push = ScanPush {
                 n: n as u32,
-                block_base: 0,
+                base: 0,
                 flags: inclusive,
             };
-            let infos = [range(input, 0, n), range(output, 0, n), range(input, 0, n)];
-            self.block.dispatch_groups(ctx, cmd, &infos, &push, 1);
+            let (i, o) = (range(input, 0, n), range(output, 0, n));
+            self.top
+                .dispatch_groups(ctx, cmd, &[i, i, o, o, i], &push, 1);
             return;
         }
-        let sums = scratch.levels[level].raw;
-        for (start, len) in segments.clone() {
-            let push = ScanPush {
-                n: len as u32,
-                block_base: (start / BLOCK) as u32,
-                flags: 0,
-            };
-            let infos = [range(input, start, len), whole(sums)];
-            self.reduce
-                .dispatch_groups(ctx, cmd, &infos, &push, len.div_ceil(BLOCK));
-        }
+        let chunk = CHUNK as u64;
+        let sums = vk::DescriptorBufferInfo {
+            buffer: scratch.levels[level].raw,
+            offset: 0,
+            range: vk::WHOLE_SIZE,
+        };
+        // Segments: the most whole blocks one binding may cover.
+        let seg = (ctx.max_storage_range() / 4 / BLOCK).max(1) * BLOCK;
+        let dispatch = |p: &ComputePipeline, flags: u32| {
+            for s in 0..n.div_ceil(seg) {
+                let (start, len) = (s * seg, seg.min(n - s * seg));
+                let push = ScanPush {
+                    n: len as u32,
+                    base: (start / chunk) as u32,
+                    flags,
+                };
+                let (i, o) = (range(input, start, len), range(output, start, len));
+                let groups = len.div_ceil(chunk).div_ceil(WG as u64);
+                p.dispatch_groups(ctx, cmd, &[i, i, o, o, sums], &push, groups);
+            }
+        };
+        dispatch(&self.chunk_reduce, 0);
         ctx.compute_barrier(cmd);
+        let next = scratch.levels[level].raw;
+        let chunks = n.div_ceil(chunk);
         self.level(
             ctx,
             cmd,
-            sums,
-            sums,
-            n.div_ceil(BLOCK),
+            next,
+            next,
+            chunks,
             ScanKind::Exclusive,
             scratch,
             level + 1,
         );
         ctx.compute_barrier(cmd);
-        for (start, len) in segments {
-            let push = ScanPush {
-                n: len as u32,
-                block_base: (start / BLOCK) as u32,
-                flags: inclusive | HAS_OFFSETS,
-            };
-            let infos = [
-                range(input, start, len),
-                range(output, start, len),
-                whole(sums),
-            ];
-            self.block
-                .dispatch_groups(ctx, cmd, &infos, &push, len.div_ceil(BLOCK));
-        }
+        dispatch(&self.chunk_down, inclusive);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        self.reduce.destroy(ctx);
-        self.block.destroy(ctx);
+        self.chunk_reduce.destroy(ctx);
+        self.chunk_down.destroy(ctx);
+        self.top.destroy(ctx);
     }
 }

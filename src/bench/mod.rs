@@ -1,0 +1,243 @@
+//! `fluidform bench <what>`: warm-up, timed repetitions, per-pass GPU ms in the output
+//! contract (timings.csv + summary.json per configuration) and a sweep table
+//! (sweep.csv + sweep.md) when several configurations run.
+pub mod primitives;
+
+use crate::config::Switches;
+use crate::error::{Error, Result};
+use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler};
+use crate::report::{stat, Report, Stat};
+use ash::vk;
+use serde_json::{json, Value};
+use std::path::PathBuf;
+
+pub struct BenchOptions {
+    pub what: String,
+    pub out: PathBuf,
+    /// Timed repetitions per configuration.
+    pub frames: u64,
+    pub warmup: u64,
+    pub switches: Switches,
+}
+
+pub const WHATS: &[&str] = &["scan", "sort", "neighbors"];
+
+/// Default particle counts of a sweep: 8K ... 256K and 1M.
+pub const SWEEP: &[u32] = &[
+    8 << 10,
+    16 << 10,
+    32 << 10,
+    64 << 10,
+    128 << 10,
+    256 << 10,
+    1 << 20,
+];
+
+/// One measured configuration: a row of the sweep table.
+pub struct Row {
+    pub variant: String,
+    pub n: u64,
+    /// The headline scope (e.g. "sort") over the timed frames.
+    pub main: Stat,
+    pub passes: Vec<(String, Stat)>,
+    pub extra: Vec<(String, String)>,
+}
+
+pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
+    if opts.frames == 0 {
+        return Err(Error::Param("--frames must be at least 1".into()));
+    }
+    let sw = &opts.switches;
+    let ctx = Context::new(&ContextOptions {
+        device: sw.device.clone(),
+        validation: sw.validation,
+    })?;
+    let rows = match opts.what.as_str() {
+        "scan" => {
+            sw.reject_unimplemented("bench scan", &[])?;
+            primitives::scan(&ctx, opts)?
+        }
+        "sort" => {
+            sw.reject_unimplemented("bench sort", &["sort"])?;
+            primitives::sort(&ctx, opts)?
+        }
+        "neighbors" => {
+            sw.reject_unimplemented("bench neighbors", &["sort", "neighbors"])?;
+            primitives::neighbors(&ctx, opts)?
+        }
+        "sph" | "render" => {
+            return Err(Error::Unsupported(format!(
+                "bench {} is not implemented yet: it arrives with the {} issue",
+                opts.what,
+                if opts.what == "sph" {
+                    "SPH (4)"
+                } else {
+                    "metaball renderer (5)"
+                }
+            )))
+        }
+        other => {
+            return Err(Error::Param(format!(
+                "unknown benchmark '{other}' (one of: {})",
+                WHATS.join(", ")
+            )))
+        }
+    };
+    write_sweep(&ctx, opts, &rows)?;
+    crate::run::check_validation(&ctx)?;
+    Ok(rows)
+}
+
+/// Particle counts to measure: --particles, or the default sweep.
+pub fn counts(opts: &BenchOptions) -> Vec<u32> {
+    match opts.switches.particles {
+        Some(n) => vec![n],
+        None => SWEEP.to_vec(),
+    }
+}
+
+/// Run `warmup + frames` frames of `record`, keep the timed ones, write the per-config
+/// outputs under out/runs/<label>/ and return the row.
+#[allow(clippy::too_many_arguments)]
+pub fn measure(
+    ctx: &Context,
+    opts: &BenchOptions,
+    variant: &str,
+    n: u64,
+    main_scope: &str,
+    config: Value,
+    mut record: impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
+) -> Result<Row> {
+    let mut frames = FrameLoop::new(ctx, 2, 64)?;
+    let total = opts.warmup + opts.frames;
+    let r = frames.run(
+        ctx,
+        total,
+        |prof, cmd, _, _| record(prof, cmd),
+        |_, _| Ok(()),
+    );
+    let mut timings: Vec<FrameTiming> = std::mem::take(&mut frames.profiler.results);
+    frames.destroy(ctx);
+    r?;
+    timings.retain(|t| t.frame >= opts.warmup);
+    for t in &mut timings {
+        t.frame -= opts.warmup;
+    }
+    let label = format!("{variant}-{n}");
+    let report = Report {
+        device: &ctx.info,
+        config: json!({
+            "command": "bench",
+            "what": opts.what,
+            "variant": variant,
+            "n": n,
+            "frames": opts.frames,
+            "warmup": opts.warmup,
+            "switches": opts.switches,
+            "detail": config,
+        }),
+        timings: &timings,
+        memory: ctx.memory_bytes(),
+        stats: json!({}),
+        validation: opts.switches.validation.then(|| ctx.validation_counts()),
+    };
+    report.write(&opts.out.join("runs").join(&label))?;
+    let passes = crate::report::pass_stats(&timings);
+    let main = passes
+        .iter()
+        .find(|(name, _)| name == main_scope)
+        .map(|(_, s)| *s)
+        .or_else(|| stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>()))
+        .ok_or_else(|| Error::Param("no timed frames".into()))?;
+    eprintln!(
+        "{:<24} n = {:>9}  {main_scope} median {:9.3} ms (min {:.3}, max {:.3})",
+        variant, n, main.median, main.min, main.max
+    );
+    Ok(Row {
+        variant: variant.to_string(),
+        n,
+        main,
+        passes,
+        extra: Vec::new(),
+    })
+}
+
+fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row]) -> Result<()> {
+    let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
+        path: p.display().to_string(),
+        source: e,
+    };
+    std::fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
+    let mut pass_names: Vec<String> = Vec::new();
+    let mut extra_names: Vec<String> = Vec::new();
+    for r in rows {
+        for (p, _) in &r.passes {
+            if !pass_names.contains(p) {
+                pass_names.push(p.clone());
+            }
+        }
+        for (k, _) in &r.extra {
+            if !extra_names.contains(k) {
+                extra_names.push(k.clone());
+            }
+        }
+    }
+    let mut csv = String::from("variant,n,median_ms,min_ms,max_ms,ns_per_element");
+    let mut md =
+        format!(
+        "| variant | N | median ms | min | max | ns/element |{}{}\n|---|---|---|---|---|---|{}{}\n",
+        pass_names.iter().map(|p| format!(" {p} ms |")).collect::<String>(),
+        extra_names.iter().map(|p| format!(" {p} |")).collect::<String>(),
+        "---|".repeat(pass_names.len()),
+        "---|".repeat(extra_names.len()),
+    );
+    for p in &pass_names {
+        csv.push_str(&format!(",{p}_ms"));
+    }
+    for k in &extra_names {
+        csv.push_str(&format!(",{k}"));
+    }
+    csv.push('\n');
+    for r in rows {
+        let per = r.main.median * 1e6 / r.n.max(1) as f64;
+        csv.push_str(&format!(
+            "{},{},{:.6},{:.6},{:.6},{:.4}",
+            r.variant, r.n, r.main.median, r.main.min, r.main.max, per
+        ));
+        md.push_str(&format!(
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.2} |",
+            r.variant, r.n, r.main.median, r.main.min, r.main.max, per
+        ));
+        for p in &pass_names {
+            let v = r.passes.iter().find(|(n, _)| n == p).map(|(_, s)| s.median);
+            csv.push_str(&format!(
+                ",{}",
+                v.map(|v| format!("{v:.6}")).unwrap_or_default()
+            ));
+            md.push_str(&format!(
+                " {} |",
+                v.map(|v| format!("{v:.3}")).unwrap_or("-".into())
+            ));
+        }
+        for k in &extra_names {
+            let v = r
+                .extra
+                .iter()
+                .find(|(n, _)| n == k)
+                .map(|(_, s)| s.as_str());
+            csv.push_str(&format!(",{}", v.unwrap_or("")));
+            md.push_str(&format!(" {} |", v.unwrap_or("-")));
+        }
+        csv.push('\n');
+        md.push('\n');
+    }
+    md.push_str(&format!(
+        "\nDevice: {} ({}, {}, Vulkan {}). {} timed repetitions after {} warm-up; GPU timestamps.\n",
+        ctx.info.name, ctx.info.kind, ctx.info.driver, ctx.info.api, opts.frames, opts.warmup
+    ));
+    let p = opts.out.join("sweep.csv");
+    std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
+    let p = opts.out.join("sweep.md");
+    std::fs::write(&p, md).map_err(|e| io(&p, e))?;
+    Ok(())
+}

@@ -1,0 +1,251 @@
+//! Benchmarks of the GPU primitives: scan (against a buffer copy), sorts, neighbours.
+use super::{counts, measure, BenchOptions, Row};
+use crate::config::{Neighbors, SortAlgo};
+use crate::error::Result;
+use crate::gpu::{Buffer, Context};
+use crate::primitives::counting::{CountingBuffers, CountingSort};
+use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
+use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
+use crate::primitives::sort::{Network, NetworkSort};
+use ash::vk;
+use rand::{Rng, SeedableRng};
+use serde_json::json;
+
+fn copy(ctx: &Context, cmd: vk::CommandBuffer, src: &Buffer, dst: &Buffer, bytes: u64) {
+    let region = vk::BufferCopy {
+        src_offset: 0,
+        dst_offset: 0,
+        size: bytes,
+    };
+    unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[region]) };
+}
+
+fn upload(ctx: &Context, name: &str, data: &[u32]) -> Result<Buffer> {
+    let mut b = ctx.storage_buffer(name, (data.len().max(1) * 4) as u64)?;
+    ctx.upload(&mut b, 0, data)?;
+    Ok(b)
+}
+
+/// Exclusive scan of N u32 beside a plain copy of the same bytes, in the same frame.
+pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let mut ns = counts(opts);
+    if opts.switches.particles.is_none() {
+        ns.push(16 << 20);
+    }
+    let mut pass = ScanPass::new(ctx, ScanVariant::Auto)?;
+    let variant = if pass.uses_subgroups {
+        "scan-subgroup"
+    } else {
+        "scan-shared"
+    };
+    let mut rows = Vec::new();
+    for n in ns {
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(opts.switches.seed);
+        let data: Vec<u32> = (0..n).map(|_| rng.random_range(0..16)).collect();
+        let mut input = upload(ctx, "bench scan input", &data)?;
+        let mut output = ctx.storage_buffer("bench scan output", n as u64 * 4)?;
+        let mut copied = ctx.storage_buffer("bench copy output", n as u64 * 4)?;
+        let mut scratch = pass.scratch(ctx, n as u64)?;
+        let bytes = n as u64 * 4;
+        let row = measure(
+            ctx,
+            opts,
+            variant,
+            n as u64,
+            "scan",
+            json!({}),
+            |prof, cmd| {
+                prof.begin(ctx, cmd, "scan");
+                pass.record(
+                    ctx,
+                    cmd,
+                    &input,
+                    &output,
+                    n as u64,
+                    ScanKind::Exclusive,
+                    &scratch,
+                )?;
+                prof.end(ctx, cmd);
+                ctx.barrier(cmd);
+                prof.begin(ctx, cmd, "copy");
+                copy(ctx, cmd, &input, &copied, bytes);
+                prof.end(ctx, cmd);
+                ctx.barrier(cmd);
+                Ok(())
+            },
+        );
+        scratch.destroy(ctx);
+        for b in [&mut input, &mut output, &mut copied] {
+            ctx.destroy_buffer(b);
+        }
+        let mut row = row?;
+        let copy_ms = row
+            .passes
+            .iter()
+            .find(|(p, _)| p == "copy")
+            .map(|(_, s)| s.median)
+            .unwrap_or(f64::NAN);
+        // Both move 2 * bytes (read + write); bandwidth = 2 * bytes / time.
+        let gbs = |ms: f64| 2.0 * bytes as f64 / (ms * 1e6);
+        row.extra = vec![
+            ("scan GB/s".into(), format!("{:.2}", gbs(row.main.median))),
+            ("copy GB/s".into(), format!("{:.2}", gbs(copy_ms))),
+            (
+                "scan/copy bandwidth".into(),
+                format!("{:.0}%", 100.0 * copy_ms / row.main.median),
+            ),
+        ];
+        rows.push(row);
+    }
+    pass.destroy(ctx);
+    Ok(rows)
+}
+
+/// Grid-cell keys of N random particles, about four per cell (the neighbour-search load).
+fn cell_keys(n: u32, seed: u64) -> (Vec<u32>, u32) {
+    let side = ((n as f64 / 4.0).cbrt().round() as u32).max(1);
+    let cells = side * side * side;
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    let keys = (0..n).map(|_| rng.random_range(0..cells)).collect();
+    (keys, cells)
+}
+
+pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let algos = match opts.switches.sort {
+        Some(s) => vec![s],
+        None => vec![SortAlgo::OddEven, SortAlgo::Bitonic, SortAlgo::Counting],
+    };
+    let mut rows = Vec::new();
+    for algo in algos {
+        let mut scan = ScanPass::new(ctx, ScanVariant::Auto)?;
+        let mut counting = CountingSort::new(ctx)?;
+        let mut network = match algo {
+            SortAlgo::OddEven => Some(NetworkSort::new(ctx, Network::OddEven)?),
+            SortAlgo::Bitonic => Some(NetworkSort::new(ctx, Network::Bitonic)?),
+            SortAlgo::Counting => None,
+        };
+        for n in counts(opts) {
+            let (keys, cells) = cell_keys(n, opts.switches.seed);
+            let vals: Vec<u32> = (0..n).collect();
+            let bytes = n as u64 * 4;
+            let mut pk = upload(ctx, "bench pristine keys", &keys)?;
+            let mut pv = upload(ctx, "bench pristine values", &vals)?;
+            let mut wk = ctx.storage_buffer("bench keys", bytes)?;
+            let mut wv = ctx.storage_buffer("bench values", bytes)?;
+            let mut sk = ctx.storage_buffer("bench sorted keys", bytes)?;
+            let mut sv = ctx.storage_buffer("bench sorted values", bytes)?;
+            let mut cb = CountingBuffers::new(ctx, &scan, n as u64, cells)?;
+            let detail = json!({ "cells": cells, "keys": "uniform random cell ids" });
+            let row = measure(
+                ctx,
+                opts,
+                &algo.as_str(),
+                n as u64,
+                "sort",
+                detail,
+                |prof, cmd| {
+                    prof.begin(ctx, cmd, "restore");
+                    copy(ctx, cmd, &pk, &wk, bytes);
+                    copy(ctx, cmd, &pv, &wv, bytes);
+                    prof.end(ctx, cmd);
+                    ctx.barrier(cmd);
+                    prof.begin(ctx, cmd, "sort");
+                    match &network {
+                        Some(s) => {
+                            s.record(ctx, cmd, &wk, &wv, n as u64)?;
+                        }
+                        None => {
+                            counting.record(ctx, cmd, &scan, &cb, &wk, &wv, &sk, &sv, n as u64)?
+                        }
+                    }
+                    prof.end(ctx, cmd);
+                    ctx.barrier(cmd);
+                    Ok(())
+                },
+            );
+            cb.destroy(ctx);
+            for b in [&mut pk, &mut pv, &mut wk, &mut wv, &mut sk, &mut sv] {
+                ctx.destroy_buffer(b);
+            }
+            rows.push(row?);
+        }
+        if let Some(s) = &mut network {
+            s.destroy(ctx);
+        }
+        counting.destroy(ctx);
+        scan.destroy(ctx);
+    }
+    Ok(rows)
+}
+
+/// Radius giving about `k` neighbours for n uniform points in the unit cube.
+pub fn radius_for(n: u32, k: f64) -> f32 {
+    (k / (n as f64 * 4.0 / 3.0 * std::f64::consts::PI)).cbrt() as f32
+}
+
+pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let sw = &opts.switches;
+    let combos: Vec<(Neighbors, SortAlgo)> = match sw.neighbors {
+        Some(s) => vec![(s, sw.sort.unwrap_or(default_sort(s)))],
+        None => vec![
+            (Neighbors::Grid, SortAlgo::Counting),
+            (Neighbors::Hash, SortAlgo::Bitonic),
+            (Neighbors::Hash, SortAlgo::OddEven),
+            (Neighbors::Morton, SortAlgo::OddEven),
+        ],
+    };
+    let max_nb = 64;
+    let mut rows = Vec::new();
+    for (strategy, sort) in combos {
+        let mut search = NeighborSearch::new(ctx, strategy, Some(sort))?;
+        for n in counts(opts) {
+            let radius = radius_for(n, 30.0);
+            let grid = GridSpec::covering([0.0; 3], [1.0; 3], radius)?;
+            let mut rng = rand_pcg::Pcg32::seed_from_u64(sw.seed);
+            let pos: Vec<[f32; 4]> = (0..n)
+                .map(|_| [rng.random(), rng.random(), rng.random(), 1.0])
+                .collect();
+            let mut p = ctx.storage_buffer("bench positions", n as u64 * 16)?;
+            ctx.upload(&mut p, 0, &pos)?;
+            let mut b = search.buffers(ctx, n as u64, &grid, max_nb)?;
+            let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
+            let detail = json!({ "radius": radius, "grid": grid.dims, "max_neighbors": max_nb });
+            let row = measure(
+                ctx,
+                opts,
+                &variant.replace('/', "-"),
+                n as u64,
+                "neighbors",
+                detail,
+                |prof, cmd| {
+                    prof.begin(ctx, cmd, "neighbors");
+                    search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
+                    search.record_query(ctx, cmd, prof, &b, n, &grid, radius)?;
+                    prof.end(ctx, cmd);
+                    ctx.barrier(cmd);
+                    Ok(())
+                },
+            );
+            let stats = row.as_ref().ok().map(|_| -> Result<(f64, f64)> {
+                let c: Vec<u32> = ctx.readback(&b.counts, 0, n as usize)?;
+                let v: Vec<u32> = ctx.readback(&b.visited, 0, n as usize)?;
+                let mean = |x: &[u32]| x.iter().map(|&a| a as f64).sum::<f64>() / n as f64;
+                Ok((mean(&c), mean(&v)))
+            });
+            b.destroy(ctx);
+            ctx.destroy_buffer(&mut p);
+            let mut row = row?;
+            row.variant = variant;
+            if let Some(s) = stats {
+                let (nb, visited) = s?;
+                row.extra = vec![
+                    ("mean neighbours".into(), format!("{nb:.1}")),
+                    ("mean candidates".into(), format!("{visited:.1}")),
+                ];
+            }
+            rows.push(row);
+        }
+        search.destroy(ctx);
+    }
+    Ok(rows)
+}
