@@ -47,9 +47,11 @@ fn buf(ctx: &Context, name: &str, data: &[u32]) -> fluidform::gpu::Buffer {
     b
 }
 
-fn check_scan(ctx: &Context, pass: &ScanPass, sizes: &[usize]) {
-    let max = *sizes.iter().max().unwrap() as u64;
-    let mut scratch = pass.scratch(ctx, max).unwrap();
+fn check_scan(
+            &ctx,
+            &pass,
+            &[0, 1, 2, 3, 31, 32, 33, 63, 64, 65, 1000, 4095, 4096, 4097, 65536, 262_145, 1_000_003, 4_194_305],
+        );
     for &n in sizes {
         for kind in [ScanKind::Exclusive, ScanKind::Inclusive] {
             // Random values (some large, so sums wrap) and all-ones.
