@@ -24,6 +24,12 @@ enum Command {
         /// Print JSON instead of text
         #[arg(long)]
         json: bool,
+        /// Print only the results/ folder name of the device `run` would pick
+        #[arg(long)]
+        slug: bool,
+        /// With --slug: the device to name (index or name substring)
+        #[arg(long)]
+        device: Option<String>,
     },
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
@@ -52,6 +58,9 @@ enum Command {
         /// Untimed warm-up repetitions
         #[arg(long, default_value_t = 5)]
         warmup: u64,
+        /// Seconds one configuration may take; slower ones get fewer repetitions (>= 3)
+        #[arg(long, default_value_t = 300.0)]
+        budget_s: f64,
         #[command(flatten)]
         switches: Switches,
     },
@@ -72,7 +81,17 @@ fn main() -> Result<()> {
         save_every: 1,
         switches: Switches::parse_default(),
     }) {
-        Command::Devices { json } => devices(json),
+        Command::Devices { json, slug, device } => {
+            if slug {
+                let ctx = fluidform::gpu::Context::new(&fluidform::gpu::ContextOptions {
+                    device,
+                    validation: false,
+                })?;
+                println!("{}", ctx.info.slug());
+                return Ok(());
+            }
+            devices(json)
+        }
         Command::Run {
             scene,
             frames,
@@ -95,6 +114,7 @@ fn main() -> Result<()> {
             out,
             frames,
             warmup,
+            budget_s,
             switches,
         } => {
             let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
@@ -102,6 +122,7 @@ fn main() -> Result<()> {
                 out: out.clone(),
                 frames,
                 warmup,
+                budget_s,
                 switches,
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);

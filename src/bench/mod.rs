@@ -17,6 +17,9 @@ pub struct BenchOptions {
     /// Timed repetitions per configuration.
     pub frames: u64,
     pub warmup: u64,
+    /// Seconds of GPU time a configuration may take; slower ones get fewer repetitions
+    /// (at least 3), and the table reports how many each had.
+    pub budget_s: f64,
     pub switches: Switches,
 }
 
@@ -40,6 +43,8 @@ pub struct Row {
     /// The headline scope (e.g. "sort") over the timed frames.
     pub main: Stat,
     pub passes: Vec<(String, Stat)>,
+    /// Timed repetitions behind the statistics.
+    pub reps: u64,
     pub extra: Vec<(String, String)>,
 }
 
@@ -83,7 +88,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
             )))
         }
     };
-    write_sweep(&ctx, opts, &rows)?;
+    let notes = primitives::notes(&opts.what, &rows);
+    write_sweep(&ctx, opts, &rows, &notes)?;
     crate::run::check_validation(&ctx)?;
     Ok(rows)
 }
@@ -108,20 +114,23 @@ pub fn measure(
     config: Value,
     mut record: impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
 ) -> Result<Row> {
-    let mut frames = FrameLoop::new(ctx, 2, 64)?;
-    let total = opts.warmup + opts.frames;
-    let r = frames.run(
-        ctx,
-        total,
-        |prof, cmd, _, _| record(prof, cmd),
-        |_, _| Ok(()),
-    );
-    let mut timings: Vec<FrameTiming> = std::mem::take(&mut frames.profiler.results);
-    frames.destroy(ctx);
-    r?;
-    timings.retain(|t| t.frame >= opts.warmup);
+    // One warm-up frame tells how long a repetition takes.
+    let first = run_frames(ctx, 1, &mut record)?;
+    let per_frame_s = first.iter().map(|t| t.frame_ms).sum::<f64>() / 1000.0;
+    let reps = if per_frame_s * opts.frames as f64 <= opts.budget_s {
+        opts.frames
+    } else {
+        ((opts.budget_s / per_frame_s.max(1e-9)) as u64).clamp(3, opts.frames)
+    };
+    let warmup = if per_frame_s * (opts.warmup as f64) < opts.budget_s / 10.0 {
+        opts.warmup.saturating_sub(1)
+    } else {
+        0
+    };
+    let mut timings = run_frames(ctx, warmup + reps, &mut record)?;
+    timings.retain(|t| t.frame >= warmup);
     for t in &mut timings {
-        t.frame -= opts.warmup;
+        t.frame -= warmup;
     }
     let label = format!("{variant}-{n}");
     let report = Report {
@@ -131,8 +140,8 @@ pub fn measure(
             "what": opts.what,
             "variant": variant,
             "n": n,
-            "frames": opts.frames,
-            "warmup": opts.warmup,
+            "frames": reps,
+            "warmup": warmup + 1,
             "switches": opts.switches,
             "detail": config,
         }),
@@ -150,7 +159,7 @@ pub fn measure(
         .or_else(|| stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>()))
         .ok_or_else(|| Error::Param("no timed frames".into()))?;
     eprintln!(
-        "{:<24} n = {:>9}  {main_scope} median {:9.3} ms (min {:.3}, max {:.3})",
+        "{:<24} n = {:>9}  {main_scope} median {:9.3} ms (min {:.3}, max {:.3}, {reps} reps)",
         variant, n, main.median, main.min, main.max
     );
     Ok(Row {
@@ -158,11 +167,29 @@ pub fn measure(
         n,
         main,
         passes,
+        reps,
         extra: Vec::new(),
     })
 }
 
-fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row]) -> Result<()> {
+fn run_frames(
+    ctx: &Context,
+    count: u64,
+    record: &mut impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
+) -> Result<Vec<FrameTiming>> {
+    let mut frames = FrameLoop::new(ctx, 2, 64)?;
+    let r = frames.run(
+        ctx,
+        count,
+        |prof, cmd, _, _| record(prof, cmd),
+        |_, _| Ok(()),
+    );
+    let timings = std::mem::take(&mut frames.profiler.results);
+    frames.destroy(ctx);
+    r.map(|_| timings)
+}
+
+fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {
     let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
         path: p.display().to_string(),
         source: e,
@@ -182,10 +209,10 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row]) -> Result<()> {
             }
         }
     }
-    let mut csv = String::from("variant,n,median_ms,min_ms,max_ms,ns_per_element");
+    let mut csv = String::from("variant,n,reps,median_ms,min_ms,max_ms,ns_per_element");
     let mut md =
         format!(
-        "| variant | N | median ms | min | max | ns/element |{}{}\n|---|---|---|---|---|---|{}{}\n",
+        "| variant | N | reps | median ms | min | max | ns/element |{}{}\n|---|---|---|---|---|---|---|{}{}\n",
         pass_names.iter().map(|p| format!(" {p} ms |")).collect::<String>(),
         extra_names.iter().map(|p| format!(" {p} |")).collect::<String>(),
         "---|".repeat(pass_names.len()),
@@ -201,12 +228,12 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row]) -> Result<()> {
     for r in rows {
         let per = r.main.median * 1e6 / r.n.max(1) as f64;
         csv.push_str(&format!(
-            "{},{},{:.6},{:.6},{:.6},{:.4}",
-            r.variant, r.n, r.main.median, r.main.min, r.main.max, per
+            "{},{},{},{:.6},{:.6},{:.6},{:.4}",
+            r.variant, r.n, r.reps, r.main.median, r.main.min, r.main.max, per
         ));
         md.push_str(&format!(
-            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.2} |",
-            r.variant, r.n, r.main.median, r.main.min, r.main.max, per
+            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} |",
+            r.variant, r.n, r.reps, r.main.median, r.main.min, r.main.max, per
         ));
         for p in &pass_names {
             let v = r.passes.iter().find(|(n, _)| n == p).map(|(_, s)| s.median);
@@ -232,9 +259,19 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row]) -> Result<()> {
         md.push('\n');
     }
     md.push_str(&format!(
-        "\nDevice: {} ({}, {}, Vulkan {}). {} timed repetitions after {} warm-up; GPU timestamps.\n",
-        ctx.info.name, ctx.info.kind, ctx.info.driver, ctx.info.api, opts.frames, opts.warmup
+        "\nDevice: {} ({}, {}, Vulkan {}). Up to {} timed repetitions after {} warm-up, fewer \
+         (reps column) where they would exceed {} s; medians of GPU timestamp scopes.\n\n",
+        ctx.info.name,
+        ctx.info.kind,
+        ctx.info.driver,
+        ctx.info.api,
+        opts.frames,
+        opts.warmup,
+        opts.budget_s
     ));
+    for n in notes {
+        md.push_str(&format!("- {n}\n"));
+    }
     let p = opts.out.join("sweep.csv");
     std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
     let p = opts.out.join("sweep.md");

@@ -249,3 +249,77 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     }
     Ok(rows)
 }
+
+/// Ratios the speed targets ask for, computed from the rows measured together.
+pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
+    let ms = |v: &str, n: u64| {
+        rows.iter()
+            .find(|r| r.variant == v && r.n == n)
+            .map(|r| r.main.median)
+    };
+    let growth = |v: &str| match (ms(v, 8 << 10), ms(v, 64 << 10)) {
+        (Some(a), Some(b)) => Some(format!(
+            "{v}: {:.1}x from 8K to 64K (8x the elements)",
+            b / a
+        )),
+        _ => None,
+    };
+    let mut out = Vec::new();
+    match what {
+        "sort" => {
+            if let (Some(o), Some(c)) = (ms("odd-even", 64 << 10), ms("counting", 64 << 10)) {
+                out.push(format!(
+                    "counting sort is {:.1}x faster than odd-even merge sort at 64K (target: 20x)",
+                    o / c
+                ));
+            }
+            if let (Some(b), Some(c)) = (ms("bitonic", 64 << 10), ms("counting", 64 << 10)) {
+                out.push(format!(
+                    "counting sort is {:.1}x faster than bitonic sort at 64K",
+                    b / c
+                ));
+            }
+            out.extend(
+                ["counting", "odd-even", "bitonic"]
+                    .iter()
+                    .filter_map(|v| growth(v)),
+            );
+            if out.iter().any(|l| l.starts_with("counting:")) {
+                out.push("target: counting grows at most 10x from 8K to 64K".into());
+            }
+        }
+        "neighbors" => {
+            for v in [
+                "grid/counting",
+                "hash/bitonic",
+                "hash/odd-even",
+                "morton/odd-even",
+            ] {
+                if let (Some(a), Some(b)) = (ms(v, 8 << 10), ms(v, 1 << 20)) {
+                    out.push(format!(
+                        "{v}: cost per particle at 1M is {:.2}x that at 8K",
+                        (b / (1 << 20) as f64) / (a / (8 << 10) as f64)
+                    ));
+                }
+            }
+            if let (Some(g), Some(m)) = (
+                ms("grid/counting", 64 << 10),
+                ms("morton/odd-even", 64 << 10),
+            ) {
+                out.push(format!(
+                    "grid/counting is {:.1}x faster than morton/odd-even at 64K",
+                    m / g
+                ));
+            }
+        }
+        "scan" => {
+            for r in rows.iter().filter(|r| r.n == 16 << 20) {
+                if let Some((_, v)) = r.extra.iter().find(|(k, _)| k == "scan/copy bandwidth") {
+                    out.push(format!("scan of 16M u32 reaches {v} of the copy bandwidth measured in the same frames (target: 30% lavapipe, 50% GPU)"));
+                }
+            }
+        }
+        _ => {}
+    }
+    out
+}
