@@ -9,5 +9,6 @@ pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod sph;
 
 pub use error::{Error, Result};

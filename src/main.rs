@@ -33,11 +33,12 @@ enum Command {
     },
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
-        /// Built-in scene name
+        /// Built-in scene (dam-break, drop, resting-block, orbits) or a TOML scene file
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: String,
-        #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..))]
-        frames: u64,
+        /// Frames to play (default: the scene's own count)
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        frames: Option<u64>,
         #[arg(long, default_value = "out/run")]
         out: PathBuf,
         /// Save every k-th frame as frame_NNNN.png (0: none)
@@ -76,7 +77,7 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command.unwrap_or(Command::Run {
         scene: DEFAULT_SCENE.into(),
-        frames: 120,
+        frames: None,
         out: "out/run".into(),
         save_every: 1,
         switches: Switches::parse_default(),

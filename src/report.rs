@@ -97,6 +97,19 @@ impl Report<'_> {
             "memory_bytes": self.memory,
             "stats": self.stats,
         });
+        if self.device.name.contains("llvmpipe")
+            && self
+                .timings
+                .iter()
+                .any(|t| t.passes.iter().any(|(n, _)| n == "draw"))
+        {
+            // Measured here: once a framebuffer is bound, llvmpipe resolves some later
+            // timestamps inside its rasterizer scene, so compute scopes of frames after a
+            // draw can read near zero while frame_ms stays right.
+            v["timing_caveat"] = json!(
+                "llvmpipe: per-pass compute times after a draw are unreliable (frame_ms is right); use `fluidform bench` for per-pass times"
+            );
+        }
         if let Some((errors, warnings)) = self.validation {
             v["validation"] = json!({ "errors": errors, "warnings": warnings });
         }

@@ -13,15 +13,15 @@ pub const SLOTS: usize = 2;
 
 pub struct RunOptions {
     pub scene: String,
-    pub frames: u64,
+    /// Frames to play; None: the scene's own count (orbits: 120).
+    pub frames: Option<u64>,
     pub out: PathBuf,
     /// Save every k-th frame as PNG; 0 saves none.
     pub save_every: u64,
     pub switches: Switches,
 }
 
-pub const SCENES: &[&str] = &["orbits"];
-pub const DEFAULT_SCENE: &str = "orbits";
+pub const DEFAULT_SCENE: &str = "dam-break";
 
 /// The run's outcome: the summary written and the validation counts.
 pub struct RunResult {
@@ -30,32 +30,33 @@ pub struct RunResult {
 }
 
 pub fn run(opts: &RunOptions) -> Result<RunResult> {
-    if opts.frames == 0 {
+    if opts.frames == Some(0) {
         return Err(Error::Param("--frames must be at least 1".into()));
     }
-    if opts.scene != "orbits" {
-        let hint = if opts.scene.ends_with(".toml") {
-            "scene files arrive with the SPH scenes (issue 4)".to_string()
-        } else {
-            format!("built-in scenes: {}", SCENES.join(", "))
-        };
-        return Err(Error::Param(format!(
-            "unknown scene '{}': {hint}",
-            opts.scene
-        )));
-    }
-    let sw = &opts.switches;
-    sw.reject_unimplemented("the orbits scene", &[])?;
-    let ctx = Context::new(&ContextOptions {
-        device: sw.device.clone(),
-        validation: sw.validation,
-    })?;
-    let particles = sw.particles.unwrap_or(4096);
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
         path: opts.out.display().to_string(),
         source: e,
     })?;
+    if opts.scene == "orbits" {
+        return run_orbits(opts);
+    }
+    let scene = crate::sph::Scene::load(&opts.scene)?;
+    run_sph(opts, scene)
+}
 
+fn open(sw: &Switches) -> Result<Context> {
+    Context::new(&ContextOptions {
+        device: sw.device.clone(),
+        validation: sw.validation,
+    })
+}
+
+fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
+    let sw = &opts.switches;
+    sw.reject_unimplemented("the orbits scene", &[])?;
+    let ctx = open(sw)?;
+    let particles = sw.particles.unwrap_or(4096);
+    let frame_count = opts.frames.unwrap_or(120);
     let state = orbits::initial_state(particles as usize, sw.seed);
     let mut pass = OrbitsPass::new(&ctx)?;
     let mut view = PointsView::new(&ctx)?;
@@ -70,11 +71,11 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
     );
     let push = PointsPush::from_camera(&cam, 1.0);
     let memory = ctx.memory_bytes();
-    let save = |f: u64| opts.save_every > 0 && f % opts.save_every == 0;
+    let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
     let mut pngs = Vec::new();
     let result = frames.run(
         &ctx,
-        opts.frames,
+        frame_count,
         |prof, cmd, frame, slot| {
             prof.begin(&ctx, cmd, OrbitsPass::NAME);
             pass.step(&ctx, cmd, &scene, 1.0 / 120.0);
@@ -113,7 +114,7 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
     let config = json!({
         "command": "run",
         "scene": opts.scene,
-        "frames": opts.frames,
+        "frames": frame_count,
         "save_every": opts.save_every,
         "particles": particles,
         "switches": sw,
@@ -144,4 +145,123 @@ pub fn check_validation(ctx: &Context) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
+    use crate::config::Neighbors;
+    use crate::sph::run::{check, physics_stats, Stepper};
+    use crate::sph::SphSolver;
+    let sw = &opts.switches;
+    sw.reject_unimplemented("SPH scenes", &["sort", "neighbors"])?;
+    let scene = match sw.particles {
+        Some(n) => scene.with_particles(n),
+        None => scene,
+    };
+    let frame_count = opts.frames.unwrap_or(scene.frames);
+    let ctx = open(sw)?;
+    let neighbors = sw.neighbors.unwrap_or(Neighbors::Grid);
+    let mut solver = SphSolver::new(&ctx, neighbors, sw.sort)?;
+    let parts = scene.particles(sw.seed);
+    let mut st = solver.state(&ctx, &scene, &parts)?;
+    let mut view = PointsView::new(&ctx)?;
+    let mut target = ColorTarget::new(&ctx, sw.width, sw.height, SLOTS)?;
+    // Scopes per step: arrange (keys, sort, ranges, reorder), density, forces, integrate.
+    let max_steps = match scene.fluid.cfl {
+        Some(_) => crate::sph::params::MAX_SUBSTEPS,
+        None => scene.fluid.substeps,
+    };
+    let mut frames = FrameLoop::new(&ctx, SLOTS, max_steps * 10 + 16)?;
+    let stepper = std::cell::RefCell::new(Stepper::new(&ctx, &st, SLOTS)?);
+    let aspect = sw.width as f32 / sw.height as f32;
+    let cam = match &scene.camera {
+        Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
+        None => {
+            let (lo, hi) = (
+                glam::Vec3::from(scene.domain.min),
+                glam::Vec3::from(scene.domain.max),
+            );
+            let c = 0.5 * (lo + hi);
+            Camera::look_at(
+                c + glam::Vec3::new(0.0, 0.4, 1.6) * (hi - lo).length(),
+                c,
+                45.0,
+                aspect,
+            )
+        }
+    };
+    // Spheres of half the rest spacing.
+    let push = PointsPush::from_camera(&cam, 0.5 * scene.fluid.spacing());
+    let memory = ctx.memory_bytes();
+    let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
+    let mut pngs = Vec::new();
+    let result = frames.run(
+        &ctx,
+        frame_count,
+        |prof, cmd, frame, slot| {
+            stepper
+                .borrow_mut()
+                .record_frame(&ctx, cmd, prof, &solver, &mut st, slot)?;
+            prof.begin(&ctx, cmd, PointsView::NAME);
+            target.begin_rendering(&ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
+            view.draw(&ctx, cmd, st.pos(), st.attr(), st.n, &push);
+            target.end_rendering(&ctx, cmd);
+            prof.end(&ctx, cmd);
+            if save(frame) {
+                prof.begin(&ctx, cmd, "readback");
+                target.copy_out(&ctx, cmd, slot);
+                prof.end(&ctx, cmd);
+            }
+            Ok(())
+        },
+        |frame, slot| {
+            stepper.borrow_mut().retire_slot(slot);
+            if save(frame) {
+                let path = opts.out.join(format!("frame_{frame:04}.png"));
+                target.save_png(slot, &path)?;
+                pngs.push(path);
+            }
+            Ok(())
+        },
+    );
+    let timings = std::mem::take(&mut frames.profiler.results);
+    let dump = if result.is_ok() {
+        Some(st.read(&ctx))
+    } else {
+        None
+    };
+    let mut stepper = stepper.into_inner();
+    let (steps, sim_time) = (stepper.steps_taken, stepper.sim_time);
+    stepper.destroy(&ctx);
+    frames.destroy(&ctx);
+    target.destroy(&ctx);
+    view.destroy(&ctx);
+    st.destroy(&ctx);
+    solver.destroy(&ctx);
+    result?;
+    let mut stats = physics_stats(&dump.expect("state read")?, &scene);
+    stats["steps"] = json!(steps);
+    stats["simulated_seconds"] = json!(sim_time);
+    let config = json!({
+        "command": "run",
+        "scene": scene.name,
+        "frames": frame_count,
+        "save_every": opts.save_every,
+        "particles": stats["particles"],
+        "neighbors": neighbors.as_str(),
+        "sort": solver.search.sort.as_str(),
+        "fluid": scene.fluid,
+        "switches": sw,
+    });
+    let report = Report {
+        device: &ctx.info,
+        config,
+        timings: &timings,
+        memory,
+        stats: stats.clone(),
+        validation: sw.validation.then(|| ctx.validation_counts()),
+    };
+    let summary = report.write(&opts.out)?;
+    check_validation(&ctx)?;
+    check(&stats)?;
+    Ok(RunResult { summary, pngs })
 }

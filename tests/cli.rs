@@ -46,6 +46,8 @@ fn run_writes_frames_timings_and_summary() {
     let out = dir.path().join("run");
     let o = fluidform(&[
         "run",
+        "--scene",
+        "orbits",
         "--frames",
         "3",
         "--out",
@@ -177,5 +179,131 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
         assert!(!o.status.success(), "{args:?} succeeded: {t}");
         assert!(t.contains(needle), "{args:?}: {t}");
         assert!(!t.contains("panicked"), "{args:?}: {t}");
+    }
+}
+
+fn summary(dir: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn run_sph_scenes_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, neighbors) in [
+        ("dam-break", "grid"),
+        ("drop", "hash"),
+        ("resting-block", "morton"),
+    ] {
+        let out = dir.path().join(scene);
+        let o = fluidform(&[
+            "run",
+            "--scene",
+            scene,
+            "--particles",
+            "1500",
+            "--frames",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "--validation",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--neighbors",
+            neighbors,
+        ]);
+        assert!(o.status.success(), "{scene}: {}", text(&o));
+        assert!(out.join("frame_0001.png").exists());
+        let s = summary(&out);
+        assert_eq!(s["validation"]["errors"], 0);
+        assert_eq!(s["stats"]["nan"], 0, "{scene}");
+        assert_eq!(s["stats"]["outside_domain"], 0, "{scene}");
+        assert!(s["stats"]["steps"].as_u64().unwrap() >= 2);
+        let rho = s["stats"]["density_mean_over_rest"].as_f64().unwrap();
+        assert!(
+            rho > 0.5 && rho < 1.5,
+            "{scene}: mean density / rho0 = {rho}"
+        );
+        for pass in ["arrange", "density", "forces", "integrate", "draw"] {
+            assert!(
+                s["pass_ms"][pass]["median"].as_f64().is_some(),
+                "{scene}: pass {pass}"
+            );
+        }
+        assert_eq!(s["config"]["neighbors"], neighbors);
+    }
+}
+
+#[test]
+fn run_scene_file_with_colliders() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/scenes/obstacles.toml");
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        scene,
+        "--frames",
+        "3",
+        "--save-every",
+        "0",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--validation",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(dir.path());
+    assert_eq!(s["config"]["scene"], "obstacles");
+    assert_eq!(s["stats"]["outside_domain"], 0);
+    assert!(
+        !dir.path().join("frame_0000.png").exists(),
+        "--save-every 0 saves no frames"
+    );
+}
+
+#[test]
+fn bench_smoke_writes_sweep_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    for (what, extra) in [
+        ("scan", vec![]),
+        ("sort", vec![]),
+        ("neighbors", vec!["--neighbors", "hash"]),
+        ("sph", vec!["--neighbors", "grid"]),
+    ] {
+        let out = dir.path().join(what);
+        let mut args = vec![
+            "bench",
+            what,
+            "--particles",
+            "3000",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--validation",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = fluidform(&args);
+        assert!(o.status.success(), "{what}: {}", text(&o));
+        let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+        let rows: Vec<&str> = csv.lines().collect();
+        assert!(
+            rows[0].starts_with("variant,n,reps,median_ms"),
+            "{what}: {}",
+            rows[0]
+        );
+        assert!(rows.len() >= 2, "{what}: no rows");
+        for r in &rows[1..] {
+            let cols: Vec<&str> = r.split(',').collect();
+            assert_eq!(cols[2], "3", "{what}: reps");
+            let ms: f64 = cols[3].parse().unwrap();
+            assert!(ms > 0.0 && ms.is_finite(), "{what}: {r}");
+        }
+        let md = std::fs::read_to_string(out.join("sweep.md")).unwrap();
+        assert!(md.contains("| variant | N | reps |"), "{what}");
+        let runs: Vec<_> = std::fs::read_dir(out.join("runs")).unwrap().collect();
+        assert_eq!(runs.len(), rows.len() - 1, "{what}: one summary per row");
     }
 }

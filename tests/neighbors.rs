@@ -15,8 +15,8 @@ fn points(n: usize, seed: u64) -> Vec<[f32; 4]> {
     let mut v: Vec<[f32; 4]> = (0..n)
         .map(|_| [rng.random(), rng.random(), rng.random(), 1.0])
         .collect();
-    for i in 0..n / 50 {
-        v[i] = [
+    for p in v.iter_mut().take(n / 50) {
+        *p = [
             0.5 + rng.random::<f32>() * 0.02,
             0.5,
             0.5 + rng.random::<f32>() * 0.02,
@@ -65,7 +65,7 @@ fn check(ctx: &Context, strategy: Neighbors, sort: SortAlgo, c: &Case) {
     ctx.upload(&mut p, 0, pos).unwrap();
     ctx.one_shot(|cmd| {
         search.record_build(ctx, cmd, &mut Labels, &b, &p, n as u32, &grid)?;
-        search.record_query(ctx, cmd, &mut Labels, &b, n as u32, &grid, radius)
+        search.record_query(ctx, cmd, &mut Labels, &b, &p, n as u32, &grid, radius)
     })
     .unwrap()
     .unwrap();

@@ -11,6 +11,12 @@
 #define NB_GRID 0
 #define NB_HASH 1
 #define NB_MORTON 2
+#ifndef NB_STRATEGY
+#define NB_STRATEGY NB_GRID
+#endif
+#ifndef NB_CELL_COUNTS
+#define NB_CELL_COUNTS 0
+#endif
 #include "morton.glsl"
 
 ivec3 nb_cell_of(vec3 p) { return ivec3(floor((p - NB_ORIGIN) / NB_CELL)); }

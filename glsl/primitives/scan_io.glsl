@@ -2,6 +2,14 @@
 // while a run of elements is fully in range) and as uint[] (the array's tail).
 #ifndef PRIMITIVES_SCAN_IO_GLSL
 #define PRIMITIVES_SCAN_IO_GLSL
+// Defaults; src/primitives/scan.rs defines both (IPT elements per invocation of the top
+// level, CHUNK per invocation of a level pass; multiples of 4).
+#ifndef IPT
+#define IPT 16u
+#endif
+#ifndef CHUNK
+#define CHUNK 64u
+#endif
 layout(push_constant) uniform Push { uint n; uint base; uint flags; } pc;
 const uint INCLUSIVE = 1u, HAS_OFFSETS = 2u;
 layout(std430, binding = 0) readonly buffer In4 { uvec4 in4[]; };     // binding 0: input as uvec4

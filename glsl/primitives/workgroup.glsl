@@ -4,6 +4,9 @@
 // Both assume invocations are numbered in subgroup order (gl_LocalInvocationIndex).
 #ifndef PRIMITIVES_WORKGROUP_GLSL
 #define PRIMITIVES_WORKGROUP_GLSL
+#ifndef SUBGROUP
+#define SUBGROUP 0
+#endif
 #if SUBGROUP
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require

@@ -1,10 +1,10 @@
 #version 450
 // Particle view: one camera-facing quad per particle (6 vertices, no vertex buffer).
-layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };    // binding 0: xyz, w = radius
+layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };    // binding 0: xyz, w = radius or 0
 layout(std430, binding = 1) readonly buffer Col { vec4 color[]; };  // binding 1: rgba
 layout(push_constant) uniform Push {
     mat4 view_proj;
-    vec4 right;  // camera right in world space, w = radius scale
+    vec4 right;  // camera right in world space, w = radius scale (the radius when pos.w = 0)
     vec4 up;     // camera up in world space
 } pc;
 layout(location = 0) out vec2 uv;
@@ -14,7 +14,7 @@ const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
 void main() {
     vec4 p = pos[gl_InstanceIndex];
     vec2 c = corners[gl_VertexIndex];
-    float r = p.w * pc.right.w;
+    float r = (p.w > 0.0 ? p.w : 1.0) * pc.right.w;  // w: per-particle radius, or 0
     vec3 world = p.xyz + (c.x * pc.right.xyz + c.y * pc.up.xyz) * r;
     gl_Position = pc.view_proj * vec4(world, 1.0);
     uv = c;

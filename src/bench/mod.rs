@@ -2,6 +2,7 @@
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
 pub mod primitives;
+pub mod sph;
 
 use crate::config::Switches;
 use crate::error::{Error, Result};
@@ -23,7 +24,7 @@ pub struct BenchOptions {
     pub switches: Switches,
 }
 
-pub const WHATS: &[&str] = &["scan", "sort", "neighbors"];
+pub const WHATS: &[&str] = &["scan", "sort", "neighbors", "sph", "stability"];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
 pub const SWEEP: &[u32] = &[
@@ -70,17 +71,18 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
             sw.reject_unimplemented("bench neighbors", &["sort", "neighbors"])?;
             primitives::neighbors(&ctx, opts)?
         }
-        "sph" | "render" => {
-            return Err(Error::Unsupported(format!(
-                "bench {} is not implemented yet: it arrives with the {} issue",
-                opts.what,
-                if opts.what == "sph" {
-                    "SPH (4)"
-                } else {
-                    "metaball renderer (5)"
-                }
-            )))
+        "sph" => {
+            sw.reject_unimplemented("bench sph", &["sort", "neighbors"])?;
+            sph::steps(&ctx, opts)?
         }
+        "stability" => {
+            sw.reject_unimplemented("bench stability", &["sort", "neighbors"])?;
+            sph::stability(&ctx, opts)?
+        }
+        "render" => return Err(Error::Unsupported(
+            "bench render is not implemented yet: it arrives with the metaball renderer (issue 5)"
+                .into(),
+        )),
         other => {
             return Err(Error::Param(format!(
                 "unknown benchmark '{other}' (one of: {})",

@@ -220,7 +220,7 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 |prof, cmd| {
                     prof.begin(ctx, cmd, "neighbors");
                     search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
-                    search.record_query(ctx, cmd, prof, &b, n, &grid, radius)?;
+                    search.record_query(ctx, cmd, prof, &b, &p, n, &grid, radius)?;
                     prof.end(ctx, cmd);
                     ctx.barrier(cmd);
                     Ok(())
@@ -252,9 +252,11 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
 
 /// Ratios the speed targets ask for, computed from the rows measured together.
 pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
+    // The row of variant v whose N is nearest n (within 25%: scenes round particle counts).
     let ms = |v: &str, n: u64| {
         rows.iter()
-            .find(|r| r.variant == v && r.n == n)
+            .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
+            .min_by_key(|r| r.n.abs_diff(n))
             .map(|r| r.main.median)
     };
     let growth = |v: &str| match (ms(v, 8 << 10), ms(v, 64 << 10)) {
@@ -310,6 +312,26 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
                     "grid/counting is {:.1}x faster than morton/odd-even at 64K",
                     m / g
                 ));
+            }
+        }
+        "sph" => {
+            if let (Some(g), Some(m)) = (
+                ms("grid/counting", 64 << 10),
+                ms("morton/odd-even", 64 << 10),
+            ) {
+                out.push(format!(
+                    "grid/counting steps {:.1}x faster than morton/odd-even near 64K (target: 5x)",
+                    m / g
+                ));
+            }
+            for v in ["grid/counting", "hash/bitonic", "morton/odd-even"] {
+                let mine: Vec<&Row> = rows.iter().filter(|r| r.variant == v).collect();
+                if let (Some(a), Some(b)) = (mine.first(), mine.last()) {
+                    if a.n != b.n {
+                        let per = |r: &Row| r.main.median / r.n as f64;
+                        out.push(format!("{v}: cost per particle at {} is {:.2}x that at {} (grid target: within 2x)", b.n, per(b) / per(a), a.n));
+                    }
+                }
             }
         }
         "scan" => {

@@ -137,12 +137,19 @@ impl ShaderCompiler {
     }
 }
 
+/// `dir/rel` with "." and ".." resolved (paths stay inside glsl/).
 fn join(dir: &str, rel: &str) -> String {
-    if dir.is_empty() {
-        rel.to_string()
-    } else {
-        format!("{dir}/{rel}")
+    let mut parts: Vec<&str> = dir.split('/').filter(|p| !p.is_empty()).collect();
+    for p in rel.split('/') {
+        match p {
+            "" | "." => {}
+            ".." => {
+                parts.pop();
+            }
+            _ => parts.push(p),
+        }
     }
+    parts.join("/")
 }
 
 /// Turn glslang's "file:line: error: text" into an error naming file and line.

@@ -28,6 +28,7 @@ impl MortonPass {
     }
 
     /// keys[i] = Morton code of pos[i] in `bounds` (two vec4), vals[i] = i.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &Context,

@@ -3,7 +3,8 @@
 //! - hash: hashed cell keys (Teschner) sorted by a network sort (Le Grand's baseline);
 //! - morton: Morton codes in the GPU-reduced bounding box, odd-even sort, and a per-query
 //!   code range from the query box's corners (seed 000).
-//! Build: keys -> sort -> reorder positions -> cell ranges. Query: lists per particle.
+//!
+//! Build: keys -> sort -> cell ranges. Query: reorder positions, lists per particle.
 //! Other passes (SPH) iterate neighbours with glsl/primitives/neighbors.glsl and the
 //! same bindings via `defines()` and `cell_buffers()`.
 use super::bounds::{BoundsBuffers, BoundsPass};
@@ -301,7 +302,7 @@ impl NeighborSearch {
         }
     }
 
-    /// Record keys, sort, reordered positions and cell ranges for `n` positions (vec4).
+    /// Record keys, sort (b.sorted_keys, b.perm) and cell ranges for `n` positions (vec4).
     #[allow(clippy::too_many_arguments)]
     pub fn record_build(
         &self,
@@ -359,9 +360,6 @@ impl NeighborSearch {
         }
         scopes.end(ctx, cmd);
         ctx.compute_barrier(cmd);
-        scopes.begin(ctx, cmd, "reorder");
-        self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
-        scopes.end(ctx, cmd);
         if !counting && self.strategy != Neighbors::Morton {
             scopes.begin(ctx, cmd, "ranges");
             unsafe {
@@ -385,7 +383,7 @@ impl NeighborSearch {
     }
 
     /// Record the neighbour lists of all `n` particles within `radius` (<= grid.cell for
-    /// grid and hash).
+    /// grid and hash), after `record_build` on the same positions.
     #[allow(clippy::too_many_arguments)]
     pub fn record_query(
         &self,
@@ -393,6 +391,7 @@ impl NeighborSearch {
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         b: &NeighborBuffers,
+        pos: &Buffer,
         n: u32,
         grid: &GridSpec,
         radius: f32,
@@ -405,6 +404,10 @@ impl NeighborSearch {
         }
         let push = self.push(b, grid, radius, n);
         let (starts, ends) = b.cell_buffers();
+        scopes.begin(ctx, cmd, "reorder");
+        self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
+        scopes.end(ctx, cmd);
+        ctx.compute_barrier(cmd);
         scopes.begin(ctx, cmd, "query");
         self.query.dispatch(
             ctx,

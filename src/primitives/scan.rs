@@ -4,6 +4,7 @@
 //! - level pass 2: each invocation scans its chunk serially from its offset;
 //! - the top level (at most WG * IPT elements) is one workgroup: a workgroup scan with
 //!   subgroup arithmetic where the device has it, shared memory where it has not.
+//!
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
 use crate::error::{Error, Result};

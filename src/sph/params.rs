@@ -1,0 +1,368 @@
+//! Fluid parameters (Kelager 2006's water by default) and their GPU mirror.
+use crate::error::{Error, Result};
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+use std::f32::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Eos {
+    /// p = k (rho - rho_0) (Kelager's ideal-gas form).
+    Ideal,
+    /// p = B ((rho / rho_0)^gamma - 1), B = rho_0 c^2 / gamma (weakly compressible).
+    Tait,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FluidParams {
+    /// rho_0, kg/m^3
+    pub rest_density: f32,
+    /// Particle mass, kg
+    pub mass: f32,
+    /// mu, Pa s
+    pub viscosity: f32,
+    /// sigma, N/m
+    pub surface_tension: f32,
+    /// l: surface tension acts where |grad c| >= l
+    pub tension_threshold: f32,
+    /// k of the ideal-gas equation of state, J
+    pub stiffness: f32,
+    pub eos: Eos,
+    /// Tait: speed of sound c, m/s
+    pub sound_speed: f32,
+    /// Tait exponent
+    pub gamma: f32,
+    /// Clamp negative pressures to zero (no tensile attraction at the free surface)
+    pub clamp_negative_pressure: bool,
+    /// Support radius h, m
+    pub h: f32,
+    /// Time step, s
+    pub dt: f32,
+    /// Steps per frame: a frame advances dt * substeps
+    pub substeps: u32,
+    /// CFL number: when set, a step never exceeds cfl * h / max(c, v_max) (v_max from the
+    /// previous frame, c the speed of sound) and the frame takes more steps to keep its time
+    pub cfl: Option<f32>,
+    pub gravity: [f32; 3],
+    /// Normal velocity kept (reversed) at a wall, 0..1
+    pub restitution: f32,
+    /// Tangential velocity lost at a wall, 0..1
+    pub friction: f32,
+}
+
+impl Default for FluidParams {
+    fn default() -> Self {
+        Self {
+            rest_density: 998.29,
+            mass: 0.02,
+            viscosity: 3.5,
+            surface_tension: 0.0728,
+            tension_threshold: 7.065,
+            stiffness: 3.0,
+            eos: Eos::Ideal,
+            sound_speed: 20.0,
+            gamma: 7.0,
+            clamp_negative_pressure: false,
+            h: 0.0457,
+            dt: 0.01,
+            substeps: 1,
+            cfl: None,
+            gravity: [0.0, -9.82, 0.0],
+            restitution: 0.0,
+            friction: 0.0,
+        }
+    }
+}
+
+/// Most steps one frame may be split into.
+pub const MAX_SUBSTEPS: u32 = 1000;
+
+impl FluidParams {
+    pub fn validate(&self) -> Result<()> {
+        let positive = [
+            ("rest_density", self.rest_density),
+            ("mass", self.mass),
+            ("h", self.h),
+            ("dt", self.dt),
+            ("sound_speed", self.sound_speed),
+        ];
+        for (name, v) in positive {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(Error::Param(format!(
+                    "fluid.{name} must be positive, got {v}"
+                )));
+            }
+        }
+        let non_negative = [
+            ("viscosity", self.viscosity),
+            ("surface_tension", self.surface_tension),
+            ("tension_threshold", self.tension_threshold),
+            ("stiffness", self.stiffness),
+        ];
+        for (name, v) in non_negative {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(Error::Param(format!("fluid.{name} must be >= 0, got {v}")));
+            }
+        }
+        for (name, v) in [
+            ("restitution", self.restitution),
+            ("friction", self.friction),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(Error::Param(format!(
+                    "fluid.{name} must be in 0..=1, got {v}"
+                )));
+            }
+        }
+        if !(self.gamma >= 1.0 && self.gamma <= 10.0) {
+            return Err(Error::Param(format!(
+                "fluid.gamma must be in 1..=10, got {}",
+                self.gamma
+            )));
+        }
+        if self.substeps == 0 || self.substeps > MAX_SUBSTEPS {
+            return Err(Error::Param(format!(
+                "fluid.substeps must be in 1..={MAX_SUBSTEPS}, got {}",
+                self.substeps
+            )));
+        }
+        if let Some(c) = self.cfl {
+            if !(c > 0.0 && c <= 1.0) {
+                return Err(Error::Param(format!(
+                    "fluid.cfl must be in (0, 1], got {c}"
+                )));
+            }
+        }
+        if self.gravity.iter().any(|g| !g.is_finite()) {
+            return Err(Error::Param("fluid.gravity must be finite".into()));
+        }
+        Ok(())
+    }
+
+    /// Lattice spacing at rest density: (m / rho_0)^(1/3).
+    pub fn spacing(&self) -> f32 {
+        (self.mass / self.rest_density).cbrt()
+    }
+
+    /// The equation of state's stiffness constant (k, or Tait's B).
+    pub fn eos_constant(&self) -> f32 {
+        match self.eos {
+            Eos::Ideal => self.stiffness,
+            Eos::Tait => self.rest_density * self.sound_speed * self.sound_speed / self.gamma,
+        }
+    }
+
+    /// Speed of sound used by the CFL limit.
+    pub fn sound(&self) -> f32 {
+        match self.eos {
+            Eos::Ideal => self.stiffness.sqrt(),
+            Eos::Tait => self.sound_speed,
+        }
+    }
+}
+
+/// Mirror of `SphParams` in glsl/sph/common.glsl (std430).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SphGpuParams {
+    pub gravity: [f32; 4],
+    pub domain_min: [f32; 4],
+    pub domain_max: [f32; 4],
+    pub h: f32,
+    pub mass: f32,
+    pub rest_density: f32,
+    pub stiffness: f32,
+    pub viscosity: f32,
+    pub tension: f32,
+    pub tension_threshold: f32,
+    pub gamma: f32,
+    pub eos: u32,
+    pub clamp_negative: u32,
+    pub colliders: u32,
+    pub pad: u32,
+    pub poly6: f32,
+    pub poly6_grad: f32,
+    pub spiky_grad: f32,
+    pub visc_lap: f32,
+}
+const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 112);
+
+impl SphGpuParams {
+    pub fn new(f: &FluidParams, lo: [f32; 3], hi: [f32; 3], dt: f32, colliders: u32) -> Self {
+        let h = f.h;
+        Self {
+            gravity: [f.gravity[0], f.gravity[1], f.gravity[2], dt],
+            domain_min: [lo[0], lo[1], lo[2], f.restitution],
+            domain_max: [hi[0], hi[1], hi[2], f.friction],
+            h,
+            mass: f.mass,
+            rest_density: f.rest_density,
+            stiffness: f.eos_constant(),
+            viscosity: f.viscosity,
+            tension: f.surface_tension,
+            tension_threshold: f.tension_threshold,
+            gamma: f.gamma,
+            eos: (f.eos == Eos::Tait) as u32,
+            clamp_negative: f.clamp_negative_pressure as u32,
+            colliders,
+            pad: 0,
+            poly6: 315.0 / (64.0 * PI * h.powi(9)),
+            poly6_grad: -945.0 / (32.0 * PI * h.powi(9)),
+            spiky_grad: -45.0 / (PI * h.powi(6)),
+            visc_lap: 45.0 / (PI * h.powi(6)),
+        }
+    }
+}
+
+/// Mirror of `Collider` in glsl/sph/integrate.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuCollider {
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+    pub vel: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<GpuCollider>() == 48);
+
+/// Static or moving colliders; the fluid stays outside spheres and capsules and on the
+/// positive side of planes. Moving colliders carry their velocity for the response.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Collider {
+    Plane {
+        normal: [f32; 3],
+        offset: f32,
+        #[serde(default)]
+        velocity: [f32; 3],
+    },
+    Sphere {
+        center: [f32; 3],
+        radius: f32,
+        #[serde(default)]
+        velocity: [f32; 3],
+    },
+    Capsule {
+        a: [f32; 3],
+        b: [f32; 3],
+        radius: f32,
+        #[serde(default)]
+        velocity: [f32; 3],
+    },
+}
+
+/// Most colliders a scene may have.
+pub const MAX_COLLIDERS: usize = 64;
+
+impl Collider {
+    pub fn to_gpu(&self) -> Result<GpuCollider> {
+        let v = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
+        Ok(match self {
+            Collider::Plane {
+                normal,
+                offset,
+                velocity,
+            } => {
+                let n = glam::Vec3::from(*normal);
+                if n.length().is_nan() || n.length() <= 1e-6 {
+                    return Err(Error::Param(
+                        "plane collider: normal must be non-zero".into(),
+                    ));
+                }
+                let n = n.normalize();
+                GpuCollider {
+                    a: [n.x, n.y, n.z, *offset],
+                    b: [0.0, 0.0, 0.0, 0.0],
+                    vel: v(velocity),
+                }
+            }
+            Collider::Sphere {
+                center,
+                radius,
+                velocity,
+            } => {
+                if radius.is_nan() || *radius <= 0.0 {
+                    return Err(Error::Param(
+                        "sphere collider: radius must be positive".into(),
+                    ));
+                }
+                GpuCollider {
+                    a: [center[0], center[1], center[2], *radius],
+                    b: [0.0, 0.0, 0.0, 1.0],
+                    vel: v(velocity),
+                }
+            }
+            Collider::Capsule {
+                a,
+                b,
+                radius,
+                velocity,
+            } => {
+                if radius.is_nan() || *radius <= 0.0 {
+                    return Err(Error::Param(
+                        "capsule collider: radius must be positive".into(),
+                    ));
+                }
+                GpuCollider {
+                    a: [a[0], a[1], a[2], *radius],
+                    b: [b[0], b[1], b[2], 2.0],
+                    vel: v(velocity),
+                }
+            }
+        })
+    }
+
+    pub fn scaled(&self, s: f32) -> Self {
+        let m = |v: &[f32; 3]| [v[0] * s, v[1] * s, v[2] * s];
+        match self {
+            Collider::Plane {
+                normal,
+                offset,
+                velocity,
+            } => Collider::Plane {
+                normal: *normal,
+                offset: offset * s,
+                velocity: *velocity,
+            },
+            Collider::Sphere {
+                center,
+                radius,
+                velocity,
+            } => Collider::Sphere {
+                center: m(center),
+                radius: radius * s,
+                velocity: *velocity,
+            },
+            Collider::Capsule {
+                a,
+                b,
+                radius,
+                velocity,
+            } => Collider::Capsule {
+                a: m(a),
+                b: m(b),
+                radius: radius * s,
+                velocity: *velocity,
+            },
+        }
+    }
+
+    /// Signed distance to the collider surface (negative inside the solid).
+    pub fn distance(&self, p: [f32; 3]) -> f32 {
+        let p = glam::Vec3::from(p);
+        match self {
+            Collider::Plane { normal, offset, .. } => {
+                glam::Vec3::from(*normal).normalize().dot(p) - offset
+            }
+            Collider::Sphere { center, radius, .. } => {
+                (p - glam::Vec3::from(*center)).length() - radius
+            }
+            Collider::Capsule { a, b, radius, .. } => {
+                let (a, b) = (glam::Vec3::from(*a), glam::Vec3::from(*b));
+                let ab = b - a;
+                let t = ((p - a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
+                (p - (a + t * ab)).length() - radius
+            }
+        }
+    }
+}

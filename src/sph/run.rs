@@ -1,0 +1,172 @@
+//! Playing an SPH scene: steps per frame (fixed, or CFL-limited from the previous
+//! frame's velocity bounds), the particle view, and end-of-run physics statistics.
+use super::scene::Scene;
+use super::solver::{SphSolver, SphState, StateDump};
+use crate::error::{Error, Result};
+use crate::gpu::{Buffer, Context, MemoryLocation, Profiler};
+use crate::primitives::bounds::{BoundsBuffers, BoundsPass};
+use ash::vk;
+use serde_json::{json, Value};
+
+/// Chooses steps per frame. With `cfl`, a step never exceeds cfl * h / max(c, v_max),
+/// v_max bounded by the velocity box read back from the latest finished frame.
+pub struct Stepper {
+    bounds: BoundsPass,
+    boxes: BoundsBuffers,
+    readbacks: Vec<Buffer>,
+    pub frame_time: f64,
+    pub steps_taken: u64,
+    pub sim_time: f64,
+    v_max: f32,
+    cfl: bool,
+}
+
+impl Stepper {
+    pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
+        let mut readbacks = Vec::new();
+        for _ in 0..slots {
+            readbacks.push(ctx.create_buffer(
+                "velocity bounds readback",
+                32,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+        }
+        Ok(Self {
+            bounds: BoundsPass::new(ctx)?,
+            boxes: BoundsBuffers::new(ctx, st.n as u64)?,
+            readbacks,
+            frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
+            steps_taken: 0,
+            sim_time: 0.0,
+            v_max: 0.0,
+            cfl: st.fluid.cfl.is_some(),
+        })
+    }
+
+    /// (steps, dt) for the next frame.
+    pub fn plan(&self, st: &SphState) -> (u32, f32) {
+        let f = &st.fluid;
+        match f.cfl {
+            None => (f.substeps, f.dt),
+            Some(cfl) => {
+                let limit = cfl * f.h / f.sound().max(self.v_max).max(1e-6);
+                let dt = f.dt.min(limit);
+                let steps = (self.frame_time / dt as f64)
+                    .ceil()
+                    .clamp(1.0, super::params::MAX_SUBSTEPS as f64)
+                    as u32;
+                (steps, (self.frame_time / steps as f64) as f32)
+            }
+        }
+    }
+
+    /// Record one frame of steps; with CFL, also the velocity bounds for this slot.
+    pub fn record_frame(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        solver: &SphSolver,
+        st: &mut SphState,
+        slot: usize,
+    ) -> Result<()> {
+        let (steps, dt) = self.plan(st);
+        st.dt = dt;
+        for _ in 0..steps {
+            solver.record_step(ctx, cmd, prof, st)?;
+        }
+        self.steps_taken += steps as u64;
+        self.sim_time += steps as f64 * dt as f64;
+        if st.fluid.cfl.is_some() {
+            prof.begin(ctx, cmd, "cfl");
+            self.bounds
+                .record(ctx, cmd, st.vel(), st.n as u64, &self.boxes)?;
+            ctx.barrier(cmd);
+            let region = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: 32,
+            };
+            unsafe {
+                ctx.device.cmd_copy_buffer(
+                    cmd,
+                    self.boxes.result.raw,
+                    self.readbacks[slot].raw,
+                    &[region],
+                )
+            };
+            ctx.barrier(cmd);
+            prof.end(ctx, cmd);
+        }
+        Ok(())
+    }
+
+    /// After a slot's fence: update v_max from its velocity bounds.
+    pub fn retire_slot(&mut self, slot: usize) {
+        if !self.cfl {
+            return;
+        }
+        let b: &[[f32; 4]] = bytemuck::cast_slice(self.readbacks[slot].mapped().expect("mapped"));
+        let v2: f32 = (0..3)
+            .map(|k| b[0][k].abs().max(b[1][k].abs()).powi(2))
+            .sum();
+        if v2.is_finite() {
+            self.v_max = v2.sqrt();
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.bounds.destroy(ctx);
+        self.boxes.destroy(ctx);
+        for b in &mut self.readbacks {
+            ctx.destroy_buffer(b);
+        }
+    }
+}
+
+/// Physics checks of a state: NaNs, particles outside the domain, density statistics.
+pub fn physics_stats(d: &StateDump, scene: &Scene) -> Value {
+    let n = d.pos.len();
+    let (lo, hi) = (scene.domain.min, scene.domain.max);
+    let nan = d
+        .pos
+        .iter()
+        .zip(&d.vel)
+        .filter(|(p, v)| p.iter().chain(v.iter()).any(|x| !x.is_finite()))
+        .count();
+    let outside = d
+        .pos
+        .iter()
+        .filter(|p| (0..3).any(|k| !(p[k] >= lo[k] && p[k] <= hi[k])))
+        .count();
+    let rho: Vec<f64> = d.rho_p.iter().map(|r| r[0] as f64).collect();
+    let mean = rho.iter().sum::<f64>() / n.max(1) as f64;
+    let speed = d
+        .vel
+        .iter()
+        .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+        .fold(0.0f32, f32::max);
+    let rho0 = scene.fluid.rest_density as f64;
+    json!({
+        "particles": n,
+        "nan": nan,
+        "outside_domain": outside,
+        "density_mean": mean,
+        "density_mean_over_rest": mean / rho0,
+        "density_min": rho.iter().cloned().fold(f64::INFINITY, f64::min),
+        "density_max": rho.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        "max_speed": speed,
+    })
+}
+
+/// Fail when the state has NaNs or particles outside the domain.
+pub fn check(stats: &Value) -> Result<()> {
+    if stats["nan"].as_u64() != Some(0) || stats["outside_domain"].as_u64() != Some(0) {
+        return Err(Error::Unsupported(format!(
+            "the simulation became invalid: {} NaN particle(s), {} outside the domain",
+            stats["nan"], stats["outside_domain"]
+        )));
+    }
+    Ok(())
+}

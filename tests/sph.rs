@@ -1,0 +1,418 @@
+//! SPH on the GPU against the f64 CPU reference, physics invariants, boundaries, scenes.
+mod common;
+use fluidform::config::{Neighbors, SortAlgo};
+use fluidform::gpu::{Context, Labels};
+use fluidform::sph::cpu;
+use fluidform::sph::params::Collider;
+use fluidform::sph::scene::{Ball, Block, Domain, Particles, Scene};
+use fluidform::sph::{Eos, FluidParams, SphSolver};
+use rand::{Rng, SeedableRng};
+
+const STRATEGIES: [(Neighbors, SortAlgo); 4] = [
+    (Neighbors::Grid, SortAlgo::Counting),
+    (Neighbors::Hash, SortAlgo::Bitonic),
+    (Neighbors::Hash, SortAlgo::OddEven),
+    (Neighbors::Morton, SortAlgo::OddEven),
+];
+
+fn block_scene(fluid: FluidParams) -> Scene {
+    Scene {
+        name: "test block".into(),
+        domain: Domain {
+            min: [0.0; 3],
+            max: [0.4, 0.4, 0.4],
+        },
+        fluid,
+        blocks: vec![Block {
+            min: [0.05, 0.0, 0.05],
+            max: [0.3, 0.2, 0.25],
+            group: 0,
+            color: [0.2, 0.5, 1.0],
+            velocity: [0.0; 3],
+        }],
+        balls: vec![Ball {
+            center: [0.3, 0.3, 0.3],
+            radius: 0.05,
+            group: 1,
+            color: [1.0, 0.5, 0.1],
+            velocity: [0.0, -0.5, 0.0],
+        }],
+        colliders: vec![],
+        camera: None,
+        frames: 1,
+    }
+}
+
+/// Random points (no two closer than a third of the rest spacing) with random velocities.
+fn random_particles(scene: &Scene, n: usize, seed: u64) -> Particles {
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    let s = scene.fluid.spacing();
+    let lo = [0.05f32, 0.02, 0.05];
+    let side = s * (n as f32).cbrt() * 1.1;
+    let mut pos: Vec<[f32; 4]> = Vec::new();
+    while pos.len() < n {
+        let p = [
+            lo[0] + rng.random::<f32>() * side,
+            lo[1] + rng.random::<f32>() * side,
+            lo[2] + rng.random::<f32>() * side,
+            0.0,
+        ];
+        let close = pos
+            .iter()
+            .any(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>() < (s / 3.0).powi(2));
+        if !close {
+            pos.push(p);
+        }
+    }
+    let vel = (0..n)
+        .map(|_| {
+            [
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+                0.0,
+            ]
+        })
+        .collect();
+    let attr = vec![[1.0, 1.0, 1.0, 0.0]; n];
+    Particles { pos, vel, attr }
+}
+
+/// One arrange + density + forces on the GPU; compare with the reference on the same
+/// (sorted) particles. Returns the largest relative errors (density, acceleration).
+fn compare(ctx: &Context, solver: &SphSolver, scene: &Scene, parts: &Particles) -> (f64, f64) {
+    let mut st = solver.state(ctx, scene, parts).unwrap();
+    ctx.one_shot(|cmd| {
+        solver.record_params(ctx, cmd, &st);
+        solver.record_arrange(ctx, cmd, &mut Labels, &mut st)?;
+        solver.record_density(ctx, cmd, &mut Labels, &st);
+        solver.record_forces(ctx, cmd, &mut Labels, &st);
+        Ok::<_, fluidform::Error>(())
+    })
+    .unwrap()
+    .unwrap();
+    let d = st.read(ctx).unwrap();
+    st.destroy(ctx);
+    let r = cpu::evaluate(&scene.fluid, &d.pos, &d.vel);
+    let n = d.pos.len();
+    let mean_a = r
+        .acc
+        .iter()
+        .map(|a| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt())
+        .sum::<f64>()
+        / n as f64;
+    let (mut err_rho, mut err_a) = (0.0f64, 0.0f64);
+    let l = scene.fluid.tension_threshold as f64;
+    for i in 0..n {
+        err_rho = err_rho.max((d.rho_p[i][0] as f64 - r.density[i]).abs() / r.density[i]);
+        // Surface tension switches on at |grad c| = l: skip particles right at the switch.
+        if (r.color_grad[i] - l).abs() < 1e-2 * l {
+            continue;
+        }
+        let da: f64 = (0..3)
+            .map(|k| (d.acc[i][k] as f64 - r.acc[i][k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let a = (0..3).map(|k| r.acc[i][k].powi(2)).sum::<f64>().sqrt();
+        err_a = err_a.max(da / a.max(mean_a));
+    }
+    (err_rho, err_a)
+}
+
+#[test]
+fn gpu_density_and_acceleration_match_f64_reference() {
+    let ctx = common::ctx();
+    let ideal = FluidParams::default();
+    let tait = FluidParams {
+        eos: Eos::Tait,
+        sound_speed: 20.0,
+        ..FluidParams::default()
+    };
+    for (strategy, sort) in STRATEGIES {
+        let mut solver = SphSolver::new(&ctx, strategy, Some(sort)).unwrap();
+        for (what, fluid) in [("kelager", ideal.clone()), ("tait", tait.clone())] {
+            let scene = block_scene(fluid);
+            let lattice = scene.particles(3);
+            let random = random_particles(&scene, 1500, 9);
+            for (kind, parts) in [("lattice", &lattice), ("random", &random)] {
+                let (e_rho, e_a) = compare(&ctx, &solver, &scene, parts);
+                assert!(
+                    e_rho < 1e-3,
+                    "{strategy:?}/{sort:?} {what} {kind}: density error {e_rho:e}"
+                );
+                assert!(
+                    e_a < 1e-3,
+                    "{strategy:?}/{sort:?} {what} {kind}: acceleration error {e_a:e}"
+                );
+            }
+        }
+        solver.destroy(&ctx);
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn internal_forces_conserve_momentum() {
+    // Pressure and viscosity are antisymmetric between pairs: without gravity, tension and
+    // walls, sum_i m a_i = 0 (relative to sum_i m |a_i|).
+    let ctx = common::ctx();
+    let fluid = FluidParams {
+        gravity: [0.0; 3],
+        surface_tension: 0.0,
+        ..FluidParams::default()
+    };
+    let scene = block_scene(fluid);
+    let parts = random_particles(&scene, 1200, 4);
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+    let mut st = solver.state(&ctx, &scene, &parts).unwrap();
+    ctx.one_shot(|cmd| {
+        solver.record_params(&ctx, cmd, &st);
+        solver
+            .record_arrange(&ctx, cmd, &mut Labels, &mut st)
+            .unwrap();
+        solver.record_density(&ctx, cmd, &mut Labels, &st);
+        solver.record_forces(&ctx, cmd, &mut Labels, &st);
+    })
+    .unwrap();
+    let d = st.read(&ctx).unwrap();
+    let mut total = [0.0f64; 3];
+    let mut abs = 0.0f64;
+    // Pair forces m a_ij = -m^2 (p_i + p_j) / (2 rho_i rho_j) grad W_ij (and the viscous
+    // analogue) are antisymmetric, so the sum of m a_i vanishes (equal masses: of a_i).
+    for a in &d.acc {
+        for k in 0..3 {
+            total[k] += a[k] as f64;
+        }
+        abs += (0..3).map(|k| (a[k] as f64).powi(2)).sum::<f64>().sqrt();
+    }
+    let net = (total[0].powi(2) + total[1].powi(2) + total[2].powi(2)).sqrt();
+    assert!(abs > 0.0);
+    assert!(
+        net < 1e-3 * abs,
+        "net force {net:e} vs total magnitude {abs:e}"
+    );
+    st.destroy(&ctx);
+    solver.destroy(&ctx);
+    common::finish(&ctx);
+}
+
+#[test]
+fn poly6_kernel_is_normalised() {
+    // Integrate W_poly6 over its support on a fine lattice: 1 within 0.5%.
+    let h = 0.0457f64;
+    let c = 315.0 / (64.0 * std::f64::consts::PI * h.powi(9));
+    let steps = 80;
+    let dx = 2.0 * h / steps as f64;
+    let mut sum = 0.0;
+    for i in 0..steps {
+        for j in 0..steps {
+            for k in 0..steps {
+                let p = [
+                    (i as f64 + 0.5) * dx - h,
+                    (j as f64 + 0.5) * dx - h,
+                    (k as f64 + 0.5) * dx - h,
+                ];
+                let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+                if r2 < h * h {
+                    sum += c * (h * h - r2).powi(3) * dx * dx * dx;
+                }
+            }
+        }
+    }
+    assert!((sum - 1.0).abs() < 5e-3, "integral {sum}");
+    // The rest lattice of Kelager's water has a density near rho_0 (about 20 neighbours).
+    let f = FluidParams::default();
+    let s = f.spacing() as f64;
+    let mut rho = 0.0;
+    for i in -3i32..=3 {
+        for j in -3i32..=3 {
+            for k in -3i32..=3 {
+                let r2 = (i * i + j * j + k * k) as f64 * s * s;
+                if r2 < h * h {
+                    rho += f.mass as f64 * c * (h * h - r2).powi(3);
+                }
+            }
+        }
+    }
+    assert!(
+        (rho / f.rest_density as f64 - 1.0).abs() < 0.1,
+        "lattice density {rho}"
+    );
+}
+
+fn run_steps(
+    ctx: &Context,
+    scene: &Scene,
+    steps: u32,
+    strategy: Neighbors,
+) -> fluidform::sph::solver::StateDump {
+    let parts = scene.particles(1);
+    let mut solver = SphSolver::new(ctx, strategy, None).unwrap();
+    let mut st = solver.state(ctx, scene, &parts).unwrap();
+    for _ in 0..steps.div_ceil(50) {
+        ctx.one_shot(|cmd| {
+            for _ in 0..50 {
+                solver.record_step(ctx, cmd, &mut Labels, &mut st).unwrap();
+            }
+        })
+        .unwrap();
+    }
+    let d = st.read(ctx).unwrap();
+    st.destroy(ctx);
+    solver.destroy(ctx);
+    d
+}
+
+fn assert_sane(d: &fluidform::sph::solver::StateDump, scene: &Scene, what: &str) {
+    let (lo, hi) = (scene.domain.min, scene.domain.max);
+    for (i, p) in d.pos.iter().enumerate() {
+        for k in 0..3 {
+            assert!(p[k].is_finite(), "{what}: particle {i} is NaN");
+            assert!(
+                p[k] >= lo[k] && p[k] <= hi[k],
+                "{what}: particle {i} left the domain: {p:?}"
+            );
+        }
+        assert!(
+            d.vel[i].iter().all(|v| v.is_finite()),
+            "{what}: velocity {i} NaN"
+        );
+    }
+}
+
+#[test]
+fn short_dam_break_is_stable_and_stays_in_the_domain() {
+    let ctx = common::ctx();
+    let scene = Scene::built_in("dam-break").unwrap().with_particles(3000);
+    let d = run_steps(&ctx, &scene, 400, Neighbors::Grid);
+    assert_sane(&d, &scene, "dam break");
+    // The column has collapsed: the centre of mass moved down and along x.
+    let n = d.pos.len() as f32;
+    let cy = d.pos.iter().map(|p| p[1]).sum::<f32>() / n;
+    let parts = scene.particles(1);
+    let cy0 = parts.pos.iter().map(|p| p[1]).sum::<f32>() / n;
+    assert!(cy < cy0 * 0.97, "centre of mass {cy0} -> {cy}");
+    let groups: std::collections::BTreeSet<u32> = d.attr.iter().map(|a| a[3].to_bits()).collect();
+    assert_eq!(groups.len(), 1);
+    common::finish(&ctx);
+}
+
+#[test]
+fn colliders_keep_fluid_out_and_strategies_agree() {
+    let ctx = common::ctx();
+    let scene = Scene::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/scenes/obstacles.toml"
+    ))
+    .unwrap();
+    assert_eq!(scene.colliders.len(), 3);
+    let mut means = Vec::new();
+    for (strategy, _) in STRATEGIES.iter().step_by(1).take(3) {
+        let d = run_steps(&ctx, &scene, 150, *strategy);
+        assert_sane(&d, &scene, "obstacles");
+        for (i, p) in d.pos.iter().enumerate() {
+            for c in &scene.colliders {
+                let dist = c.distance([p[0], p[1], p[2]]);
+                assert!(
+                    dist > -1e-4,
+                    "{strategy:?}: particle {i} inside {c:?} by {dist}"
+                );
+            }
+        }
+        let n = d.pos.len() as f64;
+        let cy = d.pos.iter().map(|p| p[1] as f64).sum::<f64>() / n;
+        let rho = d.rho_p.iter().map(|r| r[0] as f64).sum::<f64>() / n;
+        means.push((cy, rho));
+    }
+    // Same physics whatever the neighbour search: aggregates agree closely.
+    for m in &means[1..] {
+        assert!((m.0 - means[0].0).abs() < 2e-3, "centre of mass {means:?}");
+        assert!(
+            (m.1 / means[0].1 - 1.0).abs() < 1e-2,
+            "mean density {means:?}"
+        );
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn moving_collider_pushes_fluid() {
+    let ctx = common::ctx();
+    let mut scene = Scene::built_in("resting-block").unwrap();
+    scene.fluid.dt = 0.002;
+    let parts = scene.particles(1);
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+    let mut st = solver.state(&ctx, &scene, &parts).unwrap();
+    // A sphere sweeping through the block along x.
+    for step in 0..60 {
+        let x = 0.05 + step as f32 * 0.008;
+        let c = Collider::Sphere {
+            center: [x, 0.08, 0.3],
+            radius: 0.06,
+            velocity: [4.0, 0.0, 0.0],
+        };
+        st.set_colliders(&[c.to_gpu().unwrap()]).unwrap();
+        ctx.one_shot(|cmd| solver.record_step(&ctx, cmd, &mut Labels, &mut st).unwrap())
+            .unwrap();
+        let d = st.read(&ctx).unwrap();
+        for p in &d.pos {
+            assert!(
+                c.distance([p[0], p[1], p[2]]) > -1e-4,
+                "step {step}: particle inside the moving sphere"
+            );
+        }
+    }
+    let d = st.read(&ctx).unwrap();
+    assert_sane(&d, &scene, "moving collider");
+    assert!(
+        d.vel.iter().any(|v| v[0] > 0.5),
+        "nothing was pushed along +x"
+    );
+    st.destroy(&ctx);
+    solver.destroy(&ctx);
+    assert!(st
+        .set_colliders(&vec![
+            Collider::Plane {
+                normal: [0.0, 1.0, 0.0],
+                offset: 0.0,
+                velocity: [0.0; 3]
+            }
+            .to_gpu()
+            .unwrap();
+            65
+        ])
+        .is_err());
+    common::finish(&ctx);
+}
+
+#[test]
+fn bad_scenes_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("name = \"x\"\n[domain]\nmin = [0,0,0]\nmax = [1,1,1]\nbogus = 1\n", "unknown field"),
+        ("name = \"x\"\n[domain]\nmin = [0,0,0]\nmax = [1,1,1]\n", "no fluid"),
+        ("name = \"x\"\n[domain]\nmin = [0,0,0]\nmax = [1,1,1]\n[fluid]\nh = -1.0\n[[blocks]]\nmin=[0,0,0]\nmax=[1,1,1]\n", "fluid.h must be positive"),
+        ("name = \"x\"\n[domain]\nmin = [0,0,0]\nmax = [0,1,1]\n[[blocks]]\nmin=[0,0,0]\nmax=[1,1,1]\n", "empty domain"),
+        ("name = \"x\"\n[domain]\nmin = [0,0,0]\nmax = [1,1,1]\n[[blocks]]\nmin=[0,0,0]\nmax=[1,1,1]\n[[colliders]]\nkind = \"sphere\"\ncenter = [0,0,0]\nradius = 0.0\n", "radius must be positive"),
+        ("this is not toml [", "scene file"),
+    ];
+    for (i, (text, needle)) in cases.iter().enumerate() {
+        let p = dir.path().join(format!("bad{i}.toml"));
+        std::fs::write(&p, text).unwrap();
+        let e = Scene::load(p.to_str().unwrap()).unwrap_err().to_string();
+        assert!(e.contains(needle), "case {i}: {e}");
+    }
+    let e = Scene::load("no/such/scene.toml").unwrap_err().to_string();
+    assert!(e.contains("unknown scene"), "{e}");
+    for name in fluidform::sph::scene::BUILT_IN {
+        let s = Scene::built_in(name).unwrap();
+        s.validate().unwrap();
+        assert!(s.particles(1).len() > 1000, "{name}");
+    }
+    let dam = Scene::built_in("dam-break").unwrap();
+    let n = dam.particles(1).len();
+    assert!(
+        (30_000..36_000).contains(&n),
+        "dam break has {n} particles, meant 32K"
+    );
+}
