@@ -53,6 +53,8 @@ switch_enum!(Placement {
 switch_enum!(Skinning { Lbs, Dqs });
 switch_enum!(OnOff { On, Off });
 switch_enum!(BoneWeights { Eq8, Eq9 });
+switch_enum!(Offscreen { All, End });
+switch_enum!(RenderKind { Metaballs, Points });
 
 /// Every switch of DESIGN.md's command line. Unset optional switches take the default of
 /// whatever uses them; `config` in summary.json records what was used.
@@ -109,54 +111,131 @@ pub struct Switches {
     pub adaptive: Option<OnOff>,
     #[arg(long, value_enum)]
     pub bone_weights: Option<BoneWeights>,
+    /// How `run` draws particles: ray-marched metaballs (default for SPH scenes) or spheres
+    #[arg(long, value_enum)]
+    pub render: Option<RenderKind>,
+    /// Equirectangular sky image (PNG, JPEG, ...) instead of the procedural sky
+    #[arg(long, value_name = "FILE")]
+    pub sky: Option<String>,
+    /// Secondary-ray samples off screen: use every metaball (all) or end the path (end)
+    #[arg(long, value_enum)]
+    pub offscreen: Option<Offscreen>,
+    /// Camera position x,y,z (overrides the scene's)
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub eye: Option<[f32; 3]>,
+    /// Camera target x,y,z (overrides the scene's)
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub target: Option<[f32; 3]>,
+    /// Vertical field of view in degrees
+    #[arg(long, value_parser = parse_fov)]
+    pub fov: Option<f32>,
+    /// Override a fluid parameter of an SPH scene, e.g. --fluid viscosity=1.5
+    /// --fluid eos=tait (repeatable; the keys of a scene file's [fluid] table)
+    #[arg(long = "fluid", value_name = "KEY=VALUE")]
+    pub fluid: Vec<String>,
+}
+
+fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>().map_err(|e| format!("'{x}': {e}")))
+        .collect::<std::result::Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("expected three finite numbers x,y,z, got '{s}'")),
+    }
+}
+
+fn parse_fov(s: &str) -> std::result::Result<f32, String> {
+    let v: f32 = s.parse().map_err(|e| format!("{e}"))?;
+    if v > 1.0 && v < 179.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "field of view must be in (1, 179) degrees, got {v}"
+        ))
+    }
 }
 
 impl Switches {
     /// Fail for every set switch that `supported` does not list, naming the feature that
     /// will bring it: a switch never silently does nothing.
     pub fn reject_unimplemented(&self, what: &str, supported: &[&str]) -> Result<()> {
-        let set: [(&str, bool, &str); 14] = [
-            ("sort", self.sort.is_some(), "GPU sorts (issue 3)"),
+        if !self.fluid.is_empty() && !supported.contains(&"fluid") {
+            return Err(Error::Unsupported(format!(
+                "--fluid does not apply to {what}: it sets SPH parameters (run with an SPH scene, bench sph, bench stability)"
+            )));
+        }
+        // Built, but used elsewhere: (switch, set, where it applies).
+        let elsewhere: [(&str, bool, &str); 15] = [
+            (
+                "sort",
+                self.sort.is_some(),
+                "neighbour search (SPH scenes, bench sort/neighbors/sph)",
+            ),
             (
                 "neighbors",
                 self.neighbors.is_some(),
-                "neighbour search (issue 3)",
+                "neighbour search (SPH scenes, bench neighbors/sph)",
             ),
             (
                 "list",
                 self.list.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "density",
                 self.density.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "threshold",
                 self.threshold.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "radius",
                 self.radius.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "refine",
                 self.refine.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "depth",
                 self.depth.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "material",
                 self.material.is_some(),
-                "the metaball renderer (issue 5)",
+                "the metaball renderer (SPH scenes, bench render)",
             ),
+            (
+                "sky",
+                self.sky.is_some(),
+                "the metaball renderer (SPH scenes, bench render)",
+            ),
+            (
+                "offscreen",
+                self.offscreen.is_some(),
+                "the metaball renderer (SPH scenes, bench render)",
+            ),
+            ("render", self.render.is_some(), "run with an SPH scene"),
+            ("eye", self.eye.is_some(), "rendered scenes"),
+            ("target", self.target.is_some(), "rendered scenes"),
+            ("fov", self.fov.is_some(), "rendered scenes"),
+        ];
+        for (name, is_set, owner) in elsewhere {
+            if is_set && !supported.contains(&name) {
+                return Err(Error::Unsupported(format!(
+                    "--{name} does not apply to {what}: it is used by {owner}"
+                )));
+            }
+        }
+        let later: [(&str, bool, &str); 5] = [
             ("placement", self.placement.is_some(), "control particles"),
             ("skinning", self.skinning.is_some(), "character skinning"),
             (
@@ -171,10 +250,10 @@ impl Switches {
                 "control particles",
             ),
         ];
-        for (name, is_set, owner) in set {
+        for (name, is_set, owner) in later {
             if is_set && !supported.contains(&name) {
                 return Err(Error::Unsupported(format!(
-                    "--{name} is not implemented yet for {what}: it arrives with {owner}"
+                    "--{name} is not implemented yet: it arrives with {owner}"
                 )));
             }
         }

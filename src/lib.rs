@@ -10,5 +10,6 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod sph;
+pub mod viewer;
 
 pub use error::{Error, Result};

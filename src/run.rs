@@ -147,12 +147,55 @@ pub fn check_validation(ctx: &Context) -> Result<()> {
     Ok(())
 }
 
+/// The camera with --eye, --target and --fov applied.
+pub fn camera_with_switches(mut cam: Camera, sw: &Switches) -> Camera {
+    if let Some(e) = sw.eye {
+        cam.eye = e.into();
+    }
+    if let Some(t) = sw.target {
+        cam.target = t.into();
+    }
+    if let Some(f) = sw.fov {
+        cam.fov_y_deg = f;
+    }
+    cam
+}
+
 fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
-    use crate::config::Neighbors;
+    use crate::config::{Neighbors, RenderKind};
     use crate::sph::run::{check, physics_stats, Stepper};
     use crate::sph::SphSolver;
+    use crate::viewer::Viewer;
     let sw = &opts.switches;
-    sw.reject_unimplemented("SPH scenes", &["sort", "neighbors"])?;
+    let render = sw.render.unwrap_or(RenderKind::Metaballs);
+    let mut allowed = vec![
+        "sort",
+        "neighbors",
+        "fluid",
+        "render",
+        "eye",
+        "target",
+        "fov",
+    ];
+    if render == RenderKind::Metaballs {
+        allowed.extend([
+            "list",
+            "density",
+            "threshold",
+            "radius",
+            "refine",
+            "depth",
+            "material",
+            "sky",
+            "offscreen",
+        ]);
+    }
+    sw.reject_unimplemented(
+        &format!("SPH scenes drawn as {}", render.as_str()),
+        &allowed,
+    )?;
+    let mut scene = scene;
+    scene.fluid = scene.fluid.with_overrides(&sw.fluid)?;
     let scene = match sw.particles {
         Some(n) => scene.with_particles(n),
         None => scene,
@@ -163,15 +206,6 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let mut solver = SphSolver::new(&ctx, neighbors, sw.sort)?;
     let parts = scene.particles(sw.seed);
     let mut st = solver.state(&ctx, &scene, &parts)?;
-    let mut view = PointsView::new(&ctx)?;
-    let mut target = ColorTarget::new(&ctx, sw.width, sw.height, SLOTS)?;
-    // Scopes per step: arrange (keys, sort, ranges, reorder), density, forces, integrate.
-    let max_steps = match scene.fluid.cfl {
-        Some(_) => crate::sph::params::MAX_SUBSTEPS,
-        None => scene.fluid.substeps,
-    };
-    let mut frames = FrameLoop::new(&ctx, SLOTS, max_steps * 10 + 16)?;
-    let stepper = std::cell::RefCell::new(Stepper::new(&ctx, &st, SLOTS)?);
     let aspect = sw.width as f32 / sw.height as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
@@ -189,11 +223,31 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             )
         }
     };
-    // Spheres of half the rest spacing.
-    let push = PointsPush::from_camera(&cam, 0.5 * scene.fluid.spacing());
-    let memory = ctx.memory_bytes();
+    let cam = camera_with_switches(cam, sw);
+    let viewer = match render {
+        RenderKind::Metaballs => Viewer::metaballs(&ctx, sw, cam, st.n, SLOTS),
+        // Spheres of half the rest spacing.
+        RenderKind::Points => Viewer::points(&ctx, sw, &cam, 0.5 * scene.fluid.spacing(), SLOTS),
+    };
+    let mut viewer = match viewer {
+        Ok(v) => v,
+        Err(e) => {
+            st.destroy(&ctx);
+            solver.destroy(&ctx);
+            return Err(e);
+        }
+    };
+    // Scopes per step: arrange (keys, sort, ranges, reorder), density, forces, integrate.
+    let max_steps = match scene.fluid.cfl {
+        Some(_) => crate::sph::params::MAX_SUBSTEPS,
+        None => scene.fluid.substeps,
+    };
+    let mut frames = FrameLoop::new(&ctx, SLOTS, max_steps * 10 + 32)?;
+    let stepper = std::cell::RefCell::new(Stepper::new(&ctx, &st, SLOTS)?);
+    let memory_before = ctx.memory_bytes();
     let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
     let mut pngs = Vec::new();
+    let n = st.n;
     let result = frames.run(
         &ctx,
         frame_count,
@@ -201,29 +255,22 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             stepper
                 .borrow_mut()
                 .record_frame(&ctx, cmd, prof, &solver, &mut st, slot)?;
-            prof.begin(&ctx, cmd, PointsView::NAME);
-            target.begin_rendering(&ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-            view.draw(&ctx, cmd, st.pos(), st.attr(), st.n, &push);
-            target.end_rendering(&ctx, cmd);
-            prof.end(&ctx, cmd);
-            if save(frame) {
-                prof.begin(&ctx, cmd, "readback");
-                target.copy_out(&ctx, cmd, slot);
-                prof.end(&ctx, cmd);
-            }
-            Ok(())
+            viewer.record(&ctx, cmd, prof, st.pos(), st.attr(), n, slot, save(frame))
         },
         |frame, slot| {
             stepper.borrow_mut().retire_slot(slot);
-            if save(frame) {
-                let path = opts.out.join(format!("frame_{frame:04}.png"));
-                target.save_png(slot, &path)?;
-                pngs.push(path);
-            }
+            let path = save(frame).then(|| opts.out.join(format!("frame_{frame:04}.png")));
+            viewer.retire(&ctx, slot, n, path.as_deref())?;
+            pngs.extend(path);
             Ok(())
         },
     );
     let timings = std::mem::take(&mut frames.profiler.results);
+    let memory = ctx
+        .memory_bytes()
+        .into_iter()
+        .chain(memory_before)
+        .collect();
     let dump = if result.is_ok() {
         Some(st.read(&ctx))
     } else {
@@ -231,16 +278,17 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let mut stepper = stepper.into_inner();
     let (steps, sim_time) = (stepper.steps_taken, stepper.sim_time);
+    let render_stats = viewer.stats();
     stepper.destroy(&ctx);
     frames.destroy(&ctx);
-    target.destroy(&ctx);
-    view.destroy(&ctx);
+    viewer.destroy(&ctx);
     st.destroy(&ctx);
     solver.destroy(&ctx);
     result?;
     let mut stats = physics_stats(&dump.expect("state read")?, &scene);
     stats["steps"] = json!(steps);
     stats["simulated_seconds"] = json!(sim_time);
+    stats["render"] = render_stats;
     let config = json!({
         "command": "run",
         "scene": scene.name,
@@ -249,6 +297,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         "particles": stats["particles"],
         "neighbors": neighbors.as_str(),
         "sort": solver.search.sort.as_str(),
+        "render": render.as_str(),
         "fluid": scene.fluid,
         "switches": sw,
     });

@@ -156,8 +156,69 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
     let d = dir.path().to_str().unwrap();
     for (args, needle) in [
         (
-            vec!["run", "--frames", "1", "--out", d, "--material", "glass"],
-            "--material is not implemented yet",
+            vec!["run", "--frames", "1", "--out", d, "--placement", "random"],
+            "--placement is not implemented yet",
+        ),
+        (
+            vec![
+                "run",
+                "--scene",
+                "orbits",
+                "--frames",
+                "1",
+                "--out",
+                d,
+                "--material",
+                "glass",
+            ],
+            "--material does not apply to the orbits scene",
+        ),
+        (
+            vec![
+                "run",
+                "--scene",
+                "orbits",
+                "--frames",
+                "1",
+                "--out",
+                d,
+                "--neighbors",
+                "grid",
+            ],
+            "--neighbors does not apply to the orbits scene",
+        ),
+        (
+            vec![
+                "run", "--scene", "drop", "--render", "points", "--frames", "1", "--out", d,
+                "--list", "abuffer",
+            ],
+            "--list does not apply to SPH scenes drawn as points",
+        ),
+        (
+            vec![
+                "run", "--scene", "drop", "--frames", "1", "--out", d, "--fov", "200",
+            ],
+            "field of view",
+        ),
+        (
+            vec![
+                "run", "--scene", "drop", "--frames", "1", "--out", d, "--eye", "1,2",
+            ],
+            "three finite numbers",
+        ),
+        (
+            vec![
+                "run",
+                "--frames",
+                "1",
+                "--out",
+                d,
+                "--neighbors",
+                "morton",
+                "--sort",
+                "counting",
+            ],
+            "--sort odd-even or bitonic",
         ),
         (
             vec!["run", "--frames", "1", "--out", d, "--scene", "nope"],
@@ -172,6 +233,11 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
             vec!["run", "--frames", "1", "--out", d, "--particles", "0"],
             "--particles",
         ),
+        (
+            vec!["bench", "render", "--out", d, "--radius", "-1"],
+            "--radius must be positive",
+        ),
+        (vec!["bench", "nothing", "--out", d], "unknown benchmark"),
         (vec!["experiment", "table2"], "not implemented yet"),
     ] {
         let o = fluidform(&args);
@@ -189,10 +255,10 @@ fn summary(dir: &std::path::Path) -> serde_json::Value {
 #[test]
 fn run_sph_scenes_end_to_end() {
     let dir = tempfile::tempdir().unwrap();
-    for (scene, neighbors) in [
-        ("dam-break", "grid"),
-        ("drop", "hash"),
-        ("resting-block", "morton"),
+    for (scene, neighbors, render) in [
+        ("dam-break", "grid", "metaballs"),
+        ("drop", "hash", "metaballs"),
+        ("resting-block", "morton", "points"),
     ] {
         let out = dir.path().join(scene);
         let o = fluidform(&[
@@ -212,6 +278,8 @@ fn run_sph_scenes_end_to_end() {
             "64",
             "--neighbors",
             neighbors,
+            "--render",
+            render,
         ]);
         assert!(o.status.success(), "{scene}: {}", text(&o));
         assert!(out.join("frame_0001.png").exists());
@@ -225,11 +293,30 @@ fn run_sph_scenes_end_to_end() {
             rho > 0.5 && rho < 1.5,
             "{scene}: mean density / rho0 = {rho}"
         );
-        for pass in ["arrange", "density", "forces", "integrate", "draw"] {
+        let passes: Vec<&str> = if render == "metaballs" {
+            vec![
+                "arrange",
+                "density",
+                "forces",
+                "integrate",
+                "bounds",
+                "count",
+                "scan",
+                "fill",
+                "march",
+            ]
+        } else {
+            vec!["arrange", "density", "forces", "integrate", "draw"]
+        };
+        for pass in passes {
             assert!(
                 s["pass_ms"][pass]["median"].as_f64().is_some(),
                 "{scene}: pass {pass}"
             );
+        }
+        assert_eq!(s["stats"]["render"]["renderer"], render);
+        if render == "metaballs" {
+            assert!(s["stats"]["render"]["max_fragments"].as_u64().unwrap() > 0);
         }
         assert_eq!(s["config"]["neighbors"], neighbors);
     }
@@ -306,4 +393,79 @@ fn bench_smoke_writes_sweep_tables() {
         let runs: Vec<_> = std::fs::read_dir(out.join("runs")).unwrap().collect();
         assert_eq!(runs.len(), rows.len() - 1, "{what}: one summary per row");
     }
+}
+
+#[test]
+fn cfl_limits_the_step_and_keeps_the_frame_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/scenes/cfl.toml");
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        scene,
+        "--save-every",
+        "0",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--validation",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(dir.path());
+    assert_eq!(s["frames"], 3);
+    // ceil(0.01 / 9.14e-4) = 11 steps per frame while every speed stays below c.
+    assert_eq!(s["stats"]["steps"], 33, "{}", s["stats"]);
+    let t = s["stats"]["simulated_seconds"].as_f64().unwrap();
+    assert!((t - 0.03).abs() < 1e-6, "simulated {t} s");
+}
+
+#[test]
+fn fluid_overrides_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        "resting-block",
+        "--frames",
+        "1",
+        "--save-every",
+        "0",
+        "--out",
+        d,
+        "--fluid",
+        "viscosity=1.25",
+        "--fluid",
+        "eos=tait",
+        "--fluid",
+        "gravity=[0.0, -1.0, 0.0]",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(dir.path());
+    assert_eq!(s["config"]["fluid"]["viscosity"], 1.25);
+    assert_eq!(s["config"]["fluid"]["eos"], "tait");
+    assert_eq!(s["config"]["fluid"]["gravity"][1], -1.0);
+    for (arg, needle) in [
+        ("viscsity=1", "unknown field `viscsity`"),
+        ("h=-1", "fluid.h must be positive"),
+        ("eos=steam", "unknown variant `steam`"),
+        ("viscosity", "expected KEY=VALUE"),
+    ] {
+        let o = fluidform(&[
+            "run",
+            "--scene",
+            "resting-block",
+            "--frames",
+            "1",
+            "--out",
+            d,
+            "--fluid",
+            arg,
+        ]);
+        assert!(!o.status.success(), "{arg} accepted");
+        assert!(text(&o).contains(needle), "{arg}: {}", text(&o));
+    }
+    let o = fluidform(&[
+        "run", "--scene", "orbits", "--frames", "1", "--out", d, "--fluid", "h=1",
+    ]);
+    assert!(text(&o).contains("--fluid does not apply"), "{}", text(&o));
 }

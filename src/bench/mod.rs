@@ -2,6 +2,7 @@
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
 pub mod primitives;
+pub mod render;
 pub mod sph;
 
 use crate::config::Switches;
@@ -24,7 +25,7 @@ pub struct BenchOptions {
     pub switches: Switches,
 }
 
-pub const WHATS: &[&str] = &["scan", "sort", "neighbors", "sph", "stability"];
+pub const WHATS: &[&str] = &["scan", "sort", "neighbors", "sph", "stability", "render"];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
 pub const SWEEP: &[u32] = &[
@@ -72,17 +73,33 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
             primitives::neighbors(&ctx, opts)?
         }
         "sph" => {
-            sw.reject_unimplemented("bench sph", &["sort", "neighbors"])?;
+            sw.reject_unimplemented("bench sph", &["sort", "neighbors", "fluid"])?;
             sph::steps(&ctx, opts)?
         }
         "stability" => {
-            sw.reject_unimplemented("bench stability", &["sort", "neighbors"])?;
+            sw.reject_unimplemented("bench stability", &["sort", "neighbors", "fluid"])?;
             sph::stability(&ctx, opts)?
         }
-        "render" => return Err(Error::Unsupported(
-            "bench render is not implemented yet: it arrives with the metaball renderer (issue 5)"
-                .into(),
-        )),
+        "render" => {
+            sw.reject_unimplemented(
+                "bench render",
+                &[
+                    "list",
+                    "density",
+                    "threshold",
+                    "radius",
+                    "refine",
+                    "depth",
+                    "material",
+                    "sky",
+                    "offscreen",
+                    "eye",
+                    "target",
+                    "fov",
+                ],
+            )?;
+            render::render(&ctx, opts)?
+        }
         other => {
             return Err(Error::Param(format!(
                 "unknown benchmark '{other}' (one of: {})",

@@ -334,6 +334,33 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
                 }
             }
         }
+        "render" => {
+            let get = |v: &str| rows.iter().find(|r| r.variant == v);
+            if let (Some(s), Some(none)) = (get("sbuffer"), get("none")) {
+                out.push(format!(
+                    "sbuffer: {:.1}x the frame rate of none (target: 12x)",
+                    none.main.median / s.main.median
+                ));
+            }
+            if let (Some(s), Some(a)) = (get("sbuffer"), get("abuffer")) {
+                out.push(format!(
+                    "sbuffer: {:.2}x the frame rate of abuffer (target: > 1)",
+                    a.main.median / s.main.median
+                ));
+                let mb = |r: &Row| {
+                    r.extra
+                        .iter()
+                        .find(|(k, _)| k == "list MB")
+                        .and_then(|(_, v)| v.parse::<f64>().ok())
+                };
+                if let (Some(ms), Some(ma)) = (mb(s), mb(a)) {
+                    out.push(format!(
+                        "sbuffer memory is {:.2}x abuffer's (target: at most 0.7x)",
+                        ms / ma
+                    ));
+                }
+            }
+        }
         "scan" => {
             for r in rows.iter().filter(|r| r.n == 16 << 20) {
                 if let Some((_, v)) = r.extra.iter().find(|(k, _)| k == "scan/copy bandwidth") {

@@ -23,7 +23,8 @@ fn strategies(opts: &BenchOptions) -> Vec<(Neighbors, SortAlgo)> {
 
 /// One SPH step per frame on the dam break scaled to N particles.
 pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
-    let base = Scene::built_in("dam-break").expect("built-in");
+    let mut base = Scene::built_in("dam-break").expect("built-in");
+    base.fluid = base.fluid.with_overrides(&opts.switches.fluid)?;
     let mut rows = Vec::new();
     for (strategy, sort) in strategies(opts) {
         let mut solver = SphSolver::new(ctx, strategy, Some(sort))?;
@@ -66,6 +67,7 @@ pub const STABILITY_STEPS: u64 = 10_000;
 /// the domain, the settled pool's mean density within 5% of rho_0.
 pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut scene = Scene::built_in("dam-break").expect("built-in");
+    scene.fluid = scene.fluid.with_overrides(&opts.switches.fluid)?;
     if let Some(n) = opts.switches.particles {
         scene = scene.with_particles(n);
     }

@@ -237,7 +237,8 @@ pub struct GraphicsDesc<'a> {
     pub defines: &'a [(&'a str, String)],
     pub buffers: u32,
     pub push_size: u32,
-    pub color_format: vk::Format,
+    /// None: no colour attachment (passes that only write storage buffers).
+    pub color_format: Option<vk::Format>,
     pub depth_format: Option<vk::Format>,
     pub blend: bool,
     pub topology: vk::PrimitiveTopology,
@@ -292,10 +293,16 @@ impl GraphicsPipeline {
             .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
             .alpha_blend_op(vk::BlendOp::ADD)
             .color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachment);
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(
+            if d.color_format.is_some() {
+                &attachment[..]
+            } else {
+                &[]
+            },
+        );
         let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
-        let formats = [d.color_format];
+        let formats: Vec<vk::Format> = d.color_format.into_iter().collect();
         let mut rendering =
             vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
         if let Some(df) = d.depth_format {

@@ -231,6 +231,31 @@ impl ColorTarget {
     }
 }
 
+/// Begin dynamic rendering with no attachments over width x height (fragment passes that
+/// only write storage buffers), with the viewport and scissor set.
+pub fn begin_empty_rendering(ctx: &Context, cmd: vk::CommandBuffer, width: u32, height: u32) {
+    let area = vk::Rect2D {
+        offset: vk::Offset2D { x: 0, y: 0 },
+        extent: vk::Extent2D { width, height },
+    };
+    let info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1);
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: width as f32,
+        height: height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    unsafe {
+        ctx.device.cmd_begin_rendering(cmd, &info);
+        ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+        ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+    }
+}
+
 /// Write RGBA8 pixels as a PNG.
 pub fn save_rgba(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
     let img =

@@ -45,7 +45,7 @@ impl PointsView {
                     defines: &[],
                     buffers: 2,
                     push_size: std::mem::size_of::<PointsPush>() as u32,
-                    color_format: COLOR_FORMAT,
+                    color_format: Some(COLOR_FORMAT),
                     depth_format: Some(DEPTH_FORMAT),
                     blend: false,
                     topology: vk::PrimitiveTopology::TRIANGLE_LIST,

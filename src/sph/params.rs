@@ -140,6 +140,35 @@ impl FluidParams {
         Ok(())
     }
 
+    /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
+    /// a scene file's [fluid] table: unknown keys and invalid values are errors.
+    pub fn with_overrides(&self, overrides: &[String]) -> Result<Self> {
+        if overrides.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut value = toml::Value::try_from(self)
+            .map_err(|e| Error::Param(format!("fluid parameters: {e}")))?;
+        let table = value
+            .as_table_mut()
+            .expect("a struct serialises to a table");
+        for o in overrides {
+            let (k, v) = o
+                .split_once('=')
+                .ok_or_else(|| Error::Param(format!("--fluid {o}: expected KEY=VALUE")))?;
+            let (k, v) = (k.trim(), v.trim());
+            let parsed = toml::from_str::<toml::Table>(&format!("x = {v}"))
+                .ok()
+                .and_then(|mut t| t.remove("x"))
+                .unwrap_or_else(|| toml::Value::String(v.to_string()));
+            table.insert(k.to_string(), parsed);
+        }
+        let out: FluidParams = value
+            .try_into()
+            .map_err(|e| Error::Param(format!("--fluid: {e}")))?;
+        out.validate()?;
+        Ok(out)
+    }
+
     /// Lattice spacing at rest density: (m / rho_0)^(1/3).
     pub fn spacing(&self) -> f32 {
         (self.mass / self.rest_density).cbrt()

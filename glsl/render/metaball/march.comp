@@ -1,0 +1,256 @@
+#version 450
+// Ray marching through the metaball field, one invocation per pixel. The primary ray
+// marches the depth interval covered by the spheres of its pixel's list (LIST none: the
+// fluid's bounds), sums only those metaballs, refines the hit by bisection and takes the
+// normal from the analytic gradient. Glass and tinted trace reflection and refraction
+// with an explicit stack; secondary samples read the list of the pixel they project to
+// (off screen: every metaball, or the path ends).
+#include "common/index.glsl"
+#include "common.glsl"
+
+const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
+uint offscreen_samples = 0u;
+uint longest = 0u;
+
+// Field value and (optionally) gradient at x from the metaballs of pixel p (or ALL).
+float field(vec3 x, uint p) {
+    float f = 0.0;
+#if LIST == 0
+    p = ALL;
+#endif
+    if (p == ALL) {
+        for (uint j = 0u; j < P.n; ++j) { vec3 d = x - centers[j].xyz; f += density2(dot(d, d)); }
+        return f;
+    }
+#if LIST == 1
+    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
+        vec3 d = x - centers[nodes[node].x].xyz;
+        f += density2(dot(d, d));
+    }
+#elif LIST == 2
+    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) { vec3 d = x - centers[list[s]].xyz; f += density2(dot(d, d)); }
+#endif
+    return f;
+}
+
+vec3 gradient(vec3 x, uint p) {
+    vec3 g = vec3(0.0);
+#if LIST == 0
+    p = ALL;
+#endif
+    if (p == ALL) {
+        for (uint j = 0u; j < P.n; ++j) { vec3 d = x - centers[j].xyz; g += d * density_grad_over_r(dot(d, d)); }
+        return g;
+    }
+#if LIST == 1
+    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
+        vec3 d = x - centers[nodes[node].x].xyz;
+        g += d * density_grad_over_r(dot(d, d));
+    }
+#elif LIST == 2
+    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) { vec3 d = x - centers[list[s]].xyz; g += d * density_grad_over_r(dot(d, d)); }
+#endif
+    return g;
+}
+
+// The pixel whose list covers point x, NIL when x projects off screen or behind the eye.
+uint project(vec3 x) {
+    vec4 c = P.view_proj * vec4(x, 1.0);
+    if (c.w <= 1e-6) return NIL;
+    vec2 ndc = c.xy / c.w;
+    vec2 s = (ndc * 0.5 + 0.5) * vec2(P.width, P.height);
+    if (any(lessThan(s, vec2(0.0))) || s.x >= float(P.width) || s.y >= float(P.height)) return NIL;
+    return pixel_index(uvec2(s));
+}
+
+vec2 ray_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
+    vec3 inv = 1.0 / d;
+    vec3 a = (lo - o) * inv, b = (hi - o) * inv;
+    return vec2(max(max(min(a, b).x, min(a, b).y), max(min(a, b).z, 0.0)), min(min(max(a, b).x, max(a, b).y), max(a, b).z));
+}
+
+// The depth interval the spheres of pixel p cover along the primary ray.
+vec2 list_interval(vec3 o, vec3 d, uint p) {
+    float R2 = radius() * radius();
+    vec2 iv = vec2(1e30, -1e30);
+    uint len = 0u;
+#if LIST == 1
+    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
+        vec3 oc = o - centers[nodes[node].x].xyz;
+        len++;
+#elif LIST == 2
+    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) {
+        vec3 oc = o - centers[list[s]].xyz;
+        len++;
+#else
+    for (uint j = 0u; j < 0u; ++j) {
+        vec3 oc = o;
+#endif
+        float b = dot(oc, d);
+        float disc = b * b - (dot(oc, oc) - R2);
+        if (disc > 0.0) { float q = sqrt(disc); iv = vec2(min(iv.x, -b - q), max(iv.y, -b + q)); }
+    }
+    longest = max(longest, len);
+    return vec2(max(iv.x, 0.0), iv.y);
+}
+
+vec3 box_lo() { return bounds[0].xyz - vec3(radius()); }
+vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
+
+// March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
+// ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
+// -2 when a secondary sample left the screen and paths end there. Samples sit on the
+// grid t = k * step from the ray's origin, so every list variant (whose intervals start
+// at different t0) takes the same samples and bisects the same steps.
+float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w;
+    float t = ceil(t0 / step) * step;
+    float prev = max(t - step, 0.0);
+    for (uint i = 0u; i < P.max_steps && t <= t1; ++i) {
+        vec3 x = o + d * t;
+        uint p = pixel;
+        if (pixel == NIL) {
+            p = project(x);
+            if (p == NIL) {
+                offscreen_samples++;
+                if (P.offscreen_end != 0u) return -2.0;
+                p = ALL;
+            }
+        }
+        if ((field(x, p) >= T) != inside) {
+            float a = prev, b = t;
+            for (uint k = 0u; k < P.refine; ++k) {
+                float m = 0.5 * (a + b);
+                vec3 xm = o + d * m;
+                uint pm = pixel == NIL ? project(xm) : pixel;
+                if (pm == NIL) pm = ALL;
+                if ((field(xm, pm) >= T) != inside) b = m; else a = m;
+            }
+            return b;
+        }
+        prev = t;
+        t += step;
+    }
+    return -1.0;
+}
+
+vec3 normal_at(vec3 x, uint pixel) {
+    uint p = pixel == NIL ? project(x) : pixel;
+    if (p == NIL) p = ALL;
+    vec3 g = gradient(x, p);
+    float l = length(g);
+    return l > 0.0 ? -g / l : vec3(0.0, 1.0, 0.0);
+}
+
+vec3 unpack_rgb(uint v) { return unpackUnorm4x8(v).rgb; }
+
+// Procedural sky (gradient, sun, checkered ground) or an equirectangular image.
+vec3 sky_color(vec3 d) {
+    if (P.sky_w > 0u) {
+        // Bilinear lookup, wrapping in longitude and clamping in latitude.
+        float u = atan(d.z, d.x) / (2.0 * 3.14159265) + 0.5;
+        float v = acos(clamp(d.y, -1.0, 1.0)) / 3.14159265;
+        vec2 st = vec2(u * float(P.sky_w) - 0.5, v * float(P.sky_h) - 0.5);
+        vec2 fl = floor(st);
+        vec2 f = st - fl;
+        int w = int(P.sky_w), h = int(P.sky_h);
+        int x0 = int(fl.x);
+        x0 = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0);
+        int x1 = x0 + 1 >= w ? 0 : x0 + 1;
+        int y0 = clamp(int(fl.y), 0, h - 1), y1 = clamp(int(fl.y) + 1, 0, h - 1);
+        vec3 c00 = unpack_rgb(sky[y0 * w + x0]), c10 = unpack_rgb(sky[y0 * w + x1]);
+        vec3 c01 = unpack_rgb(sky[y1 * w + x0]), c11 = unpack_rgb(sky[y1 * w + x1]);
+        return pow(mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y), vec3(2.2));
+    }
+    if (d.y < 0.0) {
+        vec2 g = d.xz / max(-d.y, 1e-3);
+        float check = mod(floor(g.x * 2.0) + floor(g.y * 2.0), 2.0);
+        return mix(vec3(0.25, 0.23, 0.2), vec3(0.45, 0.42, 0.38), check) * (0.6 + 0.4 * min(-d.y * 4.0, 1.0));
+    }
+    vec3 c = mix(vec3(0.75, 0.82, 0.9), vec3(0.25, 0.45, 0.8), pow(d.y, 0.6));
+    float s = max(dot(d, P.sun.xyz), 0.0);
+    return c + vec3(1.0, 0.9, 0.7) * (pow(s, 400.0) * 8.0 + pow(s, 8.0) * 0.2);
+}
+
+vec3 phong(vec3 n, vec3 v) {
+    vec3 l = P.sun.xyz;
+    float diff = max(dot(n, l), 0.0);
+    vec3 h = normalize(l + v);
+    float spec = pow(max(dot(n, h), 0.0), 64.0);
+    return P.base.rgb * (0.15 + 0.85 * diff) + vec3(0.6) * spec;
+}
+
+struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
+const int STACK = 8;
+
+void main() {
+    uint id = global_id();
+    if (id >= P.width * P.height) return;
+    uvec2 pix = uvec2(id % P.width, id / P.width);
+    vec2 ndc = (vec2(pix) + 0.5) / vec2(P.width, P.height) * 2.0 - 1.0;
+    vec4 a = P.inv_view_proj * vec4(ndc, 0.0, 1.0);
+    vec4 b = P.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 o = P.eye.xyz;
+    vec3 d = normalize(b.xyz / b.w - a.xyz / a.w);
+
+#if LIST == 0
+    vec2 iv = ray_box(o, d, box_lo(), box_hi());
+#else
+    vec2 iv = list_interval(o, d, id);
+#endif
+    vec3 color = vec3(0.0);
+    vec4 dbg = vec4(-1.0, 0.0, 0.0, 0.0);
+    Path stack[STACK];
+    int sp = 0;
+    stack[sp++] = Path(o, d, vec3(1.0), 0u, false);
+    while (sp > 0) {
+        Path r = stack[--sp];
+        bool primary = r.depth == 0u;
+        vec2 span = primary ? iv : ray_box(r.o, r.d, box_lo(), box_hi());
+        float t = span.x <= span.y ? march(r.o, r.d, span.x, span.y, r.inside, primary ? id : NIL) : -1.0;
+        if (t < 0.0) {
+            // Left the fluid's bounds (or the screen, with offscreen_end): the sky.
+            color += r.w * sky_color(r.d);
+            continue;
+        }
+        vec3 x = r.o + r.d * t;
+        vec3 n = normal_at(x, primary ? id : NIL);
+        if (primary) dbg = vec4(t, n);
+#if MATERIAL == 0
+        color += r.w * phong(n, -r.d);
+#else
+        vec3 w = r.w;
+#if MATERIAL == 2
+        if (r.inside) w *= exp(-P.absorb.rgb * t);  // Beer-Lambert along the inside path
+#endif
+        vec3 nn = r.inside ? -n : n;  // facing the incoming ray
+        float cos_i = clamp(-dot(r.d, nn), 0.0, 1.0);
+        vec3 rd = reflect(r.d, nn);
+        float eps = 0.05 * radius();
+#if MATERIAL == 3
+        vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
+        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
+        if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd);
+        else stack[sp++] = refl;
+#else
+        float eta = r.inside ? P.absorb.w : 1.0 / P.absorb.w;
+        vec3 td = refract(r.d, nn, eta);
+        float f0 = (P.absorb.w - 1.0) / (P.absorb.w + 1.0);
+        f0 *= f0;
+        float F = dot(td, td) == 0.0 ? 1.0 : f0 + (1.0 - f0) * pow(1.0 - cos_i, 5.0);
+        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
+        Path refr = Path(x - nn * eps, normalize(td), w * (1.0 - F), r.depth + 1u, !r.inside);
+        bool deep = r.depth + 1u > P.depth;
+        if (deep || sp >= STACK) color += refl.w * sky_color(rd); else stack[sp++] = refl;
+        if (F < 1.0) {
+            if (deep || sp >= STACK) color += refr.w * sky_color(refr.d); else stack[sp++] = refr;
+        }
+#endif
+#endif
+    }
+    color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
+    pixels[id] = packUnorm4x8(vec4(color, 1.0));
+    if (P.debug != 0u) debug_out[id] = dbg;
+    if (longest > 0u) atomicMax(stats[1], longest);
+    if (offscreen_samples > 0u) atomicAdd(stats[3], offscreen_samples);
+}

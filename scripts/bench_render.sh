@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Regenerate results/<device-slug>/render.md: the thesis's rendering setup (2048 particles
+# in a resting blob, 512x512, Wyvill, T = 0.9, R = 0.04, I = 2) for none, A-buffer and
+# S-buffer, with Phong and with glass at recursion depth 3.
+# Usage: scripts/bench_render.sh [--device N|NAME] [--frames N]
+# FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${FLUIDFORM_BIN:-}
+if [ -z "$bin" ]; then
+  cargo build --release --quiet
+  bin=target/release/fluidform
+fi
+dev=()
+args=(--frames 20 --warmup 3)
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --device) dev=(--device "$2"); shift 2 ;;
+    *) args+=("$1"); shift ;;
+  esac
+done
+slug=$("$bin" devices --slug "${dev[@]}")
+dir=results/$slug
+mkdir -p "$dir"
+setup=(--particles 2048 --width 512 --height 512 --density wyvill --threshold 0.9 --radius 0.04 --refine 2)
+phong=("$bin" bench render --out out/bench/render-phong "${setup[@]}" --material phong "${dev[@]}" "${args[@]}")
+glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material glass --depth 3 "${dev[@]}" "${args[@]}")
+"${phong[@]}" > /dev/null
+"${glass[@]}" > /dev/null
+cp out/bench/render-phong/sweep.csv "$dir/render-phong.csv"
+cp out/bench/render-glass/sweep.csv "$dir/render-glass.csv"
+md=$dir/render.md
+{
+  echo "# Metaball rendering on $slug"
+  echo
+  "$bin" devices | sed 's/^/    /'
+  echo
+  echo "Made by \`scripts/bench_render.sh ${*}\`, which runs:"
+  echo
+  echo "    fluidform ${phong[*]:1}"
+  echo "    fluidform ${glass[*]:1}"
+  echo
+  echo "The thesis (GTX 1080 Ti, 2048 particles shaped like a character, 512x512): Phong"
+  echo "none 11 / A-buffer 87 / S-buffer 98 fps, 8.7 / 5.8 MB; transparent at depth 3:"
+  echo "none 2-3 / A 37-39 / S 52-57 fps. Here a resting blob of the same count and spacing."
+  echo
+  echo "## Phong"
+  echo
+  cat out/bench/render-phong/sweep.md
+  echo
+  echo "## Glass, recursion depth 3"
+  echo
+  cat out/bench/render-glass/sweep.md
+} > "$md"
+echo "wrote $md"

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Regenerate results/<device-slug>/sph.md: SPH steps per second and per-pass ms for every
+# neighbour strategy over N = 8K..1M, and the 32K dam-break stability run (10 000 steps).
+# Usage: scripts/bench_sph.sh [--device N|NAME] [--frames N]
+# FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${FLUIDFORM_BIN:-}
+if [ -z "$bin" ]; then
+  cargo build --release --quiet
+  bin=target/release/fluidform
+fi
+dev=()
+args=(--frames 20 --warmup 3)
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --device) dev=(--device "$2"); shift 2 ;;
+    *) args+=("$1"); shift ;;
+  esac
+done
+slug=$("$bin" devices --slug "${dev[@]}")
+dir=results/$slug
+mkdir -p "$dir"
+md=$dir/sph.md
+sweep=("$bin" bench sph --out out/bench/sph "${dev[@]}" "${args[@]}")
+stab=("$bin" bench stability --out out/bench/stability "${dev[@]}")
+"${sweep[@]}" > /dev/null
+"${stab[@]}" > /dev/null
+cp out/bench/sph/sweep.csv "$dir/sph.csv"
+cp out/bench/stability/stability.json "$dir/stability.json"
+{
+  echo "# SPH on $slug"
+  echo
+  "$bin" devices | sed 's/^/    /'
+  echo
+  echo "Made by \`scripts/bench_sph.sh ${*}\`, which runs:"
+  echo
+  echo "    fluidform ${sweep[*]:1}"
+  echo "    fluidform ${stab[*]:1}"
+  echo
+  echo "## Steps: the dam break scaled to N, one step per repetition"
+  echo
+  cat out/bench/sph/sweep.md
+  echo
+  echo "## Stability: the 32K dam break for 10 000 steps"
+  echo
+  cat out/bench/stability/sweep.md
+  echo
+  echo "Checkpoints (every 1000 steps) are in stability.json."
+} > "$md"
+echo "wrote $md"

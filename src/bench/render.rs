@@ -1,0 +1,77 @@
+//! `bench render`: the thesis's rendering tables. A resting blob of N particles (2048 by
+//! default) at 512x512, every axis the tables vary from the switches: --list (all three
+//! when unset), --material, --density, --threshold, --radius, --refine, --depth.
+use super::{measure, BenchOptions, Row};
+use crate::config::ListKind;
+use crate::error::Result;
+use crate::gpu::Context;
+use crate::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use crate::sph::FluidParams;
+use serde_json::json;
+
+pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let sw = &opts.switches;
+    let n = sw.particles.unwrap_or(2048) as usize;
+    let spacing = FluidParams::default().spacing();
+    let pts = blob(n, spacing);
+    let mut centers = ctx.storage_buffer("metaball centers", (n * 16) as u64)?;
+    ctx.upload(&mut centers, 0, &pts)?;
+    let lists = match sw.list {
+        Some(l) => vec![l],
+        None => vec![ListKind::None, ListKind::Abuffer, ListKind::Sbuffer],
+    };
+    let mut rows = Vec::new();
+    let result = (|| -> Result<()> {
+        for list in lists {
+            let mut settings = MetaballSettings::from_switches(sw)?;
+            settings.list = list;
+            let cam = crate::run::camera_with_switches(
+                blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
+                sw,
+            );
+            let mut r = MetaballRenderer::new(ctx, settings.clone())?;
+            let mut b = r.buffers(ctx, n as u64, 2, false)?;
+            // Size the lists (and count the redos) before timing.
+            let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0);
+            let row = sized.and_then(|(st, redos)| {
+                let detail = json!({ "settings": settings, "particles": n, "spacing": spacing });
+                let mut row = measure(
+                    ctx,
+                    opts,
+                    &list.as_str(),
+                    n as u64,
+                    "render",
+                    detail,
+                    |prof, cmd| {
+                        prof.begin(ctx, cmd, "render");
+                        r.record(ctx, cmd, prof, &b, &centers, n as u32, &cam, 0)?;
+                        prof.end(ctx, cmd);
+                        Ok(())
+                    },
+                )?;
+                let after = r.frame_stats(&b, 0);
+                row.extra = vec![
+                    ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
+                    (
+                        "list MB".into(),
+                        format!("{:.2}", st.list_bytes as f64 / 1e6),
+                    ),
+                    ("fragments".into(), st.fragments.to_string()),
+                    ("longest list".into(), st.longest.to_string()),
+                    ("redos".into(), redos.to_string()),
+                    (
+                        "overflow in timed frames".into(),
+                        after.overflow.to_string(),
+                    ),
+                ];
+                Ok(row)
+            });
+            b.destroy(ctx);
+            r.destroy(ctx);
+            rows.push(row?);
+        }
+        Ok(())
+    })();
+    ctx.destroy_buffer(&mut centers);
+    result.map(|_| rows)
+}

@@ -1,0 +1,214 @@
+//! Renderer settings from the command line (or a bench configuration), with the thesis's
+//! defaults, and their GPU mirror.
+use crate::config::{DensityFn, ListKind, Material, Switches};
+use crate::error::{Error, Result};
+use crate::render::Camera;
+use bytemuck::{Pod, Zeroable};
+use serde::Serialize;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct MetaballSettings {
+    pub list: ListKind,
+    pub density: DensityFn,
+    pub material: Material,
+    /// Iso threshold T of the summed density.
+    pub threshold: f32,
+    /// Metaball support radius R.
+    pub radius: f32,
+    /// Bisection steps I on a hit.
+    pub refine: u32,
+    /// Recursion depth D of glass, tinted and metals.
+    pub depth: u32,
+    /// March step (default R / 8).
+    pub step: f32,
+    pub max_steps: u32,
+    /// Secondary samples that leave the screen end the path (else: every metaball).
+    pub offscreen_end: bool,
+    pub width: u32,
+    pub height: u32,
+    /// Index of refraction of glass and tinted (water).
+    pub ior: f32,
+    /// Tinted: absorption per unit length, per channel.
+    pub absorb: [f32; 3],
+    /// Phong colour ("tar monster").
+    pub base: [f32; 3],
+    /// Equirectangular sky image (else the procedural sky).
+    pub sky: Option<String>,
+}
+
+pub const MAX_DEPTH: u32 = 6;
+pub const MAX_REFINE: u32 = 32;
+
+/// Complex index of refraction (n, k) per RGB channel (about 650, 550, 450 nm).
+fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
+    match m {
+        Material::Gold => Some(([0.143, 0.374, 1.442], [3.983, 2.385, 1.603])),
+        Material::Copper => Some(([0.200, 0.924, 1.102], [3.912, 2.452, 2.142])),
+        Material::Aluminium => Some(([1.657, 0.880, 0.521], [9.224, 6.270, 4.837])),
+        _ => None,
+    }
+}
+
+/// Reflectance at normal incidence from a complex index: ((n-1)^2 + k^2) / ((n+1)^2 + k^2).
+pub fn f0_from_nk(n: f32, k: f32) -> f32 {
+    ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
+}
+
+impl MetaballSettings {
+    /// The thesis's defaults (Wyvill, T = 0.9, R = 0.04, I = 2, Phong, S-buffer),
+    /// overridden by the switches that are set.
+    pub fn from_switches(sw: &Switches) -> Result<Self> {
+        let radius = sw.radius.unwrap_or(0.04);
+        let s = Self {
+            list: sw.list.unwrap_or(ListKind::Sbuffer),
+            density: sw.density.unwrap_or(DensityFn::Wyvill),
+            material: sw.material.unwrap_or(Material::Phong),
+            threshold: sw.threshold.unwrap_or(0.9),
+            radius,
+            refine: sw.refine.unwrap_or(2),
+            depth: sw.depth.unwrap_or(1),
+            step: radius / 8.0,
+            max_steps: 2048,
+            offscreen_end: sw
+                .offscreen
+                .map(|o| o == crate::config::Offscreen::End)
+                .unwrap_or(false),
+            width: sw.width,
+            height: sw.height,
+            ior: 1.33,
+            absorb: [6.0, 2.0, 0.8],
+            base: [0.08, 0.06, 0.05],
+            sky: sw.sky.clone(),
+        };
+        s.validate()?;
+        Ok(s)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if !(self.radius > 0.0 && self.radius.is_finite()) {
+            return Err(Error::Param(format!(
+                "--radius must be positive, got {}",
+                self.radius
+            )));
+        }
+        if !(self.threshold > 0.0 && self.threshold.is_finite()) {
+            return Err(Error::Param(format!(
+                "--threshold must be positive, got {}",
+                self.threshold
+            )));
+        }
+        if self.refine > MAX_REFINE {
+            return Err(Error::Param(format!(
+                "--refine must be at most {MAX_REFINE}, got {}",
+                self.refine
+            )));
+        }
+        if self.depth > MAX_DEPTH {
+            return Err(Error::Param(format!(
+                "--depth must be at most {MAX_DEPTH}, got {}",
+                self.depth
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn f0(&self) -> [f32; 3] {
+        match metal_nk(self.material) {
+            Some((n, k)) => [
+                f0_from_nk(n[0], k[0]),
+                f0_from_nk(n[1], k[1]),
+                f0_from_nk(n[2], k[2]),
+            ],
+            None => [0.04; 3],
+        }
+    }
+
+    /// Shader define MATERIAL: 0 phong, 1 glass, 2 tinted, 3 metal.
+    pub fn material_index(&self) -> u32 {
+        match self.material {
+            Material::Phong => 0,
+            Material::Glass => 1,
+            Material::Tinted => 2,
+            Material::Gold | Material::Copper | Material::Aluminium => 3,
+        }
+    }
+
+    pub fn list_index(&self) -> u32 {
+        match self.list {
+            ListKind::None => 0,
+            ListKind::Abuffer => 1,
+            ListKind::Sbuffer => 2,
+        }
+    }
+
+    pub fn pixels(&self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
+}
+
+/// Mirror of `RenderParams` in glsl/render/metaball/common.glsl (std430).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct RenderParams {
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub view: [[f32; 4]; 4],
+    pub proj: [f32; 4],
+    pub eye: [f32; 4],
+    pub sun: [f32; 4],
+    pub absorb: [f32; 4],
+    pub f0: [f32; 4],
+    pub base: [f32; 4],
+    pub width: u32,
+    pub height: u32,
+    pub n: u32,
+    pub refine: u32,
+    pub depth: u32,
+    pub max_steps: u32,
+    pub list_capacity: u32,
+    pub offscreen_end: u32,
+    pub sky_w: u32,
+    pub sky_h: u32,
+    pub debug: u32,
+    pub pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 336);
+
+impl RenderParams {
+    pub fn new(
+        s: &MetaballSettings,
+        cam: &Camera,
+        n: u32,
+        list_capacity: u64,
+        sky: (u32, u32),
+        debug: bool,
+    ) -> Self {
+        let vp = cam.view_proj();
+        let proj = cam.proj();
+        let sun = glam::Vec3::new(0.4, 0.8, 0.3).normalize();
+        let f0 = s.f0();
+        Self {
+            view_proj: vp.to_cols_array_2d(),
+            inv_view_proj: vp.inverse().to_cols_array_2d(),
+            view: cam.view().to_cols_array_2d(),
+            proj: [proj.x_axis.x, proj.y_axis.y, cam.near, 0.0],
+            eye: [cam.eye.x, cam.eye.y, cam.eye.z, s.radius],
+            sun: [sun.x, sun.y, sun.z, s.step],
+            absorb: [s.absorb[0], s.absorb[1], s.absorb[2], s.ior],
+            f0: [f0[0], f0[1], f0[2], 0.0],
+            base: [s.base[0], s.base[1], s.base[2], s.threshold],
+            width: s.width,
+            height: s.height,
+            n,
+            refine: s.refine,
+            depth: s.depth,
+            max_steps: s.max_steps,
+            list_capacity: list_capacity.min(u32::MAX as u64) as u32,
+            offscreen_end: s.offscreen_end as u32,
+            sky_w: sky.0,
+            sky_h: sky.1,
+            debug: debug as u32,
+            pad: 0,
+        }
+    }
+}

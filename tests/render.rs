@@ -1,0 +1,360 @@
+//! The metaball renderer: every list gives the same image, the GPU's hits match the CPU
+//! reference marcher, billboards are conservative, lists grow on overflow, golden images.
+mod common;
+use fluidform::config::{DensityFn, ListKind, Material, Switches};
+use fluidform::gpu::Context;
+use fluidform::render::metaball::reference::{march, MarchParams};
+use fluidform::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use fluidform::render::Camera;
+use glam::Vec3;
+
+const W: u32 = 96;
+const H: u32 = 72;
+const N: usize = 160;
+const SPACING: f32 = 0.0271;
+
+fn settings(list: ListKind, density: DensityFn, material: Material) -> MetaballSettings {
+    let mut s = MetaballSettings::from_switches(&switches()).unwrap();
+    s.list = list;
+    s.density = density;
+    s.material = material;
+    s.width = W;
+    s.height = H;
+    s.depth = 2;
+    s
+}
+
+fn switches() -> Switches {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Only {
+        #[command(flatten)]
+        s: Switches,
+    }
+    Only::parse_from(["t"]).s
+}
+
+struct Scene {
+    pts: Vec<[f32; 4]>,
+    cam: Camera,
+}
+
+fn scene() -> Scene {
+    Scene {
+        pts: blob(N, SPACING),
+        cam: blob_camera(N, SPACING, W as f32 / H as f32),
+    }
+}
+
+/// Render and return the RGBA8 pixels (and the renderer and buffers for more checks).
+fn render(
+    ctx: &Context,
+    s: MetaballSettings,
+    sc: &Scene,
+    debug: bool,
+) -> (Vec<u8>, Option<Vec<[f32; 4]>>, Option<Vec<Vec<u32>>>) {
+    let mut centers = ctx
+        .storage_buffer("centers", (sc.pts.len() * 16) as u64)
+        .unwrap();
+    ctx.upload(&mut centers, 0, &sc.pts).unwrap();
+    let list = s.list;
+    let mut r = MetaballRenderer::new(ctx, s).unwrap();
+    let mut b = r.buffers(ctx, sc.pts.len() as u64, 1, debug).unwrap();
+    let (st, _) = r
+        .render_sync(ctx, &mut b, &centers, sc.pts.len() as u32, &sc.cam, 0)
+        .unwrap();
+    assert_eq!(st.overflow, 0);
+    let px = b.pixels(0).to_vec();
+    let dbg = debug.then(|| r.debug(ctx, &b).unwrap());
+    let lists = (list == ListKind::Sbuffer).then(|| r.sbuffer_lists(ctx, &b).unwrap());
+    b.destroy(ctx);
+    r.destroy(ctx);
+    ctx.destroy_buffer(&mut centers);
+    (px, dbg, lists)
+}
+
+/// Fraction of pixels whose channels all differ by at most `tol`.
+fn agreement(a: &[u8], b: &[u8], tol: u8) -> f64 {
+    let same = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .filter(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| p.abs_diff(*q) <= tol))
+        .count();
+    same as f64 / (a.len() / 4) as f64
+}
+
+fn write_diff(name: &str, a: &[u8], b: &[u8]) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render-diffs");
+    std::fs::create_dir_all(&dir).unwrap();
+    let diff: Vec<u8> = a
+        .chunks(4)
+        .zip(b.chunks(4))
+        .flat_map(|(x, y)| {
+            let d = x
+                .iter()
+                .zip(y.iter())
+                .take(3)
+                .map(|(p, q)| p.abs_diff(*q))
+                .max()
+                .unwrap();
+            [d.saturating_mul(8), 0, 0, 255]
+        })
+        .collect();
+    let path = dir.join(format!("{name}-diff.png"));
+    fluidform::gpu::target::save_rgba(&path, W, H, &diff).unwrap();
+    fluidform::gpu::target::save_rgba(&dir.join(format!("{name}-got.png")), W, H, a).unwrap();
+    path
+}
+
+#[test]
+fn every_list_gives_the_same_image() {
+    let ctx = common::ctx();
+    let sc = scene();
+    let densities = [
+        DensityFn::Blinn,
+        DensityFn::Wyvill,
+        DensityFn::Nishimura,
+        DensityFn::Murakami,
+    ];
+    let materials = [
+        Material::Phong,
+        Material::Glass,
+        Material::Tinted,
+        Material::Gold,
+        Material::Copper,
+        Material::Aluminium,
+    ];
+    for d in densities {
+        for m in materials {
+            let (none, _, _) = render(&ctx, settings(ListKind::None, d, m), &sc, false);
+            let lit = none.chunks(4).filter(|p| p[..3] != none[..3]).count();
+            assert!(lit > 200, "{d:?}/{m:?}: the blob is not in the picture");
+            for list in [ListKind::Abuffer, ListKind::Sbuffer] {
+                let (img, _, _) = render(&ctx, settings(list, d, m), &sc, false);
+                let a = agreement(&img, &none, 1);
+                if a < 0.999 {
+                    let p = write_diff(&format!("{d:?}-{m:?}-{list:?}"), &img, &none);
+                    panic!(
+                        "{d:?}/{m:?}/{list:?}: {:.4}% of pixels agree with none (diff: {})",
+                        a * 100.0,
+                        p.display()
+                    );
+                }
+            }
+        }
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn primary_hits_match_the_cpu_reference() {
+    let ctx = common::ctx();
+    let sc = scene();
+    let centers: Vec<Vec3> = sc.pts.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    for d in [
+        DensityFn::Wyvill,
+        DensityFn::Nishimura,
+        DensityFn::Blinn,
+        DensityFn::Murakami,
+    ] {
+        let mut s = settings(ListKind::Sbuffer, d, Material::Phong);
+        s.refine = 20;
+        let p = MarchParams {
+            density: d,
+            radius: s.radius,
+            threshold: s.threshold,
+            step: s.step,
+            max_steps: s.max_steps,
+            refine: 20,
+        };
+        let (_, dbg, _) = render(&ctx, s.clone(), &sc, true);
+        let dbg = dbg.unwrap();
+        let inv = sc.cam.view_proj().inverse();
+        let (mut checked, mut disagree) = (0, 0);
+        for y in (0..H).step_by(3) {
+            for x in (0..W).step_by(3) {
+                let ndc = glam::Vec2::new(
+                    (x as f32 + 0.5) / W as f32 * 2.0 - 1.0,
+                    (y as f32 + 0.5) / H as f32 * 2.0 - 1.0,
+                );
+                let a = inv.project_point3(ndc.extend(0.0));
+                let b = inv.project_point3(ndc.extend(1.0));
+                let dir = (b - a).normalize();
+                let cpu = march(&centers, &p, sc.cam.eye, dir);
+                let g = dbg[(y * W + x) as usize];
+                match (cpu, g[0] >= 0.0) {
+                    (Some(h), true) => {
+                        checked += 1;
+                        assert!(
+                            (h.t - g[0]).abs() < 2e-3,
+                            "{d:?} pixel ({x}, {y}): t {} vs CPU {}",
+                            g[0],
+                            h.t
+                        );
+                        let n = Vec3::new(g[1], g[2], g[3]);
+                        assert!(
+                            n.dot(h.normal) > 0.995,
+                            "{d:?} pixel ({x}, {y}): normal {n:?} vs CPU {:?}",
+                            h.normal
+                        );
+                    }
+                    (None, false) => {}
+                    _ => disagree += 1,
+                }
+            }
+        }
+        assert!(checked > 50, "{d:?}: only {checked} hits compared");
+        // Grazing rays may fall either side of a step; nearly all must agree.
+        assert!(
+            disagree * 100 <= checked,
+            "{d:?}: {disagree} hit/miss disagreements in {checked}"
+        );
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn billboards_are_conservative() {
+    // Every sphere a pixel-centre ray meets is in that pixel's S-buffer list.
+    let ctx = common::ctx();
+    let sc = scene();
+    let s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong);
+    let r2 = s.radius * s.radius;
+    let (_, _, lists) = render(&ctx, s, &sc, false);
+    let lists = lists.unwrap();
+    let inv = sc.cam.view_proj().inverse();
+    let mut hits = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let ndc = glam::Vec2::new(
+                (x as f32 + 0.5) / W as f32 * 2.0 - 1.0,
+                (y as f32 + 0.5) / H as f32 * 2.0 - 1.0,
+            );
+            let a = inv.project_point3(ndc.extend(0.0));
+            let b = inv.project_point3(ndc.extend(1.0));
+            let d = (b - a).normalize();
+            let list = &lists[(y * W + x) as usize];
+            for (j, p) in sc.pts.iter().enumerate() {
+                let oc = sc.cam.eye - Vec3::new(p[0], p[1], p[2]);
+                let bq = oc.dot(d);
+                // Clearly hit (not grazing): the ray passes well inside the sphere.
+                if bq * bq - (oc.length_squared() - r2) > 1e-3 * r2 {
+                    hits += 1;
+                    assert!(
+                        list.contains(&(j as u32)),
+                        "pixel ({x}, {y}) misses sphere {j}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(hits > 1000);
+    common::finish(&ctx);
+}
+
+#[test]
+fn lists_grow_on_overflow_and_the_image_is_unchanged() {
+    let ctx = common::ctx();
+    let sc = scene();
+    let mut centers = ctx
+        .storage_buffer("centers", (sc.pts.len() * 16) as u64)
+        .unwrap();
+    ctx.upload(&mut centers, 0, &sc.pts).unwrap();
+    let (reference, _, _) = render(
+        &ctx,
+        settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong),
+        &sc,
+        false,
+    );
+    for list in [ListKind::Abuffer, ListKind::Sbuffer] {
+        let mut r = MetaballRenderer::new(&ctx, settings(list, DensityFn::Wyvill, Material::Phong))
+            .unwrap();
+        let mut b = r
+            .buffers_with_capacity(&ctx, N as u64, 1, false, 10)
+            .unwrap();
+        let (st, redos) = r
+            .render_sync(&ctx, &mut b, &centers, N as u32, &sc.cam, 0)
+            .unwrap();
+        assert!(
+            redos >= 1,
+            "{list:?}: a 10-entry list cannot hold the frame"
+        );
+        assert!(st.fragments > 10 && st.overflow == 0, "{list:?}: {st:?}");
+        assert!(b.list_capacity >= st.fragments, "{list:?}");
+        assert!(
+            agreement(b.pixels(0), &reference, 1) > 0.999,
+            "{list:?}: image changed after the regrowth"
+        );
+        b.destroy(&ctx);
+        r.destroy(&ctx);
+    }
+    ctx.destroy_buffer(&mut centers);
+    common::finish(&ctx);
+}
+
+#[test]
+fn golden_images() {
+    // FLUIDFORM_UPDATE_GOLDEN=1 rewrites them (after checking the pictures by eye).
+    let ctx = common::ctx();
+    let sc = scene();
+    for (name, m) in [
+        ("phong", Material::Phong),
+        ("glass", Material::Glass),
+        ("gold", Material::Gold),
+    ] {
+        let (img, _, _) = render(
+            &ctx,
+            settings(ListKind::Sbuffer, DensityFn::Wyvill, m),
+            &sc,
+            false,
+        );
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("tests/golden/blob-{name}.png"));
+        if std::env::var("FLUIDFORM_UPDATE_GOLDEN").is_ok() {
+            fluidform::gpu::target::save_rgba(&path, W, H, &img).unwrap();
+            continue;
+        }
+        let golden = image::open(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+            .to_rgba8();
+        assert_eq!(golden.dimensions(), (W, H));
+        // Tolerance for other drivers' arithmetic: 99% of pixels within 4/255.
+        let a = agreement(&img, golden.as_raw(), 4);
+        if a < 0.99 {
+            let p = write_diff(&format!("golden-{name}"), &img, golden.as_raw());
+            panic!(
+                "{name}: {:.3}% of pixels match the golden image (diff: {})",
+                a * 100.0,
+                p.display()
+            );
+        }
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn bad_renderer_settings_are_clear_errors() {
+    let ctx = common::ctx();
+    let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong);
+    s.radius = 0.0;
+    assert!(MetaballRenderer::new(&ctx, s)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("--radius"));
+    let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Glass);
+    s.depth = 99;
+    assert!(MetaballRenderer::new(&ctx, s)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("--depth"));
+    let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong);
+    s.sky = Some("no/such/sky.png".into());
+    let r = MetaballRenderer::new(&ctx, s).unwrap();
+    let e = r.buffers(&ctx, 10, 1, false).err().unwrap().to_string();
+    assert!(e.contains("no/such/sky.png"), "{e}");
+    let mut r = r;
+    r.destroy(&ctx);
+    common::finish(&ctx);
+}
