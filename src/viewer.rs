@@ -11,6 +11,8 @@ use serde_json::{json, Value};
 use std::cell::RefCell;
 use std::path::Path;
 
+// One viewer per run: the size difference between the variants does not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum Viewer {
     Points {
         view: PointsView,
@@ -18,7 +20,7 @@ pub enum Viewer {
         push: PointsPush,
     },
     Metaballs {
-        renderer: MetaballRenderer,
+        renderer: Box<MetaballRenderer>,
         buffers: RefCell<MetaballBuffers>,
         /// Per-slot copies of the particle positions, so a frame can be redone.
         centers: Vec<Buffer>,
@@ -52,7 +54,7 @@ impl Viewer {
             centers.push(ctx.storage_buffer("metaball centers", n as u64 * 16)?);
         }
         Ok(Viewer::Metaballs {
-            renderer,
+            renderer: Box::new(renderer),
             buffers: RefCell::new(buffers),
             centers,
             cam,

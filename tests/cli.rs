@@ -234,7 +234,7 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
             "--particles",
         ),
         (
-            vec!["bench", "render", "--out", d, "--radius", "-1"],
+            vec!["bench", "render", "--out", d, "--radius=-1"],
             "--radius must be positive",
         ),
         (vec!["bench", "nothing", "--out", d], "unknown benchmark"),

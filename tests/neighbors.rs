@@ -158,3 +158,52 @@ fn morton_with_counting_sort_is_rejected() {
     );
     common::finish(&ctx);
 }
+
+#[test]
+fn morton_equals_grid_per_particle_at_50k() {
+    // Beyond the brute-force sizes: the same count for every particle as the grid (which
+    // matches brute force above). Ranges stay under llvmpipe's per-invocation budget of
+    // 65535 loop iterations here (see README); larger N on lavapipe cuts them short.
+    let ctx = common::ctx();
+    let n = 50_000usize;
+    let radius = fluidform::bench::primitives::radius_for(n as u32, 30.0);
+    let grid = GridSpec::covering([0.0; 3], [1.0; 3], radius).unwrap();
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
+    let pos: Vec<[f32; 4]> = (0..n)
+        .map(|_| [rng.random(), rng.random(), rng.random(), 1.0])
+        .collect();
+    let mut p = ctx.storage_buffer("positions", (n * 16) as u64).unwrap();
+    ctx.upload(&mut p, 0, &pos).unwrap();
+    let mut by_strategy = Vec::new();
+    for (strategy, sort) in [
+        (Neighbors::Grid, SortAlgo::Counting),
+        (Neighbors::Morton, SortAlgo::Bitonic),
+    ] {
+        let mut search = NeighborSearch::new(&ctx, strategy, Some(sort)).unwrap();
+        let mut b = search.buffers(&ctx, n as u64, &grid, 1).unwrap();
+        ctx.one_shot(|cmd| {
+            search.record_build(&ctx, cmd, &mut Labels, &b, &p, n as u32, &grid)?;
+            search.record_query(&ctx, cmd, &mut Labels, &b, &p, n as u32, &grid, radius)
+        })
+        .unwrap()
+        .unwrap();
+        let perm: Vec<u32> = ctx.readback(&b.perm, 0, n).unwrap();
+        let counts: Vec<u32> = ctx.readback(&b.counts, 0, n).unwrap();
+        let mut by_id = vec![0u32; n];
+        for s in 0..n {
+            by_id[perm[s] as usize] = counts[s];
+        }
+        by_strategy.push(by_id);
+        b.destroy(&ctx);
+        search.destroy(&ctx);
+    }
+    let differ = (0..n)
+        .filter(|&i| by_strategy[0][i] != by_strategy[1][i])
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{differ} particles have other neighbour counts with morton than with grid"
+    );
+    ctx.destroy_buffer(&mut p);
+    common::finish(&ctx);
+}

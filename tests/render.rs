@@ -46,13 +46,11 @@ fn scene() -> Scene {
     }
 }
 
-/// Render and return the RGBA8 pixels (and the renderer and buffers for more checks).
-fn render(
-    ctx: &Context,
-    s: MetaballSettings,
-    sc: &Scene,
-    debug: bool,
-) -> (Vec<u8>, Option<Vec<[f32; 4]>>, Option<Vec<Vec<u32>>>) {
+/// Pixels, per-pixel (t, normal) when asked, and the S-buffer's lists.
+type Rendered = (Vec<u8>, Option<Vec<[f32; 4]>>, Option<Vec<Vec<u32>>>);
+
+/// Render once and read back what the checks need.
+fn render(ctx: &Context, s: MetaballSettings, sc: &Scene, debug: bool) -> Rendered {
     let mut centers = ctx
         .storage_buffer("centers", (sc.pts.len() * 16) as u64)
         .unwrap();

@@ -194,7 +194,6 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             (Neighbors::Morton, SortAlgo::OddEven),
         ],
     };
-    let max_nb = 64;
     let mut rows = Vec::new();
     for (strategy, sort) in combos {
         let mut search = NeighborSearch::new(ctx, strategy, Some(sort))?;
@@ -207,6 +206,8 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 .collect();
             let mut p = ctx.storage_buffer("bench positions", n as u64 * 16)?;
             ctx.upload(&mut p, 0, &pos)?;
+            // Up to 64 listed neighbours, fewer where the lists would exceed one binding.
+            let max_nb = (ctx.max_storage_range() / (n as u64 * 4)).min(64) as u32;
             let mut b = search.buffers(ctx, n as u64, &grid, max_nb)?;
             let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
             let detail = json!({ "radius": radius, "grid": grid.dims, "max_neighbors": max_nb });

@@ -264,6 +264,13 @@ impl NeighborSearch {
             Neighbors::Morton => 1,
         };
         let list_bytes = cap * max_neighbors.max(1) as u64 * 4;
+        if list_bytes > ctx.max_storage_range() {
+            return Err(Error::Memory(format!(
+                "neighbour lists of {max_neighbors} for {cap} particles need {list_bytes} bytes, more than one \
+                 storage binding may address on this device ({}); lower max_neighbors",
+                ctx.max_storage_range()
+            )));
+        }
         Ok(NeighborBuffers {
             keys: ctx.storage_buffer("nb keys", cap * 4)?,
             vals: ctx.storage_buffer("nb values", cap * 4)?,

@@ -192,9 +192,10 @@ impl MetaballRenderer {
             Some(p) => load_sky(p)?,
             None => (0, 0, vec![0u32]),
         };
+        let entry = if s.list == ListKind::Abuffer { 8 } else { 4 };
         let list_capacity = match s.list {
             ListKind::None => 0,
-            _ => capacity.max(1),
+            _ => capacity.max(1).min(ctx.max_storage_range() / entry),
         };
         let small = 16;
         let mut b = MetaballBuffers {
@@ -272,6 +273,19 @@ impl MetaballRenderer {
     /// Reallocate the list for `needed` entries: exactly (S-buffer) or with 25% headroom
     /// (A-buffer, whose count is only known after the pass).
     pub fn grow(&self, ctx: &Context, b: &mut MetaballBuffers, needed: u64) -> Result<()> {
+        let entry = if self.settings.list == ListKind::Abuffer {
+            8
+        } else {
+            4
+        };
+        let fits = ctx.max_storage_range() / entry;
+        if needed > fits {
+            return Err(Error::Memory(format!(
+                "the {} needs {needed} entries, more than one storage binding addresses on this \
+                 device ({fits}); lower the resolution, the metaball radius or the particle count",
+                self.settings.list.as_str()
+            )));
+        }
         match self.settings.list {
             ListKind::None => Ok(()),
             ListKind::Sbuffer => {
@@ -281,7 +295,7 @@ impl MetaballRenderer {
                 Ok(())
             }
             ListKind::Abuffer => {
-                let cap = needed + needed / 4 + 1;
+                let cap = (needed + needed / 4 + 1).min(fits);
                 ctx.destroy_buffer(&mut b.nodes);
                 b.nodes = ctx.storage_buffer("abuffer nodes", cap * 8)?;
                 b.list_capacity = cap;
