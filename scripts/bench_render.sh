@@ -6,22 +6,7 @@
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=${FLUIDFORM_BIN:-}
-if [ -z "$bin" ]; then
-  cargo build --release --quiet
-  bin=target/release/fluidform
-fi
-dev=()
-args=(--frames 20 --warmup 3)
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) dev=(--device "$2"); shift 2 ;;
-    *) args+=("$1"); shift ;;
-  esac
-done
-slug=$("$bin" devices --slug "${dev[@]}")
-dir=results/$slug
-mkdir -p "$dir"
+source scripts/bench_common.sh "$@"
 setup=(--particles 2048 --width 512 --height 512 --density wyvill --threshold 0.9 --radius 0.04 --refine 2)
 phong=("$bin" bench render --out out/bench/render-phong "${setup[@]}" --material phong "${dev[@]}" "${args[@]}")
 glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material glass --depth 3 "${dev[@]}" "${args[@]}")

@@ -5,22 +5,7 @@
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=${FLUIDFORM_BIN:-}
-if [ -z "$bin" ]; then
-  cargo build --release --quiet
-  bin=target/release/fluidform
-fi
-dev=()
-args=(--frames 20 --warmup 3)
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --device) dev=(--device "$2"); shift 2 ;;
-    *) args+=("$1"); shift ;;
-  esac
-done
-slug=$("$bin" devices --slug "${dev[@]}")
-dir=results/$slug
-mkdir -p "$dir"
+source scripts/bench_common.sh "$@"
 md=$dir/sph.md
 sweep=("$bin" bench sph --out out/bench/sph "${dev[@]}" "${args[@]}")
 stab=("$bin" bench stability --out out/bench/stability "${dev[@]}")

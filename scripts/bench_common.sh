@@ -1,0 +1,22 @@
+# Sourced by the bench_*.sh scripts: picks the binary (FLUIDFORM_BIN, else a release
+# build), splits --device from the bench switches, and names the results folder.
+# Sets: bin, dev (array), args (array), slug, dir.
+bin=${FLUIDFORM_BIN:-}
+if [ -z "$bin" ]; then
+  cargo build --release --quiet
+  bin=target/release/fluidform
+fi
+dev=()
+args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --device) dev=(--device "$2"); shift 2 ;;
+    *) args+=("$1"); shift ;;
+  esac
+done
+# Defaults unless given: 20 timed repetitions after 3 warm-up.
+[[ " ${args[*]} " == *" --frames "* ]] || args+=(--frames 20)
+[[ " ${args[*]} " == *" --warmup "* ]] || args+=(--warmup 3)
+slug=$("$bin" devices --slug "${dev[@]}")
+dir=results/$slug
+mkdir -p "$dir"
