@@ -160,12 +160,12 @@ fn morton_with_counting_sort_is_rejected() {
 }
 
 #[test]
-fn morton_equals_grid_per_particle_at_50k() {
+fn morton_equals_grid_per_particle_beyond_the_loop_budget() {
     // Beyond the brute-force sizes: the same count for every particle as the grid (which
-    // matches brute force above). Ranges stay under llvmpipe's per-invocation budget of
-    // 65535 loop iterations here (see README); larger N on lavapipe cuts them short.
+    // matches brute force above). At 131072 points some Morton ranges exceed 65535
+    // candidates, more than llvmpipe's per-invocation loop budget if walked one by one.
     let ctx = common::ctx();
-    let n = 50_000usize;
+    let n = 131_072usize;
     let radius = fluidform::bench::primitives::radius_for(n as u32, 30.0);
     let grid = GridSpec::covering([0.0; 3], [1.0; 3], radius).unwrap();
     let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
@@ -189,6 +189,14 @@ fn morton_equals_grid_per_particle_at_50k() {
         .unwrap();
         let perm: Vec<u32> = ctx.readback(&b.perm, 0, n).unwrap();
         let counts: Vec<u32> = ctx.readback(&b.counts, 0, n).unwrap();
+        let visited: Vec<u32> = ctx.readback(&b.visited, 0, n).unwrap();
+        if strategy == Neighbors::Morton {
+            let longest = visited.iter().max().copied().unwrap_or(0);
+            assert!(
+                longest > 65_535,
+                "longest range {longest}: none beyond the budget, or cut short"
+            );
+        }
         let mut by_id = vec![0u32; n];
         for s in 0..n {
             by_id[perm[s] as usize] = counts[s];

@@ -8,6 +8,7 @@
 // NB_CELL_ONLY: only the cell functions (no buffers, no iteration).
 #ifndef PRIMITIVES_NEIGHBORS_GLSL
 #define PRIMITIVES_NEIGHBORS_GLSL
+#extension GL_EXT_control_flow_attributes : require
 #define NB_GRID 0
 #define NB_HASH 1
 #define NB_MORTON 2
@@ -72,11 +73,19 @@ uint nb_lower_bound(uint key) {  // first sorted slot with nb_keys[slot] >= key
 #define NB_END }}}
 #else
 // Seed 000: the query box's corner codes bound a contiguous range of the sorted array.
+// Eight candidates per iteration of the outer loop, the inner loop unrolled away: llvmpipe
+// stops an invocation's loops after about 65535 iterations in total, and a range that
+// straddles the top octants spans most of the array.
+#define NB_UNROLL 8u
 #define NB_BEGIN(P, R, J) { \
     uint nb_lo = morton_code(morton_cell((P) - vec3(R), nb_box[0].xyz, nb_box[1].xyz)); \
     uint nb_hi = morton_code(morton_cell((P) + vec3(R), nb_box[0].xyz, nb_box[1].xyz)); \
-    for (uint J = nb_lower_bound(nb_lo); J < NB_N && nb_keys[J] <= nb_hi; ++J) {
-#define NB_END }}
+    bool nb_more = true; \
+    for (uint nb_b = nb_lower_bound(nb_lo); nb_more; nb_b += NB_UNROLL) { \
+    [[unroll]] for (uint nb_u = 0u; nb_u < NB_UNROLL; ++nb_u) { \
+        uint J = nb_b + nb_u; \
+        if (!nb_more || J >= NB_N || nb_keys[J] > nb_hi) { nb_more = false; continue; }
+#define NB_END }}}
 #endif
 #endif // NB_CELL_ONLY
 #endif

@@ -1,10 +1,12 @@
 #version 450
+#extension GL_EXT_control_flow_attributes : require
 // Ray marching through the metaball field, one invocation per pixel. The primary ray
 // marches the depth interval covered by the spheres of its pixel's list (LIST none: the
 // fluid's bounds), sums only those metaballs, refines the hit by bisection and takes the
 // normal from the analytic gradient. Glass and tinted trace reflection and refraction
 // with an explicit stack; secondary samples read the list of the pixel they project to
 // (off screen: every metaball, or the path ends).
+#extension GL_EXT_control_flow_attributes : require
 #include "common/index.glsl"
 #include "common.glsl"
 
@@ -12,44 +14,48 @@ const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
 uint longest = 0u;
 
-// Field value and (optionally) gradient at x from the metaballs of pixel p (or ALL).
+// Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Eight
+// metaballs per loop iteration (the inner loops unroll away): llvmpipe stops an
+// invocation's loops after about 65535 iterations in total, and a ray takes hundreds of
+// samples over lists of hundreds (or, for none, all) metaballs.
+#define SUM_METABALLS(x, p, ACC, TERM) { \
+    if (p == ALL) { \
+        for (uint b_ = 0u; b_ < P.n; b_ += 8u) { \
+            [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+                uint j_ = b_ + u_; \
+                if (j_ < P.n) { vec3 d = x - centers[j_].xyz; ACC += TERM; } } } \
+    } else { SUM_LIST(x, p, ACC, TERM) } }
+#if LIST == 1
+#define SUM_LIST(x, p, ACC, TERM) \
+    for (uint n_ = heads[p]; n_ != NIL;) { \
+        [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+            if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } }
+#elif LIST == 2
+#define SUM_LIST(x, p, ACC, TERM) { \
+    uint e_ = min(offsets[p], P.list_capacity); \
+    for (uint b_ = range_start(p); b_ < e_; b_ += 8u) { \
+        [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+            uint s_ = b_ + u_; \
+            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } }
+#else
+#define SUM_LIST(x, p, ACC, TERM)
+#endif
+
 float field(vec3 x, uint p) {
-    float f = 0.0;
 #if LIST == 0
     p = ALL;
 #endif
-    if (p == ALL) {
-        for (uint j = 0u; j < P.n; ++j) { vec3 d = x - centers[j].xyz; f += density2(dot(d, d)); }
-        return f;
-    }
-#if LIST == 1
-    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
-        vec3 d = x - centers[nodes[node].x].xyz;
-        f += density2(dot(d, d));
-    }
-#elif LIST == 2
-    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) { vec3 d = x - centers[list[s]].xyz; f += density2(dot(d, d)); }
-#endif
+    float f = 0.0;
+    SUM_METABALLS(x, p, f, density2(dot(d, d)))
     return f;
 }
 
 vec3 gradient(vec3 x, uint p) {
-    vec3 g = vec3(0.0);
 #if LIST == 0
     p = ALL;
 #endif
-    if (p == ALL) {
-        for (uint j = 0u; j < P.n; ++j) { vec3 d = x - centers[j].xyz; g += d * density_grad_over_r(dot(d, d)); }
-        return g;
-    }
-#if LIST == 1
-    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
-        vec3 d = x - centers[nodes[node].x].xyz;
-        g += d * density_grad_over_r(dot(d, d));
-    }
-#elif LIST == 2
-    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) { vec3 d = x - centers[list[s]].xyz; g += d * density_grad_over_r(dot(d, d)); }
-#endif
+    vec3 g = vec3(0.0);
+    SUM_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
     return g;
 }
 
