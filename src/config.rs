@@ -56,6 +56,21 @@ switch_enum!(BoneWeights { Eq8, Eq9 });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
 
+/// Switches of the metaball renderer (for `reject_unimplemented`).
+pub const METABALL_SWITCHES: &[&str] = &[
+    "list",
+    "density",
+    "threshold",
+    "radius",
+    "refine",
+    "depth",
+    "material",
+    "sky",
+    "offscreen",
+];
+/// Camera switches of rendered scenes.
+pub const CAMERA_SWITCHES: &[&str] = &["eye", "target", "fov"];
+
 /// Every switch of DESIGN.md's command line. Unset optional switches take the default of
 /// whatever uses them; `config` in summary.json records what was used.
 #[derive(Args, Clone, Debug, Serialize)]

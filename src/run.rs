@@ -168,27 +168,10 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     use crate::viewer::Viewer;
     let sw = &opts.switches;
     let render = sw.render.unwrap_or(RenderKind::Metaballs);
-    let mut allowed = vec![
-        "sort",
-        "neighbors",
-        "fluid",
-        "render",
-        "eye",
-        "target",
-        "fov",
-    ];
+    let mut allowed = vec!["sort", "neighbors", "fluid", "render"];
+    allowed.extend(crate::config::CAMERA_SWITCHES);
     if render == RenderKind::Metaballs {
-        allowed.extend([
-            "list",
-            "density",
-            "threshold",
-            "radius",
-            "refine",
-            "depth",
-            "material",
-            "sky",
-            "offscreen",
-        ]);
+        allowed.extend(crate::config::METABALL_SWITCHES);
     }
     sw.reject_unimplemented(
         &format!("SPH scenes drawn as {}", render.as_str()),
@@ -244,7 +227,6 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let mut frames = FrameLoop::new(&ctx, SLOTS, max_steps * 10 + 32)?;
     let stepper = std::cell::RefCell::new(Stepper::new(&ctx, &st, SLOTS)?);
-    let memory_before = ctx.memory_bytes();
     let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
     let mut pngs = Vec::new();
     let n = st.n;
@@ -266,11 +248,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         },
     );
     let timings = std::mem::take(&mut frames.profiler.results);
-    let memory = ctx
-        .memory_bytes()
-        .into_iter()
-        .chain(memory_before)
-        .collect();
+    let memory = ctx.memory_bytes();
     let dump = if result.is_ok() {
         Some(st.read(&ctx))
     } else {

@@ -5,7 +5,7 @@ pub mod primitives;
 pub mod render;
 pub mod sph;
 
-use crate::config::Switches;
+use crate::config::{Switches, CAMERA_SWITCHES, METABALL_SWITCHES};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler};
 use crate::report::{stat, Report, Stat};
@@ -81,23 +81,12 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
             sph::stability(&ctx, opts)?
         }
         "render" => {
-            sw.reject_unimplemented(
-                "bench render",
-                &[
-                    "list",
-                    "density",
-                    "threshold",
-                    "radius",
-                    "refine",
-                    "depth",
-                    "material",
-                    "sky",
-                    "offscreen",
-                    "eye",
-                    "target",
-                    "fov",
-                ],
-            )?;
+            let allowed: Vec<&str> = METABALL_SWITCHES
+                .iter()
+                .chain(CAMERA_SWITCHES)
+                .copied()
+                .collect();
+            sw.reject_unimplemented("bench render", &allowed)?;
             render::render(&ctx, opts)?
         }
         other => {

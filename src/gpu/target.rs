@@ -132,31 +132,11 @@ impl ColorTarget {
                     stencil: 0,
                 },
             });
-        let area = vk::Rect2D {
-            offset: vk::Offset2D { x: 0, y: 0 },
-            extent: vk::Extent2D {
-                width: self.width(),
-                height: self.height(),
-            },
-        };
         let info = vk::RenderingInfo::default()
-            .render_area(area)
             .layer_count(1)
             .color_attachments(&color)
             .depth_attachment(&depth);
-        let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: self.width() as f32,
-            height: self.height() as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
-        unsafe {
-            ctx.device.cmd_begin_rendering(cmd, &info);
-            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
-            ctx.device.cmd_set_scissor(cmd, 0, &[area]);
-        }
+        begin(ctx, cmd, info, self.width(), self.height());
     }
 
     pub fn end_rendering(&self, ctx: &Context, cmd: vk::CommandBuffer) {
@@ -234,13 +214,21 @@ impl ColorTarget {
 /// Begin dynamic rendering with no attachments over width x height (fragment passes that
 /// only write storage buffers), with the viewport and scissor set.
 pub fn begin_empty_rendering(ctx: &Context, cmd: vk::CommandBuffer, width: u32, height: u32) {
+    begin(
+        ctx,
+        cmd,
+        vk::RenderingInfo::default().layer_count(1),
+        width,
+        height,
+    );
+}
+
+/// Begin rendering over the whole width x height area and set viewport and scissor to it.
+fn begin(ctx: &Context, cmd: vk::CommandBuffer, info: vk::RenderingInfo, width: u32, height: u32) {
     let area = vk::Rect2D {
         offset: vk::Offset2D { x: 0, y: 0 },
         extent: vk::Extent2D { width, height },
     };
-    let info = vk::RenderingInfo::default()
-        .render_area(area)
-        .layer_count(1);
     let viewport = vk::Viewport {
         x: 0.0,
         y: 0.0,
@@ -250,7 +238,7 @@ pub fn begin_empty_rendering(ctx: &Context, cmd: vk::CommandBuffer, width: u32, 
         max_depth: 1.0,
     };
     unsafe {
-        ctx.device.cmd_begin_rendering(cmd, &info);
+        ctx.device.cmd_begin_rendering(cmd, &info.render_area(area));
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
         ctx.device.cmd_set_scissor(cmd, 0, &[area]);
     }
