@@ -47,7 +47,7 @@ enum Command {
         #[command(flatten)]
         switches: Switches,
     },
-    /// Benchmark an algorithm: scan, sort, neighbors (sph and render arrive later).
+    /// Benchmark an algorithm: scan, sort, neighbors, sph, stability, render.
     /// Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
         what: String,

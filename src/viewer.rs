@@ -36,6 +36,8 @@ pub struct RenderTotals {
     pub max_list_bytes: u64,
     pub longest: u32,
     pub redos: u32,
+    /// Frames with rays cut short by llvmpipe's loop budget (wrong pixels).
+    pub budget_frames: u32,
 }
 
 impl Viewer {
@@ -173,6 +175,14 @@ impl Viewer {
                 t.max_fragments = t.max_fragments.max(st.fragments);
                 t.max_list_bytes = t.max_list_bytes.max(st.list_bytes);
                 t.longest = t.longest.max(st.longest);
+                if st.budget_pixels > 0 {
+                    t.budget_frames += 1;
+                    eprintln!(
+                        "warning: {} pixels' rays were cut short by llvmpipe's loop budget \
+                         (a coarser --radius, fewer particles or lists help)",
+                        st.budget_pixels
+                    );
+                }
                 t.last = st;
                 if let Some(p) = png {
                     let s = &renderer.settings;
@@ -198,6 +208,7 @@ impl Viewer {
                     "max_list_bytes": t.max_list_bytes,
                     "longest_list": t.longest,
                     "overflow_redos": t.redos,
+                    "frames_past_loop_budget": t.budget_frames,
                 })
             }
         }

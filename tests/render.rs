@@ -62,6 +62,10 @@ fn render(ctx: &Context, s: MetaballSettings, sc: &Scene, debug: bool) -> Render
         .render_sync(ctx, &mut b, &centers, sc.pts.len() as u32, &sc.cam, 0)
         .unwrap();
     assert_eq!(st.overflow, 0);
+    assert_eq!(
+        st.budget_pixels, 0,
+        "rays cut short by llvmpipe's loop budget"
+    );
     let px = b.pixels(0).to_vec();
     let dbg = debug.then(|| r.debug(ctx, &b).unwrap());
     let lists = (list == ListKind::Sbuffer).then(|| r.sbuffer_lists(ctx, &b).unwrap());
@@ -282,6 +286,45 @@ fn lists_grow_on_overflow_and_the_image_is_unchanged() {
         assert!(
             agreement(b.pixels(0), &reference, 1) > 0.999,
             "{list:?}: image changed after the regrowth"
+        );
+        b.destroy(&ctx);
+        r.destroy(&ctx);
+    }
+    ctx.destroy_buffer(&mut centers);
+    common::finish(&ctx);
+}
+
+#[test]
+fn rays_past_llvmpipes_loop_budget_are_reported() {
+    let ctx = common::ctx();
+    let Some(budget) = ctx.info.loop_budget else {
+        eprintln!("{}: no loop budget to detect", ctx.info.name);
+        common::finish(&ctx);
+        return;
+    };
+    let sc = scene();
+    let mut centers = ctx
+        .storage_buffer("centers", (sc.pts.len() * 16) as u64)
+        .unwrap();
+    ctx.upload(&mut centers, 0, &sc.pts).unwrap();
+    // A march step so fine that a ray through the blob takes about 20 000 samples, each
+    // summing every metaball (several loop iterations): far past the budget. At the
+    // default step no pixel is cut.
+    for (step, expect_cut) in [(0.04 / 8.0, false), (0.04 / 4000.0, true)] {
+        let mut s = settings(ListKind::None, DensityFn::Wyvill, Material::Phong);
+        (s.width, s.height) = (24, 18);
+        s.step = step;
+        s.max_steps = 1 << 20;
+        let mut r = MetaballRenderer::new(&ctx, s).unwrap();
+        let mut b = r.buffers(&ctx, N as u64, 1, false).unwrap();
+        let (st, _) = r
+            .render_sync(&ctx, &mut b, &centers, N as u32, &sc.cam, 0)
+            .unwrap();
+        assert_eq!(
+            st.budget_pixels > 0,
+            expect_cut,
+            "step {step}: {} pixels reported past a budget of {budget}",
+            st.budget_pixels
         );
         b.destroy(&ctx);
         r.destroy(&ctx);

@@ -73,10 +73,12 @@ uint nb_lower_bound(uint key) {  // first sorted slot with nb_keys[slot] >= key
 #define NB_END }}}
 #else
 // Seed 000: the query box's corner codes bound a contiguous range of the sorted array.
-// Eight candidates per iteration of the outer loop, the inner loop unrolled away: llvmpipe
-// stops an invocation's loops after about 65535 iterations in total, and a range that
-// straddles the top octants spans most of the array.
-#define NB_UNROLL 8u
+// NB_UNROLL candidates per iteration of the outer loop, the inner loop unrolled away:
+// llvmpipe stops an invocation's loops after about 65535 iterations in total, and a range
+// that straddles the top octants spans most of the array (32 x 65535: 2M candidates).
+#ifndef NB_UNROLL
+#define NB_UNROLL 32u
+#endif
 #define NB_BEGIN(P, R, J) { \
     uint nb_lo = morton_code(morton_cell((P) - vec3(R), nb_box[0].xyz, nb_box[1].xyz)); \
     uint nb_hi = morton_code(morton_cell((P) + vec3(R), nb_box[0].xyz, nb_box[1].xyz)); \

@@ -336,6 +336,12 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
             }
         }
         "render" => {
+            for r in rows {
+                let cut = r.extra.iter().find(|(k, _)| k == "pixels past loop budget");
+                if let Some((_, v)) = cut.filter(|(_, v)| v != "0") {
+                    out.push(format!("WARNING: {}: {v} pixels' rays were cut short by llvmpipe's loop budget, so this row understates the cost", r.variant));
+                }
+            }
             let get = |v: &str| rows.iter().find(|r| r.variant == v);
             if let (Some(s), Some(none)) = (get("sbuffer"), get("none")) {
                 out.push(format!(

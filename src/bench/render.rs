@@ -63,7 +63,19 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                         "overflow in timed frames".into(),
                         after.overflow.to_string(),
                     ),
+                    (
+                        "pixels past loop budget".into(),
+                        after.budget_pixels.max(st.budget_pixels).to_string(),
+                    ),
                 ];
+                if after.budget_pixels.max(st.budget_pixels) > 0 {
+                    eprintln!(
+                        "warning: {}: {} pixels' rays were cut short by llvmpipe's loop \
+                         budget; this row understates the cost and its image is wrong",
+                        list.as_str(),
+                        after.budget_pixels.max(st.budget_pixels)
+                    );
+                }
                 Ok(row)
             });
             b.destroy(ctx);

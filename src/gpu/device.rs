@@ -23,6 +23,9 @@ pub struct DeviceInfo {
     pub subgroup_size_control: bool,
     pub max_storage_buffer_range: u64,
     pub max_shared_memory: u32,
+    /// Loop iterations llvmpipe lets one batch of invocations run before it stops their
+    /// loops (hang protection, LP_MAX_TGSI_LOOP_ITERATIONS); None on other drivers.
+    pub loop_budget: Option<u32>,
     /// Everything fluidform needs that this device lacks; empty when usable.
     pub missing: Vec<String>,
     #[serde(skip)]
@@ -166,6 +169,7 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
             && f13.compute_full_subgroups == vk::TRUE,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
         max_shared_memory: props.limits.max_compute_shared_memory_size,
+        loop_budget: (driver.driver_id == vk::DriverId::MESA_LLVMPIPE).then_some(65535),
         missing,
         queue_family,
         vertex_stores: f.vertex_pipeline_stores_and_atomics == vk::TRUE,

@@ -6,37 +6,49 @@
 // normal from the analytic gradient. Glass and tinted trace reflection and refraction
 // with an explicit stack; secondary samples read the list of the pixel they project to
 // (off screen: every metaball, or the path ends).
-#extension GL_EXT_control_flow_attributes : require
 #include "common/index.glsl"
 #include "common.glsl"
 
 const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
 uint longest = 0u;
+// llvmpipe stops a batch's loops after about 65535 iterations in total (hang protection);
+// every later loop then exits at once. Each loop below checks on exit that it ended by
+// its own condition (CUT_UNLESS, the negated loop condition); pixels where one did not are counted in stats[5], so a
+// cut-short frame is reported, never silently wrong. Never set on a real GPU.
+bool cut = false;
+#define CUT_UNLESS(ended) if (!(ended)) cut = true;
 
-// Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Eight
-// metaballs per loop iteration (the inner loops unroll away): llvmpipe stops an
-// invocation's loops after about 65535 iterations in total, and a ray takes hundreds of
-// samples over lists of hundreds (or, for none, all) metaballs.
+// Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Several
+// metaballs per loop iteration (the inner loops unroll away), ALL_UNROLL over every metaball:
+// llvmpipe's loop budget would otherwise cut short rays that take hundreds of samples over
+// lists of hundreds (or, for none, all) metaballs.
+#define ALL_UNROLL 32u
 #define SUM_METABALLS(x, p, ACC, TERM) { \
     if (p == ALL) { \
-        for (uint b_ = 0u; b_ < P.n; b_ += 8u) { \
-            [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+        uint b_ = 0u; \
+        for (; b_ < P.n; b_ += ALL_UNROLL) { \
+            [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) { \
                 uint j_ = b_ + u_; \
                 if (j_ < P.n) { vec3 d = x - centers[j_].xyz; ACC += TERM; } } } \
+        CUT_UNLESS(!(b_ < P.n)) \
     } else { SUM_LIST(x, p, ACC, TERM) } }
 #if LIST == 1
-#define SUM_LIST(x, p, ACC, TERM) \
-    for (uint n_ = heads[p]; n_ != NIL;) { \
+#define SUM_LIST(x, p, ACC, TERM) { \
+    uint n_ = heads[p]; \
+    for (; n_ != NIL;) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
-            if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } }
+            if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } } \
+    CUT_UNLESS(n_ == NIL) }
 #elif LIST == 2
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint e_ = min(offsets[p], P.list_capacity); \
-    for (uint b_ = range_start(p); b_ < e_; b_ += 8u) { \
+    uint b_ = range_start(p); \
+    for (; b_ < e_; b_ += 8u) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             uint s_ = b_ + u_; \
-            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } }
+            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } \
+    CUT_UNLESS(!(b_ < e_)) }
 #else
 #define SUM_LIST(x, p, ACC, TERM)
 #endif
@@ -81,11 +93,13 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
     vec2 iv = vec2(1e30, -1e30);
     uint len = 0u;
 #if LIST == 1
-    for (uint node = heads[p]; node != NIL; node = nodes[node].y) {
+    uint node = heads[p];
+    for (; node != NIL; node = nodes[node].y) {
         vec3 oc = o - centers[nodes[node].x].xyz;
         len++;
 #elif LIST == 2
-    for (uint s = range_start(p); s < min(offsets[p], P.list_capacity); ++s) {
+    uint s = range_start(p), e = min(offsets[p], P.list_capacity);
+    for (; s < e; ++s) {
         vec3 oc = o - centers[list[s]].xyz;
         len++;
 #else
@@ -96,6 +110,11 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
         float disc = b * b - (dot(oc, oc) - R2);
         if (disc > 0.0) { float q = sqrt(disc); iv = vec2(min(iv.x, -b - q), max(iv.y, -b + q)); }
     }
+#if LIST == 1
+    CUT_UNLESS(node == NIL)
+#elif LIST == 2
+    CUT_UNLESS(!(s < e))
+#endif
     longest = max(longest, len);
     return vec2(max(iv.x, 0.0), iv.y);
 }
@@ -112,7 +131,8 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float T = threshold(), step = P.sun.w;
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
-    for (uint i = 0u; i < P.max_steps && t <= t1; ++i) {
+    uint i = 0u;
+    for (; i < P.max_steps && t <= t1; ++i) {
         vec3 x = o + d * t;
         uint p = pixel;
         if (pixel == NIL) {
@@ -125,18 +145,21 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
         }
         if ((field(x, p) >= T) != inside) {
             float a = prev, b = t;
-            for (uint k = 0u; k < P.refine; ++k) {
+            uint k = 0u;
+            for (; k < P.refine; ++k) {
                 float m = 0.5 * (a + b);
                 vec3 xm = o + d * m;
                 uint pm = pixel == NIL ? project(xm) : pixel;
                 if (pm == NIL) pm = ALL;
                 if ((field(xm, pm) >= T) != inside) b = m; else a = m;
             }
+            CUT_UNLESS(!(k < P.refine))
             return b;
         }
         prev = t;
         t += step;
     }
+    CUT_UNLESS(!(i < P.max_steps && t <= t1))
     return -1.0;
 }
 
@@ -254,9 +277,11 @@ void main() {
 #endif
 #endif
     }
+    CUT_UNLESS(!(sp > 0))
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
     if (P.debug != 0u) debug_out[id] = dbg;
     if (longest > 0u) atomicMax(stats[1], longest);
     if (offscreen_samples > 0u) atomicAdd(stats[3], offscreen_samples);
+    if (cut) atomicAdd(stats[5], 1u);
 }

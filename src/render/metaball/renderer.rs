@@ -60,6 +60,9 @@ pub struct FrameStats {
     pub overflow: u32,
     /// Secondary-ray samples that left the screen.
     pub offscreen_samples: u32,
+    /// Pixels whose rays were cut short: a loop stopped before its own exit condition, as
+    /// llvmpipe's loop budget (about 65535 iterations per batch) does. Nonzero: wrong frame.
+    pub budget_pixels: u32,
     /// Bytes the list structure needs for this frame (S: offsets + list; A: heads + nodes +
     /// counter; none: 0).
     pub list_bytes: u64,
@@ -438,6 +441,7 @@ impl MetaballRenderer {
             longest: st[1],
             overflow: st[2],
             offscreen_samples: st[3],
+            budget_pixels: st[5],
             list_bytes,
         }
     }
