@@ -227,21 +227,26 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     Ok(())
                 },
             );
-            let stats = row.as_ref().ok().map(|_| -> Result<(f64, f64)> {
+            let stats = row.as_ref().ok().map(|_| -> Result<(u64, f64)> {
                 let c: Vec<u32> = ctx.readback(&b.counts, 0, n as usize)?;
                 let v: Vec<u32> = ctx.readback(&b.visited, 0, n as usize)?;
-                let mean = |x: &[u32]| x.iter().map(|&a| a as f64).sum::<f64>() / n as f64;
-                Ok((mean(&c), mean(&v)))
+                let total = |x: &[u32]| x.iter().map(|&a| a as u64).sum::<u64>();
+                Ok((total(&c), total(&v) as f64 / n as f64))
             });
             b.destroy(ctx);
             ctx.destroy_buffer(&mut p);
             let mut row = row?;
             row.variant = variant;
             if let Some(s) = stats {
-                let (nb, visited) = s?;
+                let (pairs, visited) = s?;
                 row.extra = vec![
-                    ("mean neighbours".into(), format!("{nb:.1}")),
+                    (
+                        "mean neighbours".into(),
+                        format!("{:.1}", pairs as f64 / n as f64),
+                    ),
                     ("mean candidates".into(), format!("{visited:.1}")),
+                    // Exact: every strategy must find the same pairs in the same points.
+                    (NEIGHBOUR_PAIRS.into(), pairs.to_string()),
                 ];
             }
             rows.push(row);
@@ -252,6 +257,35 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
 }
 
 /// Ratios the speed targets ask for, computed from the rows measured together.
+const NEIGHBOUR_PAIRS: &str = "neighbour pairs";
+
+/// Rows whose neighbour pairs differ from grid/counting's at the same N (same points).
+fn pair_mismatches(rows: &[Row]) -> (usize, Vec<String>) {
+    let pairs = |r: &Row| {
+        r.extra
+            .iter()
+            .find(|(k, _)| k == NEIGHBOUR_PAIRS)
+            .map(|(_, v)| v.clone())
+    };
+    let mut checked = 0;
+    let mut bad = Vec::new();
+    for r in rows.iter().filter(|r| r.variant != "grid/counting") {
+        let grid = rows
+            .iter()
+            .find(|g| g.variant == "grid/counting" && g.n == r.n);
+        if let (Some(g), Some(mine)) = (grid.and_then(pairs), pairs(r)) {
+            checked += 1;
+            if g != mine {
+                bad.push(format!(
+                    "WARNING: {} at {} found {mine} neighbour pairs, grid/counting {g}",
+                    r.variant, r.n
+                ));
+            }
+        }
+    }
+    (checked, bad)
+}
+
 pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
     // The row of variant v whose N is nearest n (within 25%: scenes round particle counts).
     let ms = |v: &str, n: u64| {
@@ -292,6 +326,11 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
             }
         }
         "neighbors" => {
+            let (checked, bad) = pair_mismatches(rows);
+            if checked > 0 && bad.is_empty() {
+                out.push(format!("every strategy found exactly grid/counting's neighbour pairs ({checked} rows checked)"));
+            }
+            out.extend(bad);
             for v in [
                 "grid/counting",
                 "hash/bitonic",
