@@ -67,6 +67,7 @@ pub const METABALL_SWITCHES: &[&str] = &[
     "material",
     "sky",
     "offscreen",
+    "list-sort",
 ];
 /// Camera switches of rendered scenes.
 pub const CAMERA_SWITCHES: &[&str] = &["eye", "target", "fov"];
@@ -135,6 +136,10 @@ pub struct Switches {
     /// Secondary-ray samples off screen: use every metaball (all) or end the path (end)
     #[arg(long, value_enum)]
     pub offscreen: Option<Offscreen>,
+    /// S-buffer ranges sorted by depth, so each sample reads only the metaballs within R of
+    /// its depth (default: on for glass and tinted; off: the thesis's unsorted S-buffer)
+    #[arg(long, value_enum)]
+    pub list_sort: Option<OnOff>,
     /// Camera position x,y,z (overrides the scene's)
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
     pub eye: Option<[f32; 3]>,
@@ -182,7 +187,7 @@ impl Switches {
             )));
         }
         // Built, but used elsewhere: (switch, set, where it applies).
-        let elsewhere: [(&str, bool, &str); 15] = [
+        let elsewhere: [(&str, bool, &str); 16] = [
             (
                 "sort",
                 self.sort.is_some(),
@@ -236,6 +241,11 @@ impl Switches {
             (
                 "offscreen",
                 self.offscreen.is_some(),
+                "the metaball renderer (SPH scenes, bench render)",
+            ),
+            (
+                "list-sort",
+                self.list_sort.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             ("render", self.render.is_some(), "run with an SPH scene"),

@@ -131,13 +131,20 @@ fn every_list_gives_the_same_image() {
             let (none, _, _) = render(&ctx, settings(ListKind::None, d, m), &sc, false);
             let lit = none.chunks(4).filter(|p| p[..3] != none[..3]).count();
             assert!(lit > 200, "{d:?}/{m:?}: the blob is not in the picture");
-            for list in [ListKind::Abuffer, ListKind::Sbuffer] {
-                let (img, _, _) = render(&ctx, settings(list, d, m), &sc, false);
+            for (list, sorted) in [
+                (ListKind::Abuffer, false),
+                (ListKind::Sbuffer, false),
+                (ListKind::Sbuffer, true),
+            ] {
+                let mut s = settings(list, d, m);
+                s.sorted = sorted;
+                let name = s.list_name();
+                let (img, _, _) = render(&ctx, s, &sc, false);
                 let a = agreement(&img, &none, 1);
                 if a < 0.999 {
-                    let p = write_diff(&format!("{d:?}-{m:?}-{list:?}"), &img, &none);
+                    let p = write_diff(&format!("{d:?}-{m:?}-{name}"), &img, &none);
                     panic!(
-                        "{d:?}/{m:?}/{list:?}: {:.4}% of pixels agree with none (diff: {})",
+                        "{d:?}/{m:?}/{name}: {:.4}% of pixels agree with none (diff: {})",
                         a * 100.0,
                         p.display()
                     );
@@ -295,6 +302,43 @@ fn lists_grow_on_overflow_and_the_image_is_unchanged() {
 }
 
 #[test]
+fn sorted_sbuffer_ranges_are_the_unsorted_ones_in_depth_order() {
+    let ctx = common::ctx();
+    let sc = scene();
+    let mut lists = Vec::new();
+    for sorted in [false, true] {
+        let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Glass);
+        s.sorted = sorted;
+        assert_eq!(
+            s.list_name(),
+            ["sbuffer", "sbuffer-sorted"][sorted as usize]
+        );
+        let (_, _, l) = render(&ctx, s, &sc, false);
+        lists.push(l.unwrap());
+    }
+    let view = sc.cam.view();
+    let depth = |i: u32| {
+        -view
+            .transform_point3(Vec3::from_slice(&sc.pts[i as usize][..3]))
+            .z
+    };
+    let mut long = 0;
+    for (p, (unsorted, sorted)) in lists[0].iter().zip(&lists[1]).enumerate() {
+        let (mut a, mut b) = (unsorted.clone(), sorted.clone());
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b, "pixel {p}: the sorted range holds other metaballs");
+        assert!(
+            sorted.windows(2).all(|w| depth(w[0]) <= depth(w[1]) + 1e-5),
+            "pixel {p}: range not in depth order"
+        );
+        long += (sorted.len() > 8) as usize;
+    }
+    assert!(long > 100, "only {long} pixels with more than 8 metaballs");
+    common::finish(&ctx);
+}
+
+#[test]
 fn rays_past_llvmpipes_loop_budget_are_reported() {
     let ctx = common::ctx();
     let Some(budget) = ctx.info.loop_budget else {
@@ -397,5 +441,26 @@ fn bad_renderer_settings_are_clear_errors() {
     assert!(e.contains("no/such/sky.png"), "{e}");
     let mut r = r;
     r.destroy(&ctx);
+    // Only the S-buffer's contiguous ranges can be sorted.
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Only {
+        #[command(flatten)]
+        s: Switches,
+    }
+    let sw = Only::parse_from(["t", "--list", "abuffer", "--list-sort", "on"]).s;
+    let e = MetaballSettings::from_switches(&sw)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("--list-sort"), "{e}");
+    // Glass sorts by default, Phong does not.
+    let glass = Only::parse_from(["t", "--material", "glass"]).s;
+    assert!(MetaballSettings::from_switches(&glass)
+        .unwrap()
+        .sorts_lists());
+    assert!(!MetaballSettings::from_switches(&switches())
+        .unwrap()
+        .sorts_lists());
     common::finish(&ctx);
 }

@@ -382,28 +382,30 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
                 }
             }
             let get = |v: &str| rows.iter().find(|r| r.variant == v);
-            if let (Some(s), Some(none)) = (get("sbuffer"), get("none")) {
-                out.push(format!(
-                    "sbuffer: {:.1}x the frame rate of none (target: 12x)",
-                    none.main.median / s.main.median
-                ));
-            }
-            if let (Some(s), Some(a)) = (get("sbuffer"), get("abuffer")) {
-                out.push(format!(
-                    "sbuffer: {:.2}x the frame rate of abuffer (target: > 1)",
-                    a.main.median / s.main.median
-                ));
-                let mb = |r: &Row| {
-                    r.extra
-                        .iter()
-                        .find(|(k, _)| k == "list MB")
-                        .and_then(|(_, v)| v.parse::<f64>().ok())
-                };
-                if let (Some(ms), Some(ma)) = (mb(s), mb(a)) {
+            for sv in ["sbuffer", "sbuffer-sorted"] {
+                if let (Some(s), Some(none)) = (get(sv), get("none")) {
                     out.push(format!(
-                        "sbuffer memory is {:.2}x abuffer's (target: at most 0.7x)",
-                        ms / ma
+                        "{sv}: {:.1}x the frame rate of none (target: 12x)",
+                        none.main.median / s.main.median
                     ));
+                }
+                if let (Some(s), Some(a)) = (get(sv), get("abuffer")) {
+                    out.push(format!(
+                        "{sv}: {:.2}x the frame rate of abuffer (target: > 1)",
+                        a.main.median / s.main.median
+                    ));
+                    let mb = |r: &Row| {
+                        r.extra
+                            .iter()
+                            .find(|(k, _)| k == "list MB")
+                            .and_then(|(_, v)| v.parse::<f64>().ok())
+                    };
+                    if let (Some(ms), Some(ma)) = (mb(s), mb(a)) {
+                        out.push(format!(
+                            "{sv} memory is {:.2}x abuffer's (target: at most 0.7x)",
+                            ms / ma
+                        ));
+                    }
                 }
             }
         }

@@ -16,15 +16,30 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let pts = blob(n, spacing);
     let mut centers = ctx.storage_buffer("metaball centers", (n * 16) as u64)?;
     ctx.upload(&mut centers, 0, &pts)?;
-    let lists = match sw.list {
-        Some(l) => vec![l],
-        None => vec![ListKind::None, ListKind::Abuffer, ListKind::Sbuffer],
+    // (list, sorted): every list when --list is unset, the S-buffer both unsorted (the
+    // thesis's) and sorted (ours) unless --list-sort picks one.
+    let sorted = MetaballSettings::from_switches(sw)?.sorted;
+    let lists = match (sw.list, sw.list_sort) {
+        (Some(l), _) => vec![(l, sorted)],
+        (None, Some(_)) => vec![
+            (ListKind::None, false),
+            (ListKind::Abuffer, false),
+            (ListKind::Sbuffer, sorted),
+        ],
+        (None, None) => vec![
+            (ListKind::None, false),
+            (ListKind::Abuffer, false),
+            (ListKind::Sbuffer, false),
+            (ListKind::Sbuffer, true),
+        ],
     };
     let mut rows = Vec::new();
     let result = (|| -> Result<()> {
-        for list in lists {
+        for (list, sorted) in lists {
             let mut settings = MetaballSettings::from_switches(sw)?;
             settings.list = list;
+            settings.sorted = sorted;
+            let name = settings.list_name();
             let cam = crate::run::camera_with_switches(
                 blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
                 sw,
@@ -35,20 +50,13 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0);
             let row = sized.and_then(|(st, redos)| {
                 let detail = json!({ "settings": settings, "particles": n, "spacing": spacing });
-                let mut row = measure(
-                    ctx,
-                    opts,
-                    &list.as_str(),
-                    n as u64,
-                    "render",
-                    detail,
-                    |prof, cmd| {
+                let mut row =
+                    measure(ctx, opts, &name, n as u64, "render", detail, |prof, cmd| {
                         prof.begin(ctx, cmd, "render");
                         r.record(ctx, cmd, prof, &b, &centers, n as u32, &cam, 0)?;
                         prof.end(ctx, cmd);
                         Ok(())
-                    },
-                )?;
+                    })?;
                 let after = r.frame_stats(&b, 0);
                 row.extra = vec![
                     ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
@@ -72,7 +80,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     eprintln!(
                         "warning: {}: {} pixels' rays were cut short by llvmpipe's loop \
                          budget; this row understates the cost and its image is wrong",
-                        list.as_str(),
+                        name,
                         after.budget_pixels.max(st.budget_pixels)
                     );
                 }

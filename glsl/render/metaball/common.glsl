@@ -1,6 +1,6 @@
 // Metaball rendering (seed 000, section 4): parameters, bindings, density functions and
 // the per-pixel metaball lists. Mirrors src/render/metaball/gpu.rs (RenderParams).
-// Defines: LIST 0 none | 1 abuffer | 2 sbuffer; DENSITY 0 blinn | 1 wyvill | 2 nishimura
+// Defines: LIST 0 none | 1 abuffer | 2 sbuffer; SORTED 1: S-buffer ranges sorted by depth; DENSITY 0 blinn | 1 wyvill | 2 nishimura
 // | 3 murakami; MATERIAL 0 phong | 1 glass | 2 tinted | 3 metal.
 #ifndef METABALL_COMMON_GLSL
 #define METABALL_COMMON_GLSL
@@ -12,6 +12,9 @@
 #endif
 #ifndef MATERIAL
 #define MATERIAL 0
+#endif
+#ifndef SORTED
+#define SORTED 0
 #endif
 
 struct RenderParams {
@@ -53,8 +56,14 @@ layout(std430, binding = 7) buffer Stats { uint stats[]; };                // bi
 layout(std430, binding = 8) writeonly buffer Pixels { uint pixels[]; };    // binding 8: RGBA8
 layout(std430, binding = 9) writeonly buffer Debug { vec4 debug_out[]; };  // binding 9: t, normal
 layout(std430, binding = 10) readonly buffer Sky { uint sky[]; };          // binding 10: RGBA8
+layout(std430, binding = 11) buffer Depths { float depths[]; };            // binding 11: view depths
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
+
+// Distance in front of the eye along the view axis (1-Lipschitz in x).
+float view_depth(vec3 x) {
+    return -(P.view[0].z * x.x + P.view[1].z * x.y + P.view[2].z * x.z + P.view[3].z);
+}
 
 float radius() { return P.eye.w; }
 float threshold() { return P.base.w; }

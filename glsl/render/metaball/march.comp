@@ -40,6 +40,29 @@ bool cut = false;
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } } \
     CUT_UNLESS(n_ == NIL) }
+#elif LIST == 2 && SORTED
+// Sorted ranges: a binary search (on depths.comp's keys) finds the first centre at depth
+// >= z - R, and the walk stops past z + R (the depth recomputed from the centre it loads
+// anyway). Exact: |x - c| >= |depth(x) - depth(c)|, so every metaball outside the window
+// is zero at x (the window has a 0.1% margin for rounding).
+#define SUM_LIST(x, p, ACC, TERM) { \
+    uint e_ = min(offsets[p], P.list_capacity); \
+    float z_ = view_depth(x), r_ = radius() * 1.001 + 1e-6; \
+    uint lo_ = range_start(p), hi_ = e_; \
+    while (lo_ < hi_) { \
+        uint m_ = (lo_ + hi_) >> 1; \
+        if (depths[list[m_]] < z_ - r_) lo_ = m_ + 1u; else hi_ = m_; } \
+    CUT_UNLESS(!(lo_ < hi_)) \
+    bool more_ = true; \
+    uint b_ = lo_; \
+    for (; more_ && b_ < e_; b_ += 8u) { \
+        [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+            uint s_ = b_ + u_; \
+            if (more_ && s_ < e_) { \
+                vec3 c_ = centers[list[s_]].xyz; \
+                if (view_depth(c_) > z_ + r_) more_ = false; \
+                else { vec3 d = x - c_; ACC += TERM; } } } } \
+    CUT_UNLESS(!(more_ && b_ < e_)) }
 #elif LIST == 2
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint e_ = min(offsets[p], P.list_capacity); \

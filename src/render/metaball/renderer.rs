@@ -16,13 +16,15 @@ use crate::render::Camera;
 use ash::vk;
 use serde::Serialize;
 
-const BINDINGS: u32 = 11;
+const BINDINGS: u32 = 12;
 const STATS: u64 = 8;
 
 pub struct MetaballRenderer {
     pub settings: MetaballSettings,
     count: Option<GraphicsPipeline>,
     fill: Option<GraphicsPipeline>,
+    /// Sorted S-buffer: every metaball's view depth, then each pixel's range by it.
+    sort: Option<(ComputePipeline, ComputePipeline)>,
     march: ComputePipeline,
     scan: ScanPass,
     bounds: BoundsPass,
@@ -39,6 +41,8 @@ pub struct MetaballBuffers {
     pub pixels: Buffer,
     debug: Buffer,
     sky: Buffer,
+    /// Sorted S-buffer: every metaball's view depth.
+    depths: Buffer,
     sky_size: (u32, u32),
     bounds: BoundsBuffers,
     scan: ScanScratch,
@@ -63,8 +67,8 @@ pub struct FrameStats {
     /// Pixels whose rays were cut short: a loop stopped before its own exit condition, as
     /// llvmpipe's loop budget (about 65535 iterations per batch) does. Nonzero: wrong frame.
     pub budget_pixels: u32,
-    /// Bytes the list structure needs for this frame (S: offsets + list; A: heads + nodes +
-    /// counter; none: 0).
+    /// Bytes the list structure needs for this frame (S: offsets + list, sorted: plus the
+    /// metaball depths; A: heads + nodes + counter; none: 0).
     pub list_bytes: u64,
 }
 
@@ -80,6 +84,7 @@ impl MetaballBuffers {
             &mut self.pixels,
             &mut self.debug,
             &mut self.sky,
+            &mut self.depths,
         ] {
             ctx.destroy_buffer(b);
         }
@@ -120,6 +125,7 @@ impl MetaballRenderer {
                 ("LIST", list.to_string()),
                 ("DENSITY", settings.density.index().to_string()),
                 ("MATERIAL", settings.material_index().to_string()),
+                ("SORTED", (settings.sorts_lists() as u32).to_string()),
             ];
             d.extend(extra);
             d
@@ -148,22 +154,34 @@ impl MetaballRenderer {
             ListKind::Abuffer => (None, Some(graphics("fill", 2)?)),
         };
         let defines = common(vec![]);
-        let march = ComputePipeline::new(
-            ctx,
-            &ComputeDesc {
-                name: "march",
-                shader: "render/metaball/march.comp",
-                defines: &defines,
-                local_size: 64,
-                spec: &[],
-                buffers: BINDINGS,
-                push_size: 0,
-            },
-        )?;
+        let compute = |name, shader| {
+            ComputePipeline::new(
+                ctx,
+                &ComputeDesc {
+                    name,
+                    shader,
+                    defines: &defines,
+                    local_size: 64,
+                    spec: &[],
+                    buffers: BINDINGS,
+                    push_size: 0,
+                },
+            )
+        };
+        let march = compute("march", "render/metaball/march.comp")?;
+        let sort = if settings.sorts_lists() {
+            Some((
+                compute("depths", "render/metaball/depths.comp")?,
+                compute("sort lists", "render/metaball/sort_lists.comp")?,
+            ))
+        } else {
+            None
+        };
         Ok(Self {
             settings,
             count,
             fill,
+            sort,
             march,
             scan: ScanPass::new(ctx, ScanVariant::Auto)?,
             bounds: BoundsPass::new(ctx)?,
@@ -240,6 +258,14 @@ impl MetaballRenderer {
             pixels: ctx.storage_buffer("render pixels", px * 4)?,
             debug: ctx.storage_buffer("render debug", if debug { px * 16 } else { small })?,
             sky: ctx.storage_buffer("sky image", sky_px.len() as u64 * 4)?,
+            depths: ctx.storage_buffer(
+                "metaball depths",
+                if s.sorts_lists() {
+                    n_capacity.max(1) * 4
+                } else {
+                    small
+                },
+            )?,
             sky_size: (sky_w, sky_h),
             bounds: BoundsBuffers::new(ctx, n_capacity.max(1))?,
             scan: self.scan.scratch(
@@ -320,6 +346,7 @@ impl MetaballRenderer {
             &b.pixels,
             &b.debug,
             &b.sky,
+            &b.depths,
         ]
     }
 
@@ -340,6 +367,12 @@ impl MetaballRenderer {
         let s = &self.settings;
         let (w, h) = (s.width, s.height);
         let px = s.pixels();
+        if s.sorts_lists() && n as u64 * 4 > b.depths.size {
+            return Err(Error::Param(format!(
+                "{n} metaballs: the buffers were made for {}",
+                b.depths.size / 4
+            )));
+        }
         let params = RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on);
         ctx.barrier(cmd);
         unsafe {
@@ -407,9 +440,18 @@ impl MetaballRenderer {
             draw(fill);
             scopes.end(ctx, cmd);
         }
-        scopes.begin(ctx, cmd, "march");
         let groups = px.div_ceil(self.march.local_size as u64);
         let infos: Vec<_> = bufs.iter().map(|b| b.info()).collect();
+        if let Some((depths, sort)) = &self.sort {
+            scopes.begin(ctx, cmd, "sort");
+            let metaball_groups = (n as u64).div_ceil(depths.local_size as u64);
+            depths.dispatch_groups(ctx, cmd, &infos, &(), metaball_groups);
+            ctx.barrier(cmd);
+            sort.dispatch_groups(ctx, cmd, &infos, &(), groups);
+            scopes.end(ctx, cmd);
+            ctx.barrier(cmd);
+        }
+        scopes.begin(ctx, cmd, "march");
         self.march.dispatch_groups(ctx, cmd, &infos, &(), groups);
         scopes.end(ctx, cmd);
         ctx.barrier(cmd);
@@ -431,11 +473,14 @@ impl MetaballRenderer {
     pub fn frame_stats(&self, b: &MetaballBuffers, slot: usize) -> FrameStats {
         let st: &[u32] = bytemuck::cast_slice(b.stats_readback[slot].mapped().expect("mapped"));
         let px = self.settings.pixels();
-        let (fragments, list_bytes) = match self.settings.list {
+        let (fragments, mut list_bytes) = match self.settings.list {
             ListKind::None => (0, 0),
             ListKind::Sbuffer => (st[4] as u64, (px + 1) * 4 + st[4] as u64 * 4),
             ListKind::Abuffer => (st[0] as u64, px * 4 + st[0] as u64 * 8 + 4),
         };
+        if self.settings.sorts_lists() {
+            list_bytes += b.depths.size;
+        }
         FrameStats {
             fragments,
             longest: st[1],
@@ -507,6 +552,10 @@ impl MetaballRenderer {
             p.destroy(ctx);
         }
         self.march.destroy(ctx);
+        if let Some((d, s)) = &mut self.sort {
+            d.destroy(ctx);
+            s.destroy(ctx);
+        }
         self.scan.destroy(ctx);
         self.bounds.destroy(ctx);
     }

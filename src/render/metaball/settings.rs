@@ -24,6 +24,10 @@ pub struct MetaballSettings {
     pub max_steps: u32,
     /// Secondary samples that leave the screen end the path (else: every metaball).
     pub offscreen_end: bool,
+    /// S-buffer ranges sorted by the metaballs' view depth (a `sort` pass), each sample
+    /// summing only those within R of its depth. Ignored by the other lists. Default: on
+    /// for glass and tinted, off for Phong and the metals (one outward bounce).
+    pub sorted: bool,
     pub width: u32,
     pub height: u32,
     /// Index of refraction of glass and tinted (water).
@@ -73,6 +77,11 @@ impl MetaballSettings {
                 .offscreen
                 .map(|o| o == crate::config::Offscreen::End)
                 .unwrap_or(false),
+            // Sorting pays where rays read the lists many times: inside glass and tinted.
+            sorted: match sw.list_sort {
+                Some(o) => o == crate::config::OnOff::On,
+                None => matches!(sw.material, Some(Material::Glass) | Some(Material::Tinted)),
+            },
             width: sw.width,
             height: sw.height,
             ior: 1.33,
@@ -80,8 +89,27 @@ impl MetaballSettings {
             base: [0.08, 0.06, 0.05],
             sky: sw.sky.clone(),
         };
+        if sw.list_sort.is_some() && s.list != ListKind::Sbuffer {
+            return Err(Error::Param(format!(
+                "--list-sort applies to the S-buffer's contiguous ranges, not --list {}",
+                s.list.as_str()
+            )));
+        }
         s.validate()?;
         Ok(s)
+    }
+
+    /// Whether the frame sorts its lists (an S-buffer with `sorted`).
+    pub fn sorts_lists(&self) -> bool {
+        self.sorted && self.list == ListKind::Sbuffer
+    }
+
+    /// The list's name in tables: none, abuffer, sbuffer (the thesis's), sbuffer-sorted.
+    pub fn list_name(&self) -> String {
+        match self.list {
+            ListKind::Sbuffer if self.sorted => "sbuffer-sorted".into(),
+            l => l.as_str(),
+        }
     }
 
     pub fn validate(&self) -> Result<()> {
