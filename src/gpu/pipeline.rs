@@ -97,6 +97,28 @@ pub struct ComputeDesc<'a> {
     pub push_size: u32,
 }
 
+impl<'a> ComputeDesc<'a> {
+    /// A pipeline with no specialization constants but the workgroup size.
+    pub fn plain(
+        name: &'a str,
+        shader: &'a str,
+        defines: &'a [(&'a str, String)],
+        local_size: u32,
+        buffers: u32,
+        push_size: u32,
+    ) -> Self {
+        Self {
+            name,
+            shader,
+            defines,
+            local_size,
+            spec: &[],
+            buffers,
+            push_size,
+        }
+    }
+}
+
 pub struct ComputePipeline {
     pub pipeline: vk::Pipeline,
     pub layout: vk::PipelineLayout,

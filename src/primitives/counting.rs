@@ -56,15 +56,7 @@ impl CountingBuffers {
 
 impl CountingSort {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let desc = |name, shader, buffers| ComputeDesc {
-            name,
-            shader,
-            defines: &[],
-            local_size: 256,
-            spec: &[],
-            buffers,
-            push_size: 8,
-        };
+        let desc = |name, shader, buffers| ComputeDesc::plain(name, shader, &[], 256, buffers, 8);
         Ok(Self {
             count: ComputePipeline::new(ctx, &desc("count", "primitives/count.comp", 3))?,
             scatter: ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp", 6))?,
@@ -139,15 +131,7 @@ impl GatherPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
-                    name: "gather",
-                    shader: "primitives/gather.comp",
-                    defines: &[],
-                    local_size: 256,
-                    spec: &[],
-                    buffers: 3,
-                    push_size: 4,
-                },
+                &ComputeDesc::plain("gather", "primitives/gather.comp", &[], 256, 3, 4),
             )?,
         })
     }

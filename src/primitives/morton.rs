@@ -14,15 +14,7 @@ impl MortonPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
-                    name: Self::NAME,
-                    shader: "primitives/morton.comp",
-                    defines: &[],
-                    local_size: 256,
-                    spec: &[],
-                    buffers: 4,
-                    push_size: 4,
-                },
+                &ComputeDesc::plain(Self::NAME, "primitives/morton.comp", &[], 256, 4, 4),
             )?,
         })
     }

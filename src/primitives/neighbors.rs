@@ -184,14 +184,8 @@ impl NeighborSearch {
         };
         let defines = Self::defines_for(strategy, sort);
         let push_size = std::mem::size_of::<NeighborPush>() as u32;
-        let desc = |name, shader, buffers, push_size| ComputeDesc {
-            name,
-            shader,
-            defines: &defines,
-            local_size: 128,
-            spec: &[],
-            buffers,
-            push_size,
+        let desc = |name, shader, buffers, push_size| {
+            ComputeDesc::plain(name, shader, &defines, 128, buffers, push_size)
         };
         let morton = strategy == Neighbors::Morton;
         Ok(Self {

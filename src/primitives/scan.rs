@@ -103,15 +103,14 @@ impl ScanPass {
         let pipeline = |name, shader| {
             ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
+                &ComputeDesc::plain(
                     name,
                     shader,
-                    defines: &defines,
-                    local_size: WG,
-                    spec: &[],
-                    buffers: 5,
-                    push_size: std::mem::size_of::<ScanPush>() as u32,
-                },
+                    &defines,
+                    WG,
+                    5,
+                    std::mem::size_of::<ScanPush>() as u32,
+                ),
             )
         };
         Ok(Self {

@@ -93,15 +93,14 @@ impl OrbitsPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
-                    name: Self::NAME,
-                    shader: "scene/orbits.comp",
-                    defines: &[],
-                    local_size: 256,
-                    spec: &[],
-                    buffers: 2,
-                    push_size: std::mem::size_of::<OrbitsPush>() as u32,
-                },
+                &ComputeDesc::plain(
+                    Self::NAME,
+                    "scene/orbits.comp",
+                    &[],
+                    256,
+                    2,
+                    std::mem::size_of::<OrbitsPush>() as u32,
+                ),
             )?,
         })
     }

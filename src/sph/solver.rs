@@ -128,15 +128,7 @@ impl SphSolver {
         let pipeline = |name, shader| {
             ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
-                    name,
-                    shader,
-                    defines: &defines,
-                    local_size: 128,
-                    spec: &[],
-                    buffers: BINDINGS,
-                    push_size,
-                },
+                &ComputeDesc::plain(name, shader, &defines, 128, BINDINGS, push_size),
             )
         };
         Ok(Self {

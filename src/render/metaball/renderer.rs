@@ -157,15 +157,7 @@ impl MetaballRenderer {
         let compute = |name, shader| {
             ComputePipeline::new(
                 ctx,
-                &ComputeDesc {
-                    name,
-                    shader,
-                    defines: &defines,
-                    local_size: 64,
-                    spec: &[],
-                    buffers: BINDINGS,
-                    push_size: 0,
-                },
+                &ComputeDesc::plain(name, shader, &defines, 64, BINDINGS, 0),
             )
         };
         let march = compute("march", "render/metaball/march.comp")?;
