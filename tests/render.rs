@@ -25,13 +25,18 @@ fn settings(list: ListKind, density: DensityFn, material: Material) -> MetaballS
 }
 
 fn switches() -> Switches {
+    parse_switches(&[])
+}
+
+/// The switches of a command line holding only `args`.
+fn parse_switches(args: &[&str]) -> Switches {
     use clap::Parser;
     #[derive(Parser)]
     struct Only {
         #[command(flatten)]
         s: Switches,
     }
-    Only::parse_from(["t"]).s
+    Only::parse_from(std::iter::once("t").chain(args.iter().copied())).s
 }
 
 struct Scene {
@@ -83,6 +88,21 @@ fn agreement(a: &[u8], b: &[u8], tol: u8) -> f64 {
         .filter(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| p.abs_diff(*q) <= tol))
         .count();
     same as f64 / (a.len() / 4) as f64
+}
+
+/// Panics, writing a diff PNG, unless at least `min` of the pixels of `img` are within
+/// `tol` per channel of `reference`.
+fn assert_agrees(name: &str, img: &[u8], reference: &[u8], tol: u8, min: f64) {
+    let a = agreement(img, reference, tol);
+    if a < min {
+        let p = write_diff(name, img, reference);
+        panic!(
+            "{name}: {:.4}% of pixels within {tol}/255 of the reference, need {}% (diff: {})",
+            a * 100.0,
+            min * 100.0,
+            p.display()
+        );
+    }
 }
 
 fn write_diff(name: &str, a: &[u8], b: &[u8]) -> std::path::PathBuf {
@@ -140,15 +160,7 @@ fn every_list_gives_the_same_image() {
                 s.sorted = sorted;
                 let name = s.list_name();
                 let (img, _, _) = render(&ctx, s, &sc, false);
-                let a = agreement(&img, &none, 1);
-                if a < 0.999 {
-                    let p = write_diff(&format!("{d:?}-{m:?}-{name}"), &img, &none);
-                    panic!(
-                        "{d:?}/{m:?}/{name}: {:.4}% of pixels agree with none (diff: {})",
-                        a * 100.0,
-                        p.display()
-                    );
-                }
+                assert_agrees(&format!("{d:?}-{m:?}-{name}"), &img, &none, 1, 0.999);
             }
         }
     }
@@ -404,15 +416,7 @@ fn golden_images() {
             .to_rgba8();
         assert_eq!(golden.dimensions(), (W, H));
         // Tolerance for other drivers' arithmetic: 99% of pixels within 4/255.
-        let a = agreement(&img, golden.as_raw(), 4);
-        if a < 0.99 {
-            let p = write_diff(&format!("golden-{name}"), &img, golden.as_raw());
-            panic!(
-                "{name}: {:.3}% of pixels match the golden image (diff: {})",
-                a * 100.0,
-                p.display()
-            );
-        }
+        assert_agrees(&format!("golden-{name}"), &img, golden.as_raw(), 4, 0.99);
     }
     common::finish(&ctx);
 }
@@ -442,20 +446,14 @@ fn bad_renderer_settings_are_clear_errors() {
     let mut r = r;
     r.destroy(&ctx);
     // Only the S-buffer's contiguous ranges can be sorted.
-    use clap::Parser;
-    #[derive(Parser)]
-    struct Only {
-        #[command(flatten)]
-        s: Switches,
-    }
-    let sw = Only::parse_from(["t", "--list", "abuffer", "--list-sort", "on"]).s;
+    let sw = parse_switches(&["--list", "abuffer", "--list-sort", "on"]);
     let e = MetaballSettings::from_switches(&sw)
         .err()
         .unwrap()
         .to_string();
     assert!(e.contains("--list-sort"), "{e}");
     // Glass sorts by default, Phong does not.
-    let glass = Only::parse_from(["t", "--material", "glass"]).s;
+    let glass = parse_switches(&["--material", "glass"]);
     assert!(MetaballSettings::from_switches(&glass)
         .unwrap()
         .sorts_lists());

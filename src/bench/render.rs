@@ -58,6 +58,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                         Ok(())
                     })?;
                 let after = r.frame_stats(&b, 0);
+                let cut = after.budget_pixels.max(st.budget_pixels);
                 row.extra = vec![
                     ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
                     (
@@ -71,17 +72,12 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                         "overflow in timed frames".into(),
                         after.overflow.to_string(),
                     ),
-                    (
-                        "pixels past loop budget".into(),
-                        after.budget_pixels.max(st.budget_pixels).to_string(),
-                    ),
+                    ("pixels past loop budget".into(), cut.to_string()),
                 ];
-                if after.budget_pixels.max(st.budget_pixels) > 0 {
+                if cut > 0 {
                     eprintln!(
-                        "warning: {}: {} pixels' rays were cut short by llvmpipe's loop \
-                         budget; this row understates the cost and its image is wrong",
-                        name,
-                        after.budget_pixels.max(st.budget_pixels)
+                        "warning: {name}: {cut} pixels' rays were cut short by llvmpipe's loop \
+                         budget; this row understates the cost and its image is wrong"
                     );
                 }
                 Ok(row)

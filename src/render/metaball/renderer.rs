@@ -205,69 +205,32 @@ impl MetaballRenderer {
             Some(p) => load_sky(p)?,
             None => (0, 0, vec![0u32]),
         };
-        let entry = if s.list == ListKind::Abuffer { 8 } else { 4 };
+        let entry = self.entry_bytes();
         let list_capacity = match s.list {
             ListKind::None => 0,
             _ => capacity.max(1).min(ctx.max_storage_range() / entry),
         };
-        let small = 16;
+        // Buffers a configuration does not use stay bound, at a token size.
+        let only = |used: bool, bytes: u64| if used { bytes } else { 16 };
+        let (sbuf, abuf) = (s.list == ListKind::Sbuffer, s.list == ListKind::Abuffer);
         let mut b = MetaballBuffers {
             params: ctx
                 .storage_buffer("render params", std::mem::size_of::<RenderParams>() as u64)?,
-            offsets: ctx.storage_buffer(
-                "sbuffer offsets",
-                if s.list == ListKind::Sbuffer {
-                    (px + 1) * 4
-                } else {
-                    small
-                },
-            )?,
-            list: ctx.storage_buffer(
-                "sbuffer list",
-                if s.list == ListKind::Sbuffer {
-                    list_capacity * 4
-                } else {
-                    small
-                },
-            )?,
-            heads: ctx.storage_buffer(
-                "abuffer heads",
-                if s.list == ListKind::Abuffer {
-                    px * 4
-                } else {
-                    small
-                },
-            )?,
-            nodes: ctx.storage_buffer(
-                "abuffer nodes",
-                if s.list == ListKind::Abuffer {
-                    list_capacity * 8
-                } else {
-                    small
-                },
-            )?,
+            offsets: ctx.storage_buffer("sbuffer offsets", only(sbuf, (px + 1) * 4))?,
+            list: ctx.storage_buffer("sbuffer list", only(sbuf, list_capacity * 4))?,
+            heads: ctx.storage_buffer("abuffer heads", only(abuf, px * 4))?,
+            nodes: ctx.storage_buffer("abuffer nodes", only(abuf, list_capacity * 8))?,
             stats: ctx.storage_buffer("render stats", STATS * 4)?,
             pixels: ctx.storage_buffer("render pixels", px * 4)?,
-            debug: ctx.storage_buffer("render debug", if debug { px * 16 } else { small })?,
+            debug: ctx.storage_buffer("render debug", only(debug, px * 16))?,
             sky: ctx.storage_buffer("sky image", sky_px.len() as u64 * 4)?,
             depths: ctx.storage_buffer(
                 "metaball depths",
-                if s.sorts_lists() {
-                    n_capacity.max(1) * 4
-                } else {
-                    small
-                },
+                only(s.sorts_lists(), n_capacity.max(1) * 4),
             )?,
             sky_size: (sky_w, sky_h),
             bounds: BoundsBuffers::new(ctx, n_capacity.max(1))?,
-            scan: self.scan.scratch(
-                ctx,
-                if s.list == ListKind::Sbuffer {
-                    px + 1
-                } else {
-                    0
-                },
-            )?,
+            scan: self.scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?,
             stats_readback: Vec::new(),
             pixels_readback: Vec::new(),
             list_capacity,
@@ -291,15 +254,19 @@ impl MetaballRenderer {
         Ok(b)
     }
 
-    /// Reallocate the list for `needed` entries: exactly (S-buffer) or with 25% headroom
-    /// (A-buffer, whose count is only known after the pass).
-    pub fn grow(&self, ctx: &Context, b: &mut MetaballBuffers, needed: u64) -> Result<()> {
-        let entry = if self.settings.list == ListKind::Abuffer {
+    /// Bytes of one list entry: an S-buffer metaball index, an A-buffer (index, next) node.
+    fn entry_bytes(&self) -> u64 {
+        if self.settings.list == ListKind::Abuffer {
             8
         } else {
             4
-        };
-        let fits = ctx.max_storage_range() / entry;
+        }
+    }
+
+    /// Reallocate the list for `needed` entries: exactly (S-buffer) or with 25% headroom
+    /// (A-buffer, whose count is only known after the pass).
+    pub fn grow(&self, ctx: &Context, b: &mut MetaballBuffers, needed: u64) -> Result<()> {
+        let fits = ctx.max_storage_range() / self.entry_bytes();
         if needed > fits {
             return Err(Error::Memory(format!(
                 "the {} needs {needed} entries, more than one storage binding addresses on this \
