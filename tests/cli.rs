@@ -252,6 +252,22 @@ fn summary(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
+/// `run` with `args`, no frames saved, validation on, into `dir`: must succeed; the summary.
+fn run_ok(dir: &std::path::Path, args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["run"];
+    all.extend_from_slice(args);
+    all.extend([
+        "--save-every",
+        "0",
+        "--out",
+        dir.to_str().unwrap(),
+        "--validation",
+    ]);
+    let o = fluidform(&all);
+    assert!(o.status.success(), "{}", text(&o));
+    summary(dir)
+}
+
 #[test]
 fn run_sph_scenes_end_to_end() {
     let dir = tempfile::tempdir().unwrap();
@@ -326,20 +342,7 @@ fn run_sph_scenes_end_to_end() {
 fn run_scene_file_with_colliders() {
     let dir = tempfile::tempdir().unwrap();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/scenes/obstacles.toml");
-    let o = fluidform(&[
-        "run",
-        "--scene",
-        scene,
-        "--frames",
-        "3",
-        "--save-every",
-        "0",
-        "--out",
-        dir.path().to_str().unwrap(),
-        "--validation",
-    ]);
-    assert!(o.status.success(), "{}", text(&o));
-    let s = summary(dir.path());
+    let s = run_ok(dir.path(), &["--scene", scene, "--frames", "3"]);
     assert_eq!(s["config"]["scene"], "obstacles");
     assert_eq!(s["stats"]["outside_domain"], 0);
     assert!(
@@ -399,18 +402,7 @@ fn bench_smoke_writes_sweep_tables() {
 fn cfl_limits_the_step_and_keeps_the_frame_time() {
     let dir = tempfile::tempdir().unwrap();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/scenes/cfl.toml");
-    let o = fluidform(&[
-        "run",
-        "--scene",
-        scene,
-        "--save-every",
-        "0",
-        "--out",
-        dir.path().to_str().unwrap(),
-        "--validation",
-    ]);
-    assert!(o.status.success(), "{}", text(&o));
-    let s = summary(dir.path());
+    let s = run_ok(dir.path(), &["--scene", scene]);
     assert_eq!(s["frames"], 3);
     // ceil(0.01 / 9.14e-4) = 11 steps per frame while every speed stays below c.
     assert_eq!(s["stats"]["steps"], 33, "{}", s["stats"]);
