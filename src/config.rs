@@ -8,7 +8,7 @@ use serde::Serialize;
 macro_rules! switch_enum {
     ($(#[$m:meta])* $name:ident { $($v:ident),+ $(,)? }) => {
         $(#[$m])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum, Serialize)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum, Serialize, serde::Deserialize)]
         #[serde(rename_all = "kebab-case")]
         pub enum $name { $($v),+ }
         impl $name {

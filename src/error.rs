@@ -17,6 +17,9 @@ pub enum Error {
         line: u32,
         message: String,
     },
+    /// A pass's Rust interface disagrees with its shader (bindings or push constants).
+    #[error("{0}")]
+    Interface(String),
     #[error("GPU memory: {0}")]
     Memory(String),
     #[error("invalid parameter: {0}")]

@@ -4,11 +4,14 @@ pub mod bench;
 pub mod config;
 pub mod error;
 pub mod gpu;
+pub mod particles;
 pub mod primitives;
 pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod session;
+pub mod shaders;
 pub mod sph;
 pub mod viewer;
 

@@ -1,15 +1,16 @@
 //! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
+//! Every scene kind is a `FrameWork` played by `session::play`.
 use crate::config::Switches;
 use crate::error::{Error, Result};
-use crate::gpu::{ColorTarget, Context, ContextOptions, FrameLoop};
+use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
 use crate::render::{points::PointsPush, Camera, PointsView};
 use crate::report::Report;
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
-use serde_json::{json, Value};
-use std::path::PathBuf;
-
-/// Frames in flight.
-pub const SLOTS: usize = 2;
+pub use crate::session::{camera_with_switches, check_validation, SLOTS};
+use crate::session::{open, play};
+use ash::vk;
+use serde_json::json;
+use std::path::{Path, PathBuf};
 
 pub struct RunOptions {
     pub scene: String,
@@ -23,10 +24,30 @@ pub struct RunOptions {
 
 pub const DEFAULT_SCENE: &str = "dam-break";
 
-/// The run's outcome: the summary written and the validation counts.
+/// The run's outcome: the summary written and the frames saved.
 pub struct RunResult {
-    pub summary: Value,
+    pub summary: serde_json::Value,
     pub pngs: Vec<PathBuf>,
+}
+
+/// Where saved frames go.
+struct Frames<'a> {
+    out: &'a Path,
+    every: u64,
+    pngs: Vec<PathBuf>,
+}
+
+impl Frames<'_> {
+    fn save(&self, f: u64) -> bool {
+        self.every > 0 && f.is_multiple_of(self.every)
+    }
+    fn path(&mut self, f: u64) -> Option<PathBuf> {
+        let p = self
+            .save(f)
+            .then(|| self.out.join(format!("frame_{f:04}.png")));
+        self.pngs.extend(p.clone());
+        p
+    }
 }
 
 pub fn run(opts: &RunOptions) -> Result<RunResult> {
@@ -44,11 +65,60 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
     run_sph(opts, scene)
 }
 
-fn open(sw: &Switches) -> Result<Context> {
-    Context::new(&ContextOptions {
-        device: sw.device.clone(),
-        validation: sw.validation,
-    })
+/// The orbits scene: a gravity step and the point view per frame.
+struct OrbitsWork<'a> {
+    pass: OrbitsPass,
+    view: PointsView,
+    scene: Orbits,
+    target: ColorTarget,
+    push: PointsPush,
+    frames: Frames<'a>,
+}
+
+impl FrameWork for OrbitsWork<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        prof.begin(ctx, cmd, OrbitsPass::NAME);
+        self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
+        prof.end(ctx, cmd);
+        // New positions -> the point view's vertex shader.
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
+        prof.begin(ctx, cmd, PointsView::NAME);
+        self.target
+            .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
+        let s = &self.scene;
+        self.view.draw(ctx, cmd, &s.pos, &s.color, s.n, &self.push);
+        self.target.end_rendering(ctx, cmd);
+        prof.end(ctx, cmd);
+        if self.frames.save(frame) {
+            prof.begin(ctx, cmd, "readback");
+            self.target.copy_out(ctx, cmd, slot);
+            prof.end(ctx, cmd);
+        }
+        Ok(())
+    }
+
+    fn retire(&mut self, _: &Context, frame: u64, slot: usize) -> Result<()> {
+        if let Some(p) = self.frames.path(frame) {
+            self.target.save_png(slot, &p)?;
+        }
+        Ok(())
+    }
+}
+
+impl OrbitsWork<'_> {
+    fn destroy(&mut self, ctx: &Context) {
+        self.target.destroy(ctx);
+        self.scene.destroy(ctx);
+        self.view.destroy(ctx);
+        self.pass.destroy(ctx);
+    }
 }
 
 fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
@@ -58,59 +128,32 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     let particles = sw.particles.unwrap_or(4096);
     let frame_count = opts.frames.unwrap_or(120);
     let state = orbits::initial_state(particles as usize, sw.seed);
-    let mut pass = OrbitsPass::new(&ctx)?;
-    let mut view = PointsView::new(&ctx)?;
-    let mut scene = Orbits::new(&ctx, &state)?;
-    let mut target = ColorTarget::new(&ctx, sw.width, sw.height, SLOTS)?;
-    let mut frames = FrameLoop::new(&ctx, SLOTS, 16)?;
     let cam = Camera::look_at(
         glam::Vec3::new(0.0, 0.8, 3.2),
         glam::Vec3::ZERO,
         45.0,
         sw.width as f32 / sw.height as f32,
     );
-    let push = PointsPush::from_camera(&cam, 1.0);
+    let pass = Guard::new(&ctx, OrbitsPass::new(&ctx)?);
+    let view = Guard::new(&ctx, PointsView::new(&ctx)?);
+    let scene = Guard::new(&ctx, Orbits::new(&ctx, &state)?);
+    let target = ColorTarget::new(&ctx, sw.width, sw.height, SLOTS)?;
+    let mut work = OrbitsWork {
+        pass: pass.take(),
+        view: view.take(),
+        scene: scene.take(),
+        target,
+        push: PointsPush::from_camera(&cam, 1.0),
+        frames: Frames {
+            out: &opts.out,
+            every: opts.save_every,
+            pngs: Vec::new(),
+        },
+    };
     let memory = ctx.memory_bytes();
-    let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
-    let mut pngs = Vec::new();
-    let result = frames.run(
-        &ctx,
-        frame_count,
-        |prof, cmd, frame, slot| {
-            prof.begin(&ctx, cmd, OrbitsPass::NAME);
-            pass.step(&ctx, cmd, &scene, 1.0 / 120.0);
-            prof.end(&ctx, cmd);
-            ctx.barrier(cmd);
-            prof.begin(&ctx, cmd, PointsView::NAME);
-            target.begin_rendering(&ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-            view.draw(&ctx, cmd, &scene.pos, &scene.color, scene.n, &push);
-            target.end_rendering(&ctx, cmd);
-            prof.end(&ctx, cmd);
-            if save(frame) {
-                prof.begin(&ctx, cmd, "readback");
-                target.copy_out(&ctx, cmd, slot);
-                prof.end(&ctx, cmd);
-            }
-            Ok(())
-        },
-        |frame, slot| {
-            if save(frame) {
-                let path = opts.out.join(format!("frame_{frame:04}.png"));
-                target.save_png(slot, &path)?;
-                pngs.push(path);
-            }
-            Ok(())
-        },
-    );
-    let timings = std::mem::take(&mut frames.profiler.results);
-    frames.destroy(&ctx);
-    target.destroy(&ctx);
-    scene.destroy(&ctx);
-    view.destroy(&ctx);
-    pass.destroy(&ctx);
-    result?;
-
-    let validation = sw.validation.then(|| ctx.validation_counts());
+    let timings = play(&ctx, frame_count, &mut work);
+    work.destroy(&ctx);
+    let timings = timings?;
     let config = json!({
         "command": "run",
         "scene": opts.scene,
@@ -125,47 +168,69 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
         timings: &timings,
         memory,
         stats: json!({ "particles": particles }),
-        validation,
+        validation: sw.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;
     check_validation(&ctx)?;
-    Ok(RunResult { summary, pngs })
+    Ok(RunResult {
+        summary,
+        pngs: work.frames.pngs,
+    })
 }
 
-/// With validation on, any validation error fails the command.
-pub fn check_validation(ctx: &Context) -> Result<()> {
-    let (errors, _) = ctx.validation_counts();
-    if errors > 0 {
-        return Err(Error::Unsupported(format!(
-            "{errors} Vulkan validation error(s); first: {}",
-            ctx.validation_messages()
-                .first()
-                .cloned()
-                .unwrap_or_default()
-        )));
-    }
-    Ok(())
+/// An SPH scene: steps per frame and the view.
+struct SphWork<'a> {
+    solver: crate::sph::SphSolver,
+    st: crate::sph::SphState,
+    stepper: crate::sph::run::Stepper,
+    view: Box<dyn crate::viewer::View>,
+    frames: Frames<'a>,
 }
 
-/// The camera with --eye, --target and --fov applied.
-pub fn camera_with_switches(mut cam: Camera, sw: &Switches) -> Camera {
-    if let Some(e) = sw.eye {
-        cam.eye = e.into();
+impl FrameWork for SphWork<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        self.stepper
+            .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
+        // The step's positions -> the view's copies and shaders.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::TRANSFER_READ | sync::GRAPHICS_READ,
+        );
+        let save = self.frames.save(frame);
+        let st = &self.st;
+        self.view
+            .record(ctx, cmd, prof, st.pos(), st.attr(), st.n, slot, save)
     }
-    if let Some(t) = sw.target {
-        cam.target = t.into();
+
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        self.stepper.retire_slot(slot);
+        let path = self.frames.path(frame);
+        self.view.retire(ctx, slot, self.st.n, path.as_deref())
     }
-    if let Some(f) = sw.fov {
-        cam.fov_y_deg = f;
+}
+
+impl SphWork<'_> {
+    fn destroy(&mut self, ctx: &Context) {
+        self.stepper.destroy(ctx);
+        self.view.destroy(ctx);
+        self.st.destroy(ctx);
+        self.solver.destroy(ctx);
     }
-    cam
 }
 
 fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     use crate::config::{Neighbors, RenderKind};
-    use crate::sph::run::{check, physics_stats, Stepper};
+    use crate::sph::run::{check, physics_stats, SphRunStats, Stepper};
     use crate::sph::SphSolver;
-    use crate::viewer::Viewer;
+    use crate::viewer::{MetaballViewer, PointsViewer, View};
     let sw = &opts.switches;
     let render = sw.render.unwrap_or(RenderKind::Metaballs);
     let mut allowed = vec!["sort", "neighbors", "fluid", "render"];
@@ -186,9 +251,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
     let neighbors = sw.neighbors.unwrap_or(Neighbors::Grid);
-    let mut solver = SphSolver::new(&ctx, neighbors, sw.sort)?;
+    let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sort)?);
     let parts = scene.particles(sw.seed);
-    let mut st = solver.state(&ctx, &scene, &parts)?;
+    let st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
     let aspect = sw.width as f32 / sw.height as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
@@ -207,74 +272,61 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         }
     };
     let cam = camera_with_switches(cam, sw);
-    let viewer = match render {
-        RenderKind::Metaballs => Viewer::metaballs(&ctx, sw, cam, st.n, SLOTS),
+    let view: Box<dyn View> = match render {
+        RenderKind::Metaballs => Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS)?),
         // Spheres of half the rest spacing.
-        RenderKind::Points => Viewer::points(&ctx, sw, &cam, 0.5 * scene.fluid.spacing(), SLOTS),
+        RenderKind::Points => Box::new(PointsViewer::new(
+            &ctx,
+            sw,
+            &cam,
+            0.5 * scene.fluid.spacing(),
+            SLOTS,
+        )?),
     };
-    let mut viewer = match viewer {
-        Ok(v) => v,
+    let mut view = view;
+    let stepper = match Stepper::new(&ctx, &st, SLOTS) {
+        Ok(s) => s,
         Err(e) => {
-            st.destroy(&ctx);
-            solver.destroy(&ctx);
+            view.destroy(&ctx);
             return Err(e);
         }
     };
-    // Scopes per step: arrange (keys, sort, ranges, reorder), density, forces, integrate.
-    let max_steps = match scene.fluid.cfl {
-        Some(_) => crate::sph::params::MAX_SUBSTEPS,
-        None => scene.fluid.substeps,
+    let mut work = SphWork {
+        solver: solver.take(),
+        st: st.take(),
+        stepper,
+        view,
+        frames: Frames {
+            out: &opts.out,
+            every: opts.save_every,
+            pngs: Vec::new(),
+        },
     };
-    let mut frames = FrameLoop::new(&ctx, SLOTS, max_steps * 10 + 32)?;
-    let stepper = std::cell::RefCell::new(Stepper::new(&ctx, &st, SLOTS)?);
-    let save = |f: u64| opts.save_every > 0 && f.is_multiple_of(opts.save_every);
-    let mut pngs = Vec::new();
-    let n = st.n;
-    let result = frames.run(
-        &ctx,
-        frame_count,
-        |prof, cmd, frame, slot| {
-            stepper
-                .borrow_mut()
-                .record_frame(&ctx, cmd, prof, &solver, &mut st, slot)?;
-            viewer.record(&ctx, cmd, prof, st.pos(), st.attr(), n, slot, save(frame))
-        },
-        |frame, slot| {
-            stepper.borrow_mut().retire_slot(slot);
-            let path = save(frame).then(|| opts.out.join(format!("frame_{frame:04}.png")));
-            viewer.retire(&ctx, slot, n, path.as_deref())?;
-            pngs.extend(path);
-            Ok(())
-        },
-    );
-    let timings = std::mem::take(&mut frames.profiler.results);
+    let timings = play(&ctx, frame_count, &mut work);
     let memory = ctx.memory_bytes();
-    let dump = if result.is_ok() {
-        Some(st.read(&ctx))
-    } else {
-        None
+    let dump = match &timings {
+        Ok(_) => Some(work.st.read(&ctx)),
+        Err(_) => None,
     };
-    let mut stepper = stepper.into_inner();
-    let (steps, sim_time) = (stepper.steps_taken, stepper.sim_time);
-    let render_stats = viewer.stats();
-    stepper.destroy(&ctx);
-    frames.destroy(&ctx);
-    viewer.destroy(&ctx);
-    st.destroy(&ctx);
-    solver.destroy(&ctx);
-    result?;
-    let mut stats = physics_stats(&dump.expect("state read")?, &scene);
-    stats["steps"] = json!(steps);
-    stats["simulated_seconds"] = json!(sim_time);
-    stats["render"] = render_stats;
+    let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
+    let render_stats = work.view.stats();
+    let sort = work.solver.search.sort;
+    work.destroy(&ctx);
+    let timings = timings?;
+    let stats = SphRunStats {
+        physics: physics_stats(&dump.expect("state read")?, &scene),
+        steps,
+        simulated_seconds,
+        render: render_stats,
+    };
     let config = json!({
         "command": "run",
         "scene": scene.name,
         "frames": frame_count,
         "save_every": opts.save_every,
-        "particles": stats["particles"],
+        "particles": stats.physics.particles,
         "neighbors": neighbors.as_str(),
-        "sort": solver.search.sort.as_str(),
+        "sort": sort.as_str(),
         "render": render.as_str(),
         "fluid": scene.fluid,
         "switches": sw,
@@ -284,11 +336,14 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         config,
         timings: &timings,
         memory,
-        stats: stats.clone(),
+        stats: serde_json::to_value(&stats).expect("stats serialise"),
         validation: sw.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;
     check_validation(&ctx)?;
-    check(&stats)?;
-    Ok(RunResult { summary, pngs })
+    check(&stats.physics)?;
+    Ok(RunResult {
+        summary,
+        pngs: work.frames.pngs,
+    })
 }

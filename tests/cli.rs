@@ -74,7 +74,7 @@ fn run_writes_frames_timings_and_summary() {
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("frame,pass,ms"));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    for pass in ["frame", "simulate", "draw", "readback"] {
+    for pass in ["frame", "simulate", "points", "readback"] {
         let n = rows.iter().filter(|r| r[1] == pass).count();
         assert_eq!(n, 3, "pass {pass} rows");
     }
@@ -91,7 +91,7 @@ fn run_writes_frames_timings_and_summary() {
     assert_eq!(s["frames"], 3);
     assert_eq!(s["config"]["switches"]["width"], 160);
     assert_eq!(s["config"]["particles"], 500);
-    for pass in ["simulate", "draw", "readback"] {
+    for pass in ["simulate", "points", "readback"] {
         let p = &s["pass_ms"][pass];
         let (lo, med, hi) = (
             p["min"].as_f64().unwrap(),
@@ -311,18 +311,25 @@ fn run_sph_scenes_end_to_end() {
         );
         let passes: Vec<&str> = if render == "metaballs" {
             vec![
-                "arrange",
-                "density",
-                "forces",
-                "integrate",
-                "bounds",
-                "count",
-                "scan",
-                "fill",
-                "march",
+                "sph/arrange",
+                "sph/arrange/sort",
+                "sph/density",
+                "sph/forces",
+                "sph/integrate",
+                "render/bounds",
+                "render/count",
+                "render/scan",
+                "render/fill",
+                "render/march",
             ]
         } else {
-            vec!["arrange", "density", "forces", "integrate", "draw"]
+            vec![
+                "sph/arrange",
+                "sph/density",
+                "sph/forces",
+                "sph/integrate",
+                "points",
+            ]
         };
         for pass in passes {
             assert!(

@@ -3,7 +3,9 @@
 mod common;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use fluidform::gpu::{shader, ColorTarget, ComputeDesc, ComputePipeline, FrameLoop};
+use fluidform::gpu::{
+    shader, ColorTarget, ComputeDesc, ComputePipeline, Context, FrameLoop, FrameWork, Profiler,
+};
 use fluidform::render::points::{PointsPush, PointsView};
 use fluidform::Error;
 
@@ -42,21 +44,18 @@ struct SaxpyPush {
     n: u32,
 }
 
+fluidform::gpu_interface! {
+    /// glsl/test/saxpy.comp
+    SaxpyIo / SaxpyBufs: "SAXPY", push SaxpyPush { x = 0, y = 1, u = 2 }
+}
+
 #[test]
 fn compute_round_trip_matches_cpu_exactly() {
     let ctx = common::ctx();
     // Local size 32 so 3M elements need more than 65535 groups: exercises the y split.
-    let mut p = ComputePipeline::new(
+    let mut p = ComputePipeline::<SaxpyIo>::new(
         &ctx,
-        &ComputeDesc {
-            name: "saxpy",
-            shader: "test/saxpy.comp",
-            defines: &[],
-            local_size: 32,
-            spec: &[],
-            buffers: 3,
-            push_size: 8,
-        },
+        &ComputeDesc::plain("saxpy", "test/saxpy.comp", &[], 32),
     )
     .unwrap();
     for n in [1usize, 1000, 3_000_001] {
@@ -73,7 +72,12 @@ fn compute_round_trip_matches_cpu_exactly() {
             a: 2.0,
             n: n as u32,
         };
-        ctx.one_shot(|cmd| p.dispatch(&ctx, cmd, &[&bx, &by, &bu], &push, n as u64))
+        let bufs = SaxpyBufs {
+            x: &bx,
+            y: &by,
+            u: &bu,
+        };
+        ctx.one_shot(|cmd| p.dispatch(&ctx, cmd, &bufs, &push, n as u64))
             .unwrap();
         let gy: Vec<f32> = ctx.read_all(&by).unwrap();
         let gu: Vec<u32> = ctx.read_all(&bu).unwrap();
@@ -237,17 +241,9 @@ fn graphics_round_trip_matches_expected_pixels() {
 #[test]
 fn profiler_scopes_present_and_nested_inside_frame() {
     let ctx = common::ctx();
-    let mut p = ComputePipeline::new(
+    let mut p = ComputePipeline::<SaxpyIo>::new(
         &ctx,
-        &ComputeDesc {
-            name: "saxpy",
-            shader: "test/saxpy.comp",
-            defines: &[],
-            local_size: 64,
-            spec: &[],
-            buffers: 3,
-            push_size: 8,
-        },
+        &ComputeDesc::plain("saxpy", "test/saxpy.comp", &[], 64),
     )
     .unwrap();
     let n = 1 << 20;
@@ -258,33 +254,54 @@ fn profiler_scopes_present_and_nested_inside_frame() {
     for b in &mut bufs {
         ctx.upload(b, 0, &vec![1u32; n as usize]).unwrap();
     }
-    let mut frames = FrameLoop::new(&ctx, 2, 8).unwrap();
+    let mut frames = FrameLoop::new(&ctx, 2).unwrap();
     let push = SaxpyPush {
         a: 0.5,
         n: n as u32,
     };
-    let mut done = Vec::new();
-    frames
-        .run(
-            &ctx,
-            7,
-            |prof, cmd, _frame, _slot| {
-                for name in ["first", "second"] {
-                    prof.begin(&ctx, cmd, name);
-                    p.dispatch(&ctx, cmd, &[&bufs[0], &bufs[1], &bufs[2]], &push, n);
-                    ctx.compute_barrier(cmd);
-                    prof.end(&ctx, cmd);
-                }
-                Ok(())
-            },
-            |frame, _| {
-                done.push(frame);
-                Ok(())
-            },
-        )
-        .unwrap();
+    struct Work<'a> {
+        p: &'a ComputePipeline<SaxpyIo>,
+        bufs: SaxpyBufs<'a>,
+        push: SaxpyPush,
+        n: u64,
+        done: Vec<u64>,
+    }
+    impl FrameWork for Work<'_> {
+        fn record(
+            &mut self,
+            ctx: &Context,
+            cmd: ash::vk::CommandBuffer,
+            prof: &mut Profiler,
+            _: u64,
+            _: usize,
+        ) -> fluidform::Result<()> {
+            for name in ["first", "second"] {
+                prof.begin(ctx, cmd, name);
+                self.p.dispatch(ctx, cmd, &self.bufs, &self.push, self.n);
+                ctx.compute_barrier(cmd);
+                prof.end(ctx, cmd);
+            }
+            Ok(())
+        }
+        fn retire(&mut self, _: &Context, frame: u64, _: usize) -> fluidform::Result<()> {
+            self.done.push(frame);
+            Ok(())
+        }
+    }
+    let mut work = Work {
+        p: &p,
+        bufs: SaxpyBufs {
+            x: &bufs[0],
+            y: &bufs[1],
+            u: &bufs[2],
+        },
+        push,
+        n,
+        done: Vec::new(),
+    };
+    frames.run(&ctx, 7, &mut work).unwrap();
     assert_eq!(
-        done,
+        work.done,
         (0..7).collect::<Vec<_>>(),
         "every frame retired once, in order"
     );
@@ -345,15 +362,32 @@ fn shader_error_names_file_and_line() {
 }
 
 #[test]
-fn every_glsl_file_compiles() {
+fn every_glsl_file_compiles_with_every_define_set_the_code_uses() {
     let c = shader::ShaderCompiler::new().unwrap();
+    let variants = fluidform::shaders::variants();
     let mut count = 0;
     for f in shader::glsl_files() {
         if f.ends_with(".glsl") {
             continue; // include-only
         }
-        c.compile(f, &[]).unwrap_or_else(|e| panic!("{e}"));
-        count += 1;
+        let mine: Vec<_> = variants.iter().filter(|(file, _)| *file == f).collect();
+        // Test shaders declare literal bindings; every other one must be registered.
+        if mine.is_empty() {
+            assert!(
+                f.starts_with("test/"),
+                "glsl/{f} is in no shaders::variants() entry"
+            );
+            c.compile(f, &[]).unwrap_or_else(|e| panic!("{e}"));
+        }
+        for (_, defines) in mine {
+            let d: Vec<(&str, String)> = defines
+                .iter()
+                .map(|(k, v)| (k.as_str(), v.clone()))
+                .collect();
+            c.compile(f, &d)
+                .unwrap_or_else(|e| panic!("glsl/{f} with {defines:?}: {e}"));
+            count += 1;
+        }
     }
-    assert!(count >= 4, "only {count} shaders found");
+    assert!(count >= 100, "only {count} shader variants compiled");
 }

@@ -4,15 +4,15 @@
 // visited[i] counts the candidates examined.
 #include "common/index.glsl"
 #include "nb_common.glsl"
-#define NB_B_KEYS 1
-#define NB_B_START 2
-#define NB_B_END 3
-#define NB_B_BOX 4
+#define NB_B_KEYS NBQ_B_NB_KEYS
+#define NB_B_START NBQ_B_NB_START
+#define NB_B_END NBQ_B_NB_END
+#define NB_B_BOX NBQ_B_NB_BOX
 #include "neighbors.glsl"
-layout(std430, binding = 0) readonly buffer Pos { vec4 pos[]; };        // binding 0: sorted positions
-layout(std430, binding = 5) writeonly buffer Cnt { uint counts[]; };    // binding 5
-layout(std430, binding = 6) writeonly buffer List { uint list[]; };     // binding 6
-layout(std430, binding = 7) writeonly buffer Vis { uint visited[]; };   // binding 7
+layout(std430, binding = NBQ_B_POS) readonly buffer Pos { vec4 pos[]; };        // binding 0: sorted positions
+layout(std430, binding = NBQ_B_COUNTS) writeonly buffer Counts { uint counts[]; };    // binding 5
+layout(std430, binding = NBQ_B_LIST) writeonly buffer List { uint list[]; };     // binding 6
+layout(std430, binding = NBQ_B_VISITED) writeonly buffer Visited { uint visited[]; };   // binding 7
 void main() {
     uint i = global_id();
     if (i >= pc.n) return;

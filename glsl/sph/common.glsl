@@ -1,13 +1,15 @@
 // SPH after Müller et al. 2003 / Kelager 2006: parameters, kernels and bindings shared by
-// the passes. Mirrors src/sph/gpu.rs (SphGpuParams). Particle arrays are in sorted order.
+// the passes. Bindings: SphIo in src/sph/solver.rs (SPH_B_* defines); SphParams and
+// Collider mirror SphGpuParams and GpuCollider in src/sph/params.rs (field offsets tested).
+// Particle arrays are in sorted order.
 #ifndef SPH_COMMON_GLSL
 #define SPH_COMMON_GLSL
 #include "common/index.glsl"
 #include "../primitives/nb_common.glsl"
-#define NB_B_KEYS 1
-#define NB_B_START 2
-#define NB_B_END 3
-#define NB_B_BOX 4
+#define NB_B_KEYS SPH_B_NB_KEYS
+#define NB_B_START SPH_B_NB_START
+#define NB_B_END SPH_B_NB_END
+#define NB_B_BOX SPH_B_NB_BOX
 #include "../primitives/neighbors.glsl"
 
 struct SphParams {
@@ -22,7 +24,7 @@ struct SphParams {
     float tension;
     float tension_threshold;
     float gamma;       // Tait exponent
-    uint eos;          // 0: p = k (rho - rho0), 1: Tait
+    uint eos;          // EOS_IDEAL: p = k (rho - rho0), EOS_TAIT
     uint clamp_negative;
     uint colliders;
     uint pad;
@@ -31,14 +33,21 @@ struct SphParams {
     float spiky_grad;  // -45 / (pi h^6)
     float visc_lap;    // 45 / (pi h^6)
 };
-layout(std430, binding = 0) readonly buffer Params { SphParams P; };          // binding 0
-layout(std430, binding = 5) buffer Pos { vec4 pos[]; };                      // binding 5: xyz
-layout(std430, binding = 6) buffer Vel { vec4 vel[]; };                      // binding 6: v(t)
-layout(std430, binding = 7) buffer Rho { vec2 rho_p[]; };                    // binding 7: density, pressure
-layout(std430, binding = 8) buffer Acc { vec4 acc[]; };                      // binding 8: acceleration
+struct Collider {
+    vec4 a;    // plane: normal, w = offset (fluid where dot(n, x) >= w); sphere/capsule: point, w = radius
+    vec4 b;    // capsule: second point; w = kind (0 plane, 1 sphere, 2 capsule)
+    vec4 vel;  // collider velocity (moving colliders)
+};
+layout(std430, binding = SPH_B_PARAMS) readonly buffer Params { SphParams P; };
+layout(std430, binding = SPH_B_POS) buffer Pos { vec4 pos[]; };          // xyz
+layout(std430, binding = SPH_B_VEL) buffer Vel { vec4 vel[]; };          // v(t)
+layout(std430, binding = SPH_B_RHO_P) buffer RhoP { vec2 rho_p[]; };     // density, pressure
+layout(std430, binding = SPH_B_ACC) buffer Acc { vec4 acc[]; };          // acceleration
+layout(std430, binding = SPH_B_VHALF) buffer Vhalf { vec4 vhalf[]; };    // v(t - dt/2)
+layout(std430, binding = SPH_B_COLLIDERS) readonly buffer Colliders { Collider cols[]; };
 
 float pressure_of(float rho) {
-    float p = P.eos == 1u ? P.stiffness * (pow(rho / P.rest_density, P.gamma) - 1.0)
+    float p = P.eos == EOS_TAIT ? P.stiffness * (pow(rho / P.rest_density, P.gamma) - 1.0)
                           : P.stiffness * (rho - P.rest_density);
     return P.clamp_negative != 0u ? max(p, 0.0) : p;
 }

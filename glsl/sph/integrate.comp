@@ -4,13 +4,6 @@
 // domain box (velocity split into normal and tangential parts, restitution and friction),
 // and a final clamp: no particle ever leaves the domain.
 #include "common.glsl"
-layout(std430, binding = 9) buffer Half { vec4 vhalf[]; };  // binding 9: v(t - dt/2)
-struct Collider {
-    vec4 a;    // plane: normal, w = offset (fluid where dot(n, x) >= w); sphere/capsule: point, w = radius
-    vec4 b;    // capsule: second point; w = kind (0 plane, 1 sphere, 2 capsule)
-    vec4 vel;  // collider velocity (moving colliders)
-};
-layout(std430, binding = 10) readonly buffer Cols { Collider cols[]; };  // binding 10
 
 // Reflect the velocity's normal part (n points into the fluid side), damp the tangent.
 vec3 respond(vec3 v, vec3 n, vec3 wall_v) {

@@ -7,7 +7,7 @@ pub mod sph;
 
 use crate::config::{Switches, CAMERA_SWITCHES, METABALL_SWITCHES};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler};
+use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler, RecordOnly};
 use crate::report::{stat, Report, Stat};
 use ash::vk;
 use serde_json::{json, Value};
@@ -185,12 +185,11 @@ fn run_frames(
     count: u64,
     record: &mut impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
 ) -> Result<Vec<FrameTiming>> {
-    let mut frames = FrameLoop::new(ctx, 2, 64)?;
+    let mut frames = FrameLoop::new(ctx, 2)?;
     let r = frames.run(
         ctx,
         count,
-        |prof, cmd, _, _| record(prof, cmd),
-        |_, _| Ok(()),
+        &mut RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd)),
     );
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);

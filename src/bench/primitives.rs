@@ -2,7 +2,7 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
-use crate::gpu::{Buffer, Context};
+use crate::gpu::{sync, Buffer, Context};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
@@ -12,12 +12,7 @@ use rand::{Rng, SeedableRng};
 use serde_json::json;
 
 fn copy(ctx: &Context, cmd: vk::CommandBuffer, src: &Buffer, dst: &Buffer, bytes: u64) {
-    let region = vk::BufferCopy {
-        src_offset: 0,
-        dst_offset: 0,
-        size: bytes,
-    };
-    unsafe { ctx.device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[region]) };
+    ctx.copy(cmd, src, 0, dst, 0, bytes);
 }
 
 fn upload(ctx: &Context, name: &str, data: &[u32]) -> Result<Buffer> {
@@ -66,11 +61,21 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     &scratch,
                 )?;
                 prof.end(ctx, cmd);
-                ctx.barrier(cmd);
+                // Serialised so each scope times one operation (and the next repetition's
+                // scan rewrites the output).
+                ctx.barrier(
+                    cmd,
+                    sync::COMPUTE_WRITE,
+                    sync::TRANSFER_READ | sync::COMPUTE_READ,
+                );
                 prof.begin(ctx, cmd, "copy");
                 copy(ctx, cmd, &input, &copied, bytes);
                 prof.end(ctx, cmd);
-                ctx.barrier(cmd);
+                ctx.barrier(
+                    cmd,
+                    sync::TRANSFER_WRITE,
+                    sync::TRANSFER_READ | sync::COMPUTE_READ,
+                );
                 Ok(())
             },
         );
@@ -148,7 +153,7 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     copy(ctx, cmd, &pk, &wk, bytes);
                     copy(ctx, cmd, &pv, &wv, bytes);
                     prof.end(ctx, cmd);
-                    ctx.barrier(cmd);
+                    ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // restored keys -> sort
                     prof.begin(ctx, cmd, "sort");
                     match &network {
                         Some(s) => {
@@ -159,7 +164,8 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                         }
                     }
                     prof.end(ctx, cmd);
-                    ctx.barrier(cmd);
+                    // The next repetition's restore overwrites what the sort read and wrote.
+                    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
                     Ok(())
                 },
             );
@@ -223,7 +229,7 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
                     search.record_query(ctx, cmd, prof, &b, &p, n, &grid, radius)?;
                     prof.end(ctx, cmd);
-                    ctx.barrier(cmd);
+                    ctx.compute_barrier(cmd); // the next repetition rewrites every buffer
                     Ok(())
                 },
             );

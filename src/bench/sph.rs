@@ -3,11 +3,12 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, FrameLoop, Labels};
+use crate::gpu::{Context, FrameLoop, Labels, Profiler, RecordOnly};
 use crate::primitives::neighbors::default_sort;
-use crate::sph::run::{check, physics_stats};
+use crate::sph::run::{check, physics_stats, PhysicsStats};
 use crate::sph::{Scene, SphSolver};
-use serde_json::{json, Value};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
 
 fn strategies(opts: &BenchOptions) -> Vec<(Neighbors, SortAlgo)> {
     let sw = &opts.switches;
@@ -40,14 +41,9 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &variant.replace('/', "-"),
                 actual,
-                "step",
+                "sph",
                 detail,
-                |prof, cmd| {
-                    prof.begin(ctx, cmd, "step");
-                    solver.record_step(ctx, cmd, prof, &mut st)?;
-                    prof.end(ctx, cmd);
-                    Ok(())
-                },
+                |prof, cmd| solver.record_step(ctx, cmd, prof, &mut st),
             );
             st.destroy(ctx);
             let mut row = row?;
@@ -58,6 +54,14 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         solver.destroy(ctx);
     }
     Ok(rows)
+}
+
+/// One stability checkpoint (stability.json).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Checkpoint {
+    pub step: u64,
+    #[serde(flatten)]
+    pub physics: PhysicsStats,
 }
 
 /// Steps the stability run takes.
@@ -76,32 +80,30 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let parts = scene.particles(opts.switches.seed);
     let mut st = solver.state(ctx, &scene, &parts)?;
     let per_frame = 50u64;
-    let mut frames = FrameLoop::new(ctx, 2, 4)?;
-    let mut checkpoints: Vec<Value> = Vec::new();
+    let mut frames = FrameLoop::new(ctx, 2)?;
+    let mut checkpoints: Vec<Checkpoint> = Vec::new();
     let started = std::time::Instant::now();
     let frame_count = STABILITY_STEPS / per_frame;
     let result = (|| -> Result<()> {
         for chunk in 0..10 {
             let count = frame_count / 10;
-            frames.run(
-                ctx,
-                count,
-                |prof, cmd, _, _| {
-                    prof.begin(ctx, cmd, "steps");
-                    for _ in 0..per_frame {
-                        solver.record_step(ctx, cmd, &mut Labels, &mut st)?;
-                    }
-                    prof.end(ctx, cmd);
-                    Ok(())
-                },
-                |_, _| Ok(()),
-            )?;
+            let mut work = RecordOnly(|prof: &mut Profiler, cmd| {
+                prof.begin(ctx, cmd, "steps");
+                for _ in 0..per_frame {
+                    solver.record_step(ctx, cmd, &mut Labels, &mut st)?;
+                }
+                prof.end(ctx, cmd);
+                Ok(())
+            });
+            frames.run(ctx, count, &mut work)?;
             let d = st.read(ctx)?;
-            let mut s = physics_stats(&d, &scene);
-            s["step"] = json!((chunk + 1) * count * per_frame);
+            let s = Checkpoint {
+                step: (chunk + 1) * count * per_frame,
+                physics: physics_stats(&d, &scene),
+            };
             eprintln!(
                 "stability: step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",
-                s["step"], s["density_mean_over_rest"].as_f64().unwrap_or(f64::NAN), s["max_speed"].as_f64().unwrap_or(f64::NAN), s["nan"], s["outside_domain"]
+                s.step, s.physics.density_mean_over_rest, s.physics.max_speed, s.physics.nan, s.physics.outside_domain
             );
             checkpoints.push(s);
         }
@@ -112,15 +114,18 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     st.destroy(ctx);
     solver.destroy(ctx);
     result?;
-    let last = checkpoints.last().cloned().unwrap_or(Value::Null);
-    let ratio = last["density_mean_over_rest"].as_f64().unwrap_or(f64::NAN);
+    let last = checkpoints
+        .last()
+        .map(|c| c.physics.clone())
+        .ok_or_else(|| Error::Param("stability: no checkpoint".into()))?;
+    let ratio = last.density_mean_over_rest;
     let density_ok = (ratio - 1.0).abs() <= 0.05;
     let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
     let summary = json!({
         "scene": scene.name,
         "neighbors": strategy.as_str(),
         "sort": sort.as_str(),
-        "particles": last["particles"],
+        "particles": last.particles,
         "steps": STABILITY_STEPS,
         "dt": scene.fluid.dt,
         "simulated_seconds": STABILITY_STEPS as f64 * scene.fluid.dt as f64,
@@ -145,7 +150,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     check(&last)?;
     let row = Row {
         variant: format!("stability {}/{}", strategy.as_str(), sort.as_str()),
-        n: last["particles"].as_u64().unwrap_or(0),
+        n: last.particles as u64,
         main: crate::report::stat(
             &timings
                 .iter()
@@ -158,8 +163,8 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         extra: vec![
             ("steps".into(), STABILITY_STEPS.to_string()),
             ("final mean density / rho0".into(), format!("{ratio:.4}")),
-            ("NaN".into(), last["nan"].to_string()),
-            ("outside domain".into(), last["outside_domain"].to_string()),
+            ("NaN".into(), last.nan.to_string()),
+            ("outside domain".into(), last.outside_domain.to_string()),
             (
                 "within 5%".into(),
                 if density_ok {

@@ -1,6 +1,7 @@
 //! The device owner: instance (with optional Khronos validation), physical-device choice,
 //! logical device, queue, allocator, shader compiler. The only GPU type that implements Drop.
 use super::device::{self, DeviceInfo};
+use super::instance::{create_instance, load_entry};
 use super::shader::ShaderCompiler;
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
@@ -10,8 +11,6 @@ use std::ffi::{c_void, CStr, CString};
 use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Mutex;
-
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to open a device.
 #[derive(Clone, Debug, Default)]
@@ -76,62 +75,8 @@ pub struct Context {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     one_shot_pool: Mutex<vk::CommandPool>,
     pub(crate) memory: Mutex<BTreeMap<String, u64>>,
-}
-
-pub(crate) fn load_entry() -> Result<ash::Entry> {
-    unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))
-}
-
-/// Create an instance; with `validation`, the Khronos layer and a messenger counting into `counts`.
-pub(crate) fn create_instance(
-    entry: &ash::Entry,
-    validation: bool,
-) -> Result<(ash::Instance, bool)> {
-    let layers = unsafe { entry.enumerate_instance_layer_properties() }.ctx("list layers")?;
-    let has_layer = layers
-        .iter()
-        .any(|l| l.layer_name_as_c_str().ok() == Some(VALIDATION_LAYER));
-    if validation && !has_layer {
-        return Err(Error::Unsupported(
-            "--validation: the Khronos validation layer is not installed (Debian package \
-             vulkan-validationlayers; run scripts/setup.sh)"
-                .into(),
-        ));
-    }
-    let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
-        .ctx("list instance extensions")?;
-    let has_debug = exts
-        .iter()
-        .any(|e| e.extension_name_as_c_str().ok() == Some(ash::ext::debug_utils::NAME));
-    let version = unsafe { entry.try_enumerate_instance_version() }
-        .ctx("instance version")?
-        .unwrap_or(vk::API_VERSION_1_0);
-    if version < vk::API_VERSION_1_3 {
-        return Err(Error::Unsupported(format!(
-            "the Vulkan loader supports {}, fluidform needs 1.3",
-            device::version_string(version)
-        )));
-    }
-    let app = vk::ApplicationInfo::default()
-        .application_name(c"fluidform")
-        .engine_name(c"fluidform")
-        .api_version(vk::API_VERSION_1_3);
-    let layer_ptrs = if validation {
-        vec![VALIDATION_LAYER.as_ptr()]
-    } else {
-        vec![]
-    };
-    let ext_ptrs = if has_debug {
-        vec![ash::ext::debug_utils::NAME.as_ptr()]
-    } else {
-        vec![]
-    };
-    let info = vk::InstanceCreateInfo::default()
-        .application_info(&app)
-        .enabled_layer_names(&layer_ptrs)
-        .enabled_extension_names(&ext_ptrs);
-    let instance = unsafe { entry.create_instance(&info, None) }.ctx("create instance")?;
-    Ok((instance, has_debug))
+    /// Live pipelines, buffers, images, pools: what an error path could leak.
+    objects: Mutex<BTreeMap<&'static str, i64>>,
 }
 
 impl Context {
@@ -200,19 +145,33 @@ impl Context {
         let debug_device = debug_instance
             .as_ref()
             .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
-            physical_device: physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        })
-        .map_err(|e| Error::Memory(format!("create allocator: {e}")))?;
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(queue_family)
-            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
-        let pool = unsafe { device.create_command_pool(&pool_info, None) }.ctx("command pool")?;
+        // Everything below can fail: release the device and the instance on every path.
+        let rest = (|| -> Result<_> {
+            let shaders = ShaderCompiler::new()?;
+            let allocator = Allocator::new(&AllocatorCreateDesc {
+                instance: instance.clone(),
+                device: device.clone(),
+                physical_device: physical,
+                debug_settings: Default::default(),
+                buffer_device_address: false,
+                allocation_sizes: Default::default(),
+            })
+            .map_err(|e| Error::Memory(format!("create allocator: {e}")))?;
+            let pool_info = vk::CommandPoolCreateInfo::default()
+                .queue_family_index(queue_family)
+                .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+            let pool =
+                unsafe { device.create_command_pool(&pool_info, None) }.ctx("command pool")?;
+            Ok((shaders, allocator, pool))
+        })();
+        let (shaders, allocator, pool) = match rest {
+            Ok(r) => r,
+            Err(e) => {
+                unsafe { device.destroy_device(None) };
+                cleanup(&debug_instance);
+                return Err(e);
+            }
+        };
         let ctx = Self {
             entry,
             instance,
@@ -223,7 +182,7 @@ impl Context {
             queue,
             queue_family,
             push_descriptor,
-            shaders: ShaderCompiler::new()?,
+            shaders,
             debug_instance,
             debug_device,
             messenger,
@@ -231,6 +190,7 @@ impl Context {
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             one_shot_pool: Mutex::new(pool),
             memory: Mutex::new(BTreeMap::new()),
+            objects: Mutex::new(BTreeMap::new()),
         };
         ctx.set_name(pool, "one-shot command pool");
         ctx.set_name(ctx.queue, "main queue");
@@ -257,6 +217,21 @@ impl Context {
     /// Bytes held by each named buffer and image now alive.
     pub fn memory_bytes(&self) -> BTreeMap<String, u64> {
         self.memory.lock().unwrap().clone()
+    }
+
+    /// Count a created (+1) or destroyed (-1) object of `kind`.
+    pub(crate) fn count_object(&self, kind: &'static str, delta: i64) {
+        let mut m = self.objects.lock().unwrap();
+        let v = m.entry(kind).or_default();
+        *v += delta;
+        if *v == 0 {
+            m.remove(kind);
+        }
+    }
+
+    /// Objects of each kind created through this context and not yet destroyed.
+    pub fn live_objects(&self) -> BTreeMap<&'static str, i64> {
+        self.objects.lock().unwrap().clone()
     }
 
     /// Give a Vulkan object a debug name (shown by validation messages and capture tools).
@@ -335,28 +310,6 @@ impl Context {
         }
     }
 
-    /// Memory dependency between all earlier and all later commands (compute, transfer, draw).
-    pub fn barrier(&self, cmd: vk::CommandBuffer) {
-        let b = [vk::MemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-            .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-            .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&b);
-        unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
-    }
-
-    /// Compute-to-compute dependency: shader writes visible to later dispatches.
-    pub fn compute_barrier(&self, cmd: vk::CommandBuffer) {
-        let b = [vk::MemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
-            .src_access_mask(vk::AccessFlags2::SHADER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
-            .dst_access_mask(vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&b);
-        unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
-    }
-
     /// Largest range one storage-buffer binding may cover.
     pub fn max_storage_range(&self) -> u64 {
         self.limits.max_storage_buffer_range as u64
@@ -402,8 +355,9 @@ impl Drop for Context {
         unsafe {
             let _ = self.device.device_wait_idle();
             let leaked = self.memory.lock().unwrap().clone();
-            if !leaked.is_empty() {
-                eprintln!("fluidform: GPU objects not destroyed: {leaked:?}");
+            let objects = self.live_objects();
+            if !leaked.is_empty() || !objects.is_empty() {
+                eprintln!("fluidform: GPU objects not destroyed: {leaked:?} {objects:?}");
             }
             ManuallyDrop::drop(&mut self.allocator);
             self.device

@@ -1,5 +1,6 @@
 //! Physical-device listing, the feature check, and the choice by index, name or type.
-use super::context::{create_instance, load_entry};
+pub use super::instance::version_string;
+use super::instance::{create_instance, load_entry};
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
 use serde::Serialize;
@@ -52,15 +53,6 @@ impl DeviceInfo {
         // "llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe-llvm-15-0-6-256-bits"
         s.trim_matches('-').to_string()
     }
-}
-
-pub fn version_string(v: u32) -> String {
-    format!(
-        "{}.{}.{}",
-        vk::api_version_major(v),
-        vk::api_version_minor(v),
-        vk::api_version_patch(v)
-    )
 }
 
 /// Read properties and check requirements of one device.

@@ -1,9 +1,46 @@
-//! Frames in flight: one command buffer, fence and timestamp pool per slot. Frame f waits
-//! only for frame f - slots, reads that frame's timestamps and hands it to `done`.
+//! Frames in flight: one command buffer, fence and timestamp pools per slot. Frame f waits
+//! only for frame f - slots, reads that frame's timestamps and retires it. The work of a
+//! frame is one `FrameWork` owner, driven by `record` and `retire` with `&mut self`.
 use super::profiler::Profiler;
-use super::Context;
+use super::{sync, Context};
 use crate::error::{Result, VkContext};
 use ash::vk;
+
+/// What a run does each frame: record it, then retire it once its fence has signalled
+/// (its timestamps already collected), before its slot is reused.
+pub trait FrameWork {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()>;
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()>;
+}
+
+/// Frames that only record (benchmarks): `F(prof, cmd)` per frame, nothing to retire.
+pub struct RecordOnly<F>(pub F);
+
+impl<F> FrameWork for RecordOnly<F>
+where
+    F: FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
+{
+    fn record(
+        &mut self,
+        _: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        _: u64,
+        _: usize,
+    ) -> Result<()> {
+        (self.0)(prof, cmd)
+    }
+    fn retire(&mut self, _: &Context, _: u64, _: usize) -> Result<()> {
+        Ok(())
+    }
+}
 
 pub struct FrameLoop {
     pool: vk::CommandPool,
@@ -12,7 +49,7 @@ pub struct FrameLoop {
 }
 
 impl FrameLoop {
-    pub fn new(ctx: &Context, slots: usize, max_scopes: u32) -> Result<Self> {
+    pub fn new(ctx: &Context, slots: usize) -> Result<Self> {
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -22,37 +59,42 @@ impl FrameLoop {
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(slots as u32);
-        let cmds = unsafe { ctx.device.allocate_command_buffers(&alloc) }.ctx("frame commands")?;
-        let mut v = Vec::new();
-        for (i, cmd) in cmds.into_iter().enumerate() {
-            let fence = unsafe {
-                ctx.device
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-            }
-            .ctx("frame fence")?;
-            ctx.set_name(cmd, &format!("frame slot {i}"));
-            ctx.set_name(fence, &format!("frame fence {i}"));
-            v.push((cmd, fence, None));
-        }
-        Ok(Self {
+        let mut me = Self {
             pool,
-            slots: v,
-            profiler: Profiler::new(ctx, slots, max_scopes)?,
-        })
+            slots: Vec::new(),
+            profiler: Profiler::new(ctx, 0)?,
+        };
+        // Everything made so far is released if a later step fails.
+        let rest = (|| -> Result<()> {
+            let cmds =
+                unsafe { ctx.device.allocate_command_buffers(&alloc) }.ctx("frame commands")?;
+            for (i, cmd) in cmds.into_iter().enumerate() {
+                let fence = unsafe {
+                    ctx.device
+                        .create_fence(&vk::FenceCreateInfo::default(), None)
+                }
+                .ctx("frame fence")?;
+                ctx.set_name(cmd, &format!("frame slot {i}"));
+                ctx.set_name(fence, &format!("frame fence {i}"));
+                me.slots.push((cmd, fence, None));
+            }
+            me.profiler = Profiler::new(ctx, slots)?;
+            Ok(())
+        })();
+        match rest {
+            Ok(()) => Ok(me),
+            Err(e) => {
+                me.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
-    /// Record and submit `frames` frames; `done(frame, slot)` runs once a frame's fence
-    /// signalled (its timestamps already collected), before its slot is reused.
-    pub fn run(
-        &mut self,
-        ctx: &Context,
-        frames: u64,
-        mut record: impl FnMut(&mut Profiler, vk::CommandBuffer, u64, usize) -> Result<()>,
-        mut done: impl FnMut(u64, usize) -> Result<()>,
-    ) -> Result<()> {
+    /// Record, submit and retire `frames` frames of `work`.
+    pub fn run(&mut self, ctx: &Context, frames: u64, work: &mut dyn FrameWork) -> Result<()> {
         for frame in 0..frames {
             let slot = (frame % self.slots.len() as u64) as usize;
-            self.retire(ctx, slot, &mut done)?;
+            self.retire(ctx, slot, work)?;
             let (cmd, fence, _) = self.slots[slot];
             unsafe {
                 ctx.device
@@ -64,8 +106,15 @@ impl FrameLoop {
                     .begin_command_buffer(cmd, &begin)
                     .ctx("begin frame")?;
             }
+            // Frame boundary: the previous frames' writes are visible to this one's passes,
+            // so a frame's work needs no barrier before its first reads.
+            ctx.barrier(
+                cmd,
+                sync::COMPUTE_WRITE | sync::TRANSFER_WRITE | sync::FRAGMENT_WRITE,
+                sync::COMPUTE_READ | sync::TRANSFER_READ | sync::GRAPHICS_READ,
+            );
             self.profiler.begin_frame(ctx, cmd, slot, frame);
-            let recorded = record(&mut self.profiler, cmd, frame, slot);
+            let recorded = work.record(ctx, cmd, &mut self.profiler, frame, slot);
             self.profiler.end_frame(ctx, cmd);
             unsafe { ctx.device.end_command_buffer(cmd) }.ctx("end frame")?;
             if let Err(e) = recorded {
@@ -77,24 +126,19 @@ impl FrameLoop {
         }
         for slot in 0..self.slots.len() {
             let next = (frames as usize + slot) % self.slots.len();
-            self.retire(ctx, next, &mut done)?;
+            self.retire(ctx, next, work)?;
         }
         Ok(())
     }
 
-    fn retire(
-        &mut self,
-        ctx: &Context,
-        slot: usize,
-        done: &mut impl FnMut(u64, usize) -> Result<()>,
-    ) -> Result<()> {
+    fn retire(&mut self, ctx: &Context, slot: usize, work: &mut dyn FrameWork) -> Result<()> {
         let (_, fence, pending) = self.slots[slot];
         if let Some(frame) = pending {
             ctx.wait(fence)?;
             unsafe { ctx.device.reset_fences(&[fence]) }.ctx("reset fence")?;
             self.slots[slot].2 = None;
             self.profiler.collect(ctx, slot)?;
-            done(frame, slot)?;
+            work.retire(ctx, frame, slot)?;
         }
         Ok(())
     }

@@ -106,6 +106,7 @@ impl Context {
             .unwrap()
             .entry(name.to_string())
             .or_default() += req.size;
+        self.count_object("buffer", 1);
         Ok(Buffer {
             raw,
             size,
@@ -117,6 +118,7 @@ impl Context {
     pub fn destroy_buffer(&self, b: &mut Buffer) {
         if let Some(a) = b.alloc.take() {
             self.forget(&b.name, a.size());
+            self.count_object("buffer", -1);
             let _ = self.allocator().free(a);
             unsafe { self.device.destroy_buffer(b.raw, None) };
             b.raw = vk::Buffer::null();

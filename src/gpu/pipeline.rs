@@ -1,10 +1,13 @@
-//! Compute and graphics pipelines. Storage buffers are bound with push descriptors, so a
-//! pass owns only layouts and pipelines and any buffer (of any size) can be bound per dispatch.
+//! Compute and graphics pipelines of a checked interface (gpu/interface.rs). Storage buffers
+//! are bound with push descriptors, so a pass owns only layouts and pipelines and any buffer
+//! (of any size) can be bound per dispatch.
 //! Specialization constant 0 is the workgroup size (`layout(local_size_x_id = 0) in;`),
 //! constants 1.. are the pass's own.
-use super::Context;
+use super::interface::{check, BindingDecl, Interface, Reflected};
+use super::{Buffer, Context};
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
+use std::marker::PhantomData;
 
 /// Most workgroups one dimension of a dispatch may have on every Vulkan device.
 pub const MAX_GROUPS_X: u32 = 65535;
@@ -17,19 +20,20 @@ fn shader_module(ctx: &Context, spv: &[u32], name: &str) -> Result<vk::ShaderMod
     Ok(m)
 }
 
-/// Set layout of `count` storage buffers (bindings 0..count) for push descriptors,
-/// and a pipeline layout with `push_size` bytes of push constants.
+/// Set layout of the interface's storage buffers for push descriptors, and a pipeline
+/// layout with `push_size` bytes of push constants.
 fn layouts(
     ctx: &Context,
-    count: u32,
+    decls: &[BindingDecl],
     push_size: u32,
     stages: vk::ShaderStageFlags,
     name: &str,
 ) -> Result<(vk::DescriptorSetLayout, vk::PipelineLayout)> {
-    let bindings: Vec<_> = (0..count)
-        .map(|i| {
+    let bindings: Vec<_> = decls
+        .iter()
+        .map(|d| {
             vk::DescriptorSetLayoutBinding::default()
-                .binding(i)
+                .binding(d.binding)
                 .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
                 .descriptor_count(1)
                 .stage_flags(stages)
@@ -51,8 +55,13 @@ fn layouts(
     if push_size > 0 {
         pl = pl.push_constant_ranges(&ranges);
     }
-    let layout = unsafe { ctx.device.create_pipeline_layout(&pl, None) }
-        .ctx(&format!("{name} pipeline layout"))?;
+    let layout = match unsafe { ctx.device.create_pipeline_layout(&pl, None) } {
+        Ok(l) => l,
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_set_layout(set_layout, None) };
+            return Err(e).ctx(&format!("{name} pipeline layout"));
+        }
+    };
     ctx.set_name(layout, &format!("{name} pipeline layout"));
     Ok((set_layout, layout))
 }
@@ -62,14 +71,13 @@ fn push_buffers(
     cmd: vk::CommandBuffer,
     bind: vk::PipelineBindPoint,
     layout: vk::PipelineLayout,
-    infos: &[vk::DescriptorBufferInfo],
+    buffers: &[(u32, vk::DescriptorBufferInfo)],
 ) {
-    let writes: Vec<_> = infos
+    let writes: Vec<_> = buffers
         .iter()
-        .enumerate()
-        .map(|(i, info)| {
+        .map(|(binding, info)| {
             vk::WriteDescriptorSet::default()
-                .dst_binding(i as u32)
+                .dst_binding(*binding)
                 .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
                 .buffer_info(std::slice::from_ref(info))
         })
@@ -80,6 +88,39 @@ fn push_buffers(
                 .cmd_push_descriptor_set(cmd, bind, layout, 0, &writes)
         };
     }
+}
+
+/// The interface's binding defines followed by the pass's own.
+fn all_defines<I: Interface>(own: &[(&str, String)]) -> Vec<(String, String)> {
+    let mut d = I::defines();
+    d.extend(own.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    d
+}
+
+fn as_refs(d: &[(String, String)]) -> Vec<(&str, String)> {
+    d.iter().map(|(k, v)| (k.as_str(), v.clone())).collect()
+}
+
+/// Compile `files` with `defines` and check what they declare against `I`.
+fn checked_stages<I: Interface>(
+    ctx: &Context,
+    pass: &str,
+    files: &[&str],
+    defines: &[(&str, String)],
+) -> Result<Vec<std::sync::Arc<Vec<u32>>>> {
+    let mut declared = Vec::new();
+    let mut spv = Vec::new();
+    for f in files {
+        declared.push(ctx.shaders.declared(f, defines)?);
+        spv.push(ctx.shaders.compile(f, defines)?);
+    }
+    let stages: Vec<(&str, &Reflected)> = files
+        .iter()
+        .zip(&declared)
+        .map(|(f, r)| (*f, r.as_ref()))
+        .collect();
+    check(pass, &stages, I::BINDINGS, std::mem::size_of::<I::Push>())?;
+    Ok(spv)
 }
 
 /// Where a compute shader comes from and how it is specialised.
@@ -93,8 +134,6 @@ pub struct ComputeDesc<'a> {
     pub local_size: u32,
     /// Specialization constants 1, 2, ...
     pub spec: &'a [u32],
-    pub buffers: u32,
-    pub push_size: u32,
 }
 
 impl<'a> ComputeDesc<'a> {
@@ -104,8 +143,6 @@ impl<'a> ComputeDesc<'a> {
         shader: &'a str,
         defines: &'a [(&'a str, String)],
         local_size: u32,
-        buffers: u32,
-        push_size: u32,
     ) -> Self {
         Self {
             name,
@@ -113,22 +150,21 @@ impl<'a> ComputeDesc<'a> {
             defines,
             local_size,
             spec: &[],
-            buffers,
-            push_size,
         }
     }
 }
 
-pub struct ComputePipeline {
+/// A compute pipeline of interface `I`: dispatches take `I::Bufs` and `I::Push`.
+pub struct ComputePipeline<I: Interface> {
     pub pipeline: vk::Pipeline,
     pub layout: vk::PipelineLayout,
     pub set_layout: vk::DescriptorSetLayout,
     pub local_size: u32,
-    pub buffers: u32,
     pub name: String,
+    interface: PhantomData<I>,
 }
 
-impl ComputePipeline {
+impl<I: Interface> ComputePipeline<I> {
     pub fn new(ctx: &Context, d: &ComputeDesc) -> Result<Self> {
         if d.local_size == 0 || d.local_size > ctx.limits.max_compute_work_group_invocations {
             return Err(Error::Param(format!(
@@ -136,15 +172,23 @@ impl ComputePipeline {
                 d.name, d.local_size, ctx.limits.max_compute_work_group_invocations
             )));
         }
-        let spv = ctx.shaders.compile(d.shader, d.defines)?;
-        let module = shader_module(ctx, &spv, d.shader)?;
+        let defines = all_defines::<I>(d.defines);
+        let spv = checked_stages::<I>(ctx, d.name, &[d.shader], &as_refs(&defines))?;
+        let push_size = std::mem::size_of::<I::Push>() as u32;
         let (set_layout, layout) = layouts(
             ctx,
-            d.buffers,
-            d.push_size,
+            I::BINDINGS,
+            push_size,
             vk::ShaderStageFlags::COMPUTE,
             d.name,
         )?;
+        let module = match shader_module(ctx, &spv[0], d.shader) {
+            Ok(m) => m,
+            Err(e) => {
+                destroy_layouts(ctx, layout, set_layout);
+                return Err(e);
+            }
+        };
         let mut values = vec![d.local_size];
         values.extend_from_slice(d.spec);
         let entries: Vec<_> = (0..values.len() as u32)
@@ -170,43 +214,38 @@ impl ComputePipeline {
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
         };
         unsafe { ctx.device.destroy_shader_module(module, None) };
-        let pipeline = r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name))?[0];
+        let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
+            Ok(p) => p[0],
+            Err(e) => {
+                destroy_layouts(ctx, layout, set_layout);
+                return Err(e);
+            }
+        };
         ctx.set_name(pipeline, d.name);
+        ctx.count_object("pipeline", 1);
         Ok(Self {
             pipeline,
             layout,
             set_layout,
             local_size: d.local_size,
-            buffers: d.buffers,
             name: d.name.to_string(),
+            interface: PhantomData,
         })
     }
 
     /// Bind, push descriptors and constants, dispatch `groups` workgroups (split over y when
     /// more than 65535; shaders linearise with `global_id()` from common/index.glsl).
-    pub fn dispatch_groups<P: bytemuck::Pod>(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        infos: &[vk::DescriptorBufferInfo],
-        push: &P,
-        groups: u64,
-    ) {
-        debug_assert_eq!(
-            infos.len() as u32,
-            self.buffers,
-            "{}: buffer count",
-            self.name
-        );
-        if groups == 0 {
-            return;
-        }
-        let gx = groups.min(MAX_GROUPS_X as u64) as u32;
-        let gy = groups.div_ceil(gx as u64) as u32;
+    fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            push_buffers(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout, infos);
+            push_buffers(
+                ctx,
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.layout,
+                &I::buffers(bufs),
+            );
             let bytes = bytemuck::bytes_of(push);
             if !bytes.is_empty() {
                 ctx.device.cmd_push_constants(
@@ -217,37 +256,75 @@ impl ComputePipeline {
                     bytes,
                 );
             }
-            ctx.device.cmd_dispatch(cmd, gx, gy, 1);
         }
     }
 
-    /// Dispatch one invocation per element (bounds-checked in the shader).
-    pub fn dispatch<P: bytemuck::Pod>(
+    pub fn dispatch_groups(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        buffers: &[&super::Buffer],
-        push: &P,
+        bufs: &I::Bufs<'_>,
+        push: &I::Push,
+        groups: u64,
+    ) {
+        if groups == 0 {
+            return;
+        }
+        let gx = groups.min(MAX_GROUPS_X as u64) as u32;
+        let gy = groups.div_ceil(gx as u64) as u32;
+        self.bind(ctx, cmd, bufs, push);
+        unsafe { ctx.device.cmd_dispatch(cmd, gx, gy, 1) };
+    }
+
+    /// Dispatch one invocation per element (bounds-checked in the shader).
+    pub fn dispatch(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        bufs: &I::Bufs<'_>,
+        push: &I::Push,
         elements: u64,
     ) {
-        let infos: Vec<_> = buffers.iter().map(|b| b.info()).collect();
         self.dispatch_groups(
             ctx,
             cmd,
-            &infos,
+            bufs,
             push,
             elements.div_ceil(self.local_size as u64),
         );
     }
 
+    /// Dispatch with the group counts a GPU pass wrote into `args` at byte `offset`
+    /// (a VkDispatchIndirectCommand): element counts that live on the GPU.
+    pub fn dispatch_indirect(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        bufs: &I::Bufs<'_>,
+        push: &I::Push,
+        args: &Buffer,
+        offset: u64,
+    ) {
+        self.bind(ctx, cmd, bufs, push);
+        unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
+        if self.pipeline != vk::Pipeline::null() {
+            unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
+            ctx.count_object("pipeline", -1);
         }
+        destroy_layouts(ctx, self.layout, self.set_layout);
         self.pipeline = vk::Pipeline::null();
+        self.layout = vk::PipelineLayout::null();
+        self.set_layout = vk::DescriptorSetLayout::null();
+    }
+}
+
+fn destroy_layouts(ctx: &Context, layout: vk::PipelineLayout, set: vk::DescriptorSetLayout) {
+    unsafe {
+        ctx.device.destroy_pipeline_layout(layout, None);
+        ctx.device.destroy_descriptor_set_layout(set, None);
     }
 }
 
@@ -257,8 +334,6 @@ pub struct GraphicsDesc<'a> {
     pub vertex: &'a str,
     pub fragment: &'a str,
     pub defines: &'a [(&'a str, String)],
-    pub buffers: u32,
-    pub push_size: u32,
     /// None: no colour attachment (passes that only write storage buffers).
     pub color_format: Option<vk::Format>,
     pub depth_format: Option<vk::Format>,
@@ -266,21 +341,37 @@ pub struct GraphicsDesc<'a> {
     pub topology: vk::PrimitiveTopology,
 }
 
-pub struct GraphicsPipeline {
+/// A graphics pipeline of interface `I` (both stages checked against it).
+pub struct GraphicsPipeline<I: Interface> {
     pub pipeline: vk::Pipeline,
     pub layout: vk::PipelineLayout,
     pub set_layout: vk::DescriptorSetLayout,
     pub name: String,
+    interface: PhantomData<I>,
 }
 
-impl GraphicsPipeline {
+impl<I: Interface> GraphicsPipeline<I> {
     pub fn new(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
-        let vs = ctx.shaders.compile(d.vertex, d.defines)?;
-        let fs = ctx.shaders.compile(d.fragment, d.defines)?;
-        let vsm = shader_module(ctx, &vs, d.vertex)?;
-        let fsm = shader_module(ctx, &fs, d.fragment)?;
+        let defines = all_defines::<I>(d.defines);
+        let spv = checked_stages::<I>(ctx, d.name, &[d.vertex, d.fragment], &as_refs(&defines))?;
         let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let (set_layout, layout) = layouts(ctx, d.buffers, d.push_size, stages_flags, d.name)?;
+        let push_size = std::mem::size_of::<I::Push>() as u32;
+        let (set_layout, layout) = layouts(ctx, I::BINDINGS, push_size, stages_flags, d.name)?;
+        let modules = shader_module(ctx, &spv[0], d.vertex).and_then(|v| {
+            shader_module(ctx, &spv[1], d.fragment)
+                .map_err(|e| {
+                    unsafe { ctx.device.destroy_shader_module(v, None) };
+                    e
+                })
+                .map(|f| (v, f))
+        });
+        let (vsm, fsm) = match modules {
+            Ok(m) => m,
+            Err(e) => {
+                destroy_layouts(ctx, layout, set_layout);
+                return Err(e);
+            }
+        };
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
@@ -350,25 +441,26 @@ impl GraphicsPipeline {
             ctx.device.destroy_shader_module(vsm, None);
             ctx.device.destroy_shader_module(fsm, None);
         }
-        let pipeline = r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name))?[0];
+        let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
+            Ok(p) => p[0],
+            Err(e) => {
+                destroy_layouts(ctx, layout, set_layout);
+                return Err(e);
+            }
+        };
         ctx.set_name(pipeline, d.name);
+        ctx.count_object("pipeline", 1);
         Ok(Self {
             pipeline,
             layout,
             set_layout,
             name: d.name.to_string(),
+            interface: PhantomData,
         })
     }
 
     /// Bind the pipeline, its buffers and push constants (inside a rendering scope).
-    pub fn bind<P: bytemuck::Pod>(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        buffers: &[&super::Buffer],
-        push: &P,
-    ) {
-        let infos: Vec<_> = buffers.iter().map(|b| b.info()).collect();
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -377,7 +469,7 @@ impl GraphicsPipeline {
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
                 self.layout,
-                &infos,
+                &I::buffers(bufs),
             );
             let bytes = bytemuck::bytes_of(push);
             if !bytes.is_empty() {
@@ -393,12 +485,25 @@ impl GraphicsPipeline {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
+        if self.pipeline != vk::Pipeline::null() {
+            unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
+            ctx.count_object("pipeline", -1);
         }
+        destroy_layouts(ctx, self.layout, self.set_layout);
         self.pipeline = vk::Pipeline::null();
+        self.layout = vk::PipelineLayout::null();
+        self.set_layout = vk::DescriptorSetLayout::null();
+    }
+}
+
+impl<I: Interface> super::Destroy for ComputePipeline<I> {
+    fn destroy(&mut self, ctx: &Context) {
+        ComputePipeline::destroy(self, ctx)
+    }
+}
+
+impl<I: Interface> super::Destroy for GraphicsPipeline<I> {
+    fn destroy(&mut self, ctx: &Context) {
+        GraphicsPipeline::destroy(self, ctx)
     }
 }

@@ -1,11 +1,14 @@
-//! GPU timestamp scopes. One query pool per frame slot, so a slot's results are read after
-//! its own fence without waiting for frames still in flight. Each scope opens a debug label
-//! of the same name, so captures and timings agree on pass names.
+//! GPU timestamp scopes. Query pools per frame slot, so a slot's results are read after its
+//! own fence without waiting for frames still in flight; a slot adds a pool when a frame
+//! records more scopes than it holds, so the profiler sizes itself from what is recorded.
+//! A scope is keyed by its path, the names of the scopes open around it and its own
+//! (`sph/arrange/sort`, `render/sort`), so two passes of the same name never merge. Each
+//! scope opens a debug label of its name, so captures and timings agree.
 use super::Context;
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
 
-/// GPU time of one frame: its passes in order (name, ms) and the whole frame in ms.
+/// GPU time of one frame: its scopes in order (key, ms) and the whole frame in ms.
 #[derive(Clone, Debug)]
 pub struct FrameTiming {
     pub frame: u64,
@@ -13,9 +16,12 @@ pub struct FrameTiming {
     pub frame_ms: f64,
 }
 
+/// Queries per pool (a begin and an end per scope).
+const POOL_QUERIES: u32 = 256;
+
 struct Slot {
-    pool: vk::QueryPool,
-    /// (name, begin query, end query)
+    pools: Vec<vk::QueryPool>,
+    /// (key, begin query, end query); query q lives in pool q / POOL_QUERIES.
     scopes: Vec<(String, u32, u32)>,
     used: u32,
     frame: Option<u64>,
@@ -23,10 +29,10 @@ struct Slot {
 
 pub struct Profiler {
     slots: Vec<Slot>,
-    capacity: u32,
     period_ns: f64,
     mask: u64,
-    stack: Vec<usize>,
+    /// Open scopes: (index into the slot's scopes, key).
+    stack: Vec<(usize, String)>,
     current: usize,
     pub results: Vec<FrameTiming>,
 }
@@ -62,29 +68,20 @@ impl Scopes for Profiler {
 pub const FRAME_SCOPE: &str = "frame";
 
 impl Profiler {
-    /// `slots` frames in flight, up to `max_scopes` scopes each (the frame scope included).
-    pub fn new(ctx: &Context, slots: usize, max_scopes: u32) -> Result<Self> {
-        let capacity = max_scopes * 2;
+    /// `slots` frames in flight.
+    pub fn new(ctx: &Context, slots: usize) -> Result<Self> {
         let mut v = Vec::new();
-        for i in 0..slots {
-            let info = vk::QueryPoolCreateInfo::default()
-                .query_type(vk::QueryType::TIMESTAMP)
-                .query_count(capacity);
-            let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("query pool")?;
-            ctx.set_name(pool, &format!("timestamps slot {i}"));
-            // Queries must be reset before first use; a host reset needs no command buffer.
-            unsafe { ctx.device.reset_query_pool(pool, 0, capacity) };
+        for _ in 0..slots {
             v.push(Slot {
-                pool,
+                pools: Vec::new(),
                 scopes: Vec::new(),
                 used: 0,
                 frame: None,
             });
         }
         let bits = ctx.info.timestamp_valid_bits;
-        Ok(Self {
+        let mut p = Self {
             slots: v,
-            capacity,
             period_ns: ctx.info.timestamp_period_ns as f64,
             mask: if bits >= 64 {
                 u64::MAX
@@ -94,17 +91,39 @@ impl Profiler {
             stack: Vec::new(),
             current: 0,
             results: Vec::new(),
-        })
+        };
+        for i in 0..slots {
+            if let Err(e) = p.add_pool(ctx, i) {
+                p.destroy(ctx);
+                return Err(e);
+            }
+        }
+        Ok(p)
+    }
+
+    fn add_pool(&mut self, ctx: &Context, slot: usize) -> Result<()> {
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(POOL_QUERIES);
+        let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("query pool")?;
+        let s = &mut self.slots[slot];
+        ctx.set_name(
+            pool,
+            &format!("timestamps slot {slot} pool {}", s.pools.len()),
+        );
+        // Queries must be reset before first use; a host reset needs no command buffer.
+        unsafe { ctx.device.reset_query_pool(pool, 0, POOL_QUERIES) };
+        s.pools.push(pool);
+        Ok(())
     }
 
     /// Start recording frame `frame` into `slot` (whose previous results were collected).
     pub fn begin_frame(&mut self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize, frame: u64) {
         let s = &mut self.slots[slot];
         debug_assert!(s.frame.is_none(), "slot {slot} not collected");
-        unsafe {
-            ctx.device
-                .cmd_reset_query_pool(cmd, s.pool, 0, self.capacity)
-        };
+        for &pool in &s.pools {
+            unsafe { ctx.device.cmd_reset_query_pool(cmd, pool, 0, POOL_QUERIES) };
+        }
         s.scopes.clear();
         s.used = 0;
         s.frame = Some(frame);
@@ -119,31 +138,53 @@ impl Profiler {
         }
     }
 
-    /// Open a named scope: a debug label and a timestamp.
+    /// The next query, adding a (host-reset, unused) pool when the slot's are full.
+    fn next_query(&mut self, ctx: &Context) -> Option<(vk::QueryPool, u32)> {
+        let slot = self.current;
+        if self.slots[slot].used >= self.slots[slot].pools.len() as u32 * POOL_QUERIES
+            && self.add_pool(ctx, slot).is_err()
+        {
+            return None;
+        }
+        let s = &mut self.slots[slot];
+        let q = s.used;
+        s.used += 1;
+        Some((s.pools[(q / POOL_QUERIES) as usize], q))
+    }
+
+    /// Open a named scope: a debug label and a timestamp, keyed by its path.
     pub fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
         ctx.begin_label(cmd, name);
+        let key = match self.stack.last() {
+            Some((_, parent)) if parent != FRAME_SCOPE => format!("{parent}/{name}"),
+            _ => name.to_string(),
+        };
+        let begin = self.next_query(ctx);
+        let end = self.next_query(ctx);
+        let (b, e) = match (begin, end) {
+            (Some((pool, q)), Some(_)) => {
+                unsafe {
+                    ctx.device.cmd_write_timestamp2(
+                        cmd,
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        pool,
+                        q % POOL_QUERIES,
+                    )
+                };
+                (q, q + 1)
+            }
+            // No query pool could be made: keep the label, report at collect.
+            _ => (u32::MAX, u32::MAX),
+        };
         let s = &mut self.slots[self.current];
-        if s.used + 2 > self.capacity {
-            // Out of queries: keep the label, skip the timing (reported at collect).
-            s.scopes.push((name.to_string(), u32::MAX, u32::MAX));
-        } else {
-            let q = s.used;
-            s.used += 2;
-            unsafe {
-                ctx.device.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    s.pool,
-                    q,
-                )
-            };
-            s.scopes.push((name.to_string(), q, q + 1));
-        }
-        self.stack.push(s.scopes.len() - 1);
+        s.scopes.push((key.clone(), b, e));
+        self.stack.push((s.scopes.len() - 1, key));
     }
 
     pub fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        let Some(i) = self.stack.pop() else { return };
+        let Some((i, _)) = self.stack.pop() else {
+            return;
+        };
         let s = &self.slots[self.current];
         let (_, _, q) = s.scopes[i];
         if q != u32::MAX {
@@ -151,8 +192,8 @@ impl Profiler {
                 ctx.device.cmd_write_timestamp2(
                     cmd,
                     vk::PipelineStageFlags2::ALL_COMMANDS,
-                    s.pool,
-                    q,
+                    s.pools[(q / POOL_QUERIES) as usize],
+                    q % POOL_QUERIES,
                 )
             };
         }
@@ -166,18 +207,17 @@ impl Profiler {
             return Ok(());
         };
         if s.scopes.iter().any(|(_, q, _)| *q == u32::MAX) {
-            return Err(Error::Param(format!(
-                "profiler: more than {} scopes in frame {frame}",
-                self.capacity / 2
+            return Err(Error::Memory(format!(
+                "profiler: no query pool could be added for frame {frame}"
             )));
         }
         let mut raw = vec![0u64; s.used as usize];
-        if s.used > 0 {
+        for (k, chunk) in raw.chunks_mut(POOL_QUERIES as usize).enumerate() {
             unsafe {
                 ctx.device.get_query_pool_results(
-                    s.pool,
+                    s.pools[k],
                     0,
-                    &mut raw,
+                    chunk,
                     vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
                 )
             }
@@ -212,7 +252,9 @@ impl Profiler {
 
     pub fn destroy(&mut self, ctx: &Context) {
         for s in self.slots.drain(..) {
-            unsafe { ctx.device.destroy_query_pool(s.pool, None) };
+            for pool in s.pools {
+                unsafe { ctx.device.destroy_query_pool(pool, None) };
+            }
         }
     }
 }

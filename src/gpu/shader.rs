@@ -1,6 +1,7 @@
 //! GLSL to SPIR-V with shaderc (glslang). Sources are embedded at build time from glsl/
 //! (or read from `FLUIDFORM_GLSL_DIR` when set, to edit shaders without rebuilding);
 //! `#include "common/x.glsl"` resolves against the glsl/ root or the including file.
+use super::interface::Reflected;
 use crate::error::{Error, Result};
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -59,6 +60,7 @@ type Key = (String, Vec<(String, String)>);
 pub struct ShaderCompiler {
     compiler: Mutex<shaderc::Compiler>,
     cache: Mutex<HashMap<Key, Arc<Vec<u32>>>>,
+    declared: Mutex<HashMap<Key, Arc<Reflected>>>,
 }
 
 impl ShaderCompiler {
@@ -68,6 +70,7 @@ impl ShaderCompiler {
         Ok(Self {
             compiler: Mutex::new(compiler),
             cache: Mutex::new(HashMap::new()),
+            declared: Mutex::new(HashMap::new()),
         })
     }
 
@@ -97,6 +100,50 @@ impl ShaderCompiler {
         kind: shaderc::ShaderKind,
         defines: &[(&str, String)],
     ) -> Result<Vec<u32>> {
+        self.compile_at(
+            name,
+            source,
+            kind,
+            defines,
+            shaderc::OptimizationLevel::Performance,
+        )
+    }
+
+    /// What glsl/`path` declares (bindings, push constants), from an unoptimized compile:
+    /// the optimizer drops bindings a shader declares but does not use, and a pipeline is
+    /// checked against everything its GLSL declares (gpu/interface.rs).
+    pub fn declared(&self, path: &str, defines: &[(&str, String)]) -> Result<Arc<Reflected>> {
+        let key: Key = (
+            path.to_string(),
+            defines
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.clone()))
+                .collect(),
+        );
+        if let Some(r) = self.declared.lock().unwrap().get(&key) {
+            return Ok(r.clone());
+        }
+        let source = glsl_source(path)?;
+        let spv = self.compile_at(
+            path,
+            &source,
+            stage_of(path)?,
+            defines,
+            shaderc::OptimizationLevel::Zero,
+        )?;
+        let r = Arc::new(super::interface::reflect(path, &spv)?);
+        self.declared.lock().unwrap().insert(key, r.clone());
+        Ok(r)
+    }
+
+    fn compile_at(
+        &self,
+        name: &str,
+        source: &str,
+        kind: shaderc::ShaderKind,
+        defines: &[(&str, String)],
+        level: shaderc::OptimizationLevel,
+    ) -> Result<Vec<u32>> {
         let mut opts = shaderc::CompileOptions::new()
             .map_err(|e| Error::Unsupported(format!("shaderc options: {e}")))?;
         opts.set_target_env(
@@ -104,7 +151,7 @@ impl ShaderCompiler {
             shaderc::EnvVersion::Vulkan1_2 as u32,
         );
         opts.set_target_spirv(shaderc::SpirvVersion::V1_5);
-        opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
+        opts.set_optimization_level(level);
         opts.set_generate_debug_info();
         for (k, v) in defines {
             opts.add_macro_definition(k, Some(v));

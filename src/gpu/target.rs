@@ -256,3 +256,4 @@ pub fn save_rgba(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()
         message: e.to_string(),
     })
 }
+crate::impl_destroy!(ColorTarget);

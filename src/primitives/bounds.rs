@@ -11,14 +11,19 @@ const BLOCK: u64 = (WG * ITEMS) as u64;
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct BoundsPush {
+pub struct BoundsPush {
     n: u32,
     pairs: u32,
 }
 const _: () = assert!(std::mem::size_of::<BoundsPush>() == 8);
 
+crate::gpu_interface! {
+    /// glsl/primitives/bounds.comp
+    pub BoundsIo / BoundsBufs: "BOUNDS", push BoundsPush { src = 0, dst = 1 }
+}
+
 pub struct BoundsPass {
-    pipeline: ComputePipeline,
+    pipeline: ComputePipeline<BoundsIo>,
 }
 
 /// Partial (min, max) pairs for up to `capacity` positions, and the final box.
@@ -58,8 +63,6 @@ impl BoundsPass {
                     defines: &[],
                     local_size: WG,
                     spec: &[ITEMS],
-                    buffers: 2,
-                    push_size: 8,
                 },
             )?,
         })
@@ -86,15 +89,22 @@ impl BoundsPass {
             n: n as u32,
             pairs: 0,
         };
+        let bufs = BoundsBufs {
+            src: pos,
+            dst: &b.partials,
+        };
         self.pipeline
-            .dispatch_groups(ctx, cmd, &[pos.info(), b.partials.info()], &push, groups);
-        ctx.compute_barrier(cmd);
+            .dispatch_groups(ctx, cmd, &bufs, &push, groups);
+        ctx.compute_barrier(cmd); // partial boxes -> the final reduction
         let push = BoundsPush {
             n: groups as u32,
             pairs: 1,
         };
-        self.pipeline
-            .dispatch_groups(ctx, cmd, &[b.partials.info(), b.result.info()], &push, 1);
+        let bufs = BoundsBufs {
+            src: &b.partials,
+            dst: &b.result,
+        };
+        self.pipeline.dispatch_groups(ctx, cmd, &bufs, &push, 1);
         Ok(())
     }
 

@@ -3,20 +3,37 @@
 //! start + rank. O(N + cells); order inside a cell is arbitrary.
 use super::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct CountPush {
+pub struct CountPush {
     n: u32,
     cells: u32,
 }
 
+crate::gpu_interface! {
+    /// glsl/primitives/count.comp
+    pub CountIo / CountBufs: "COUNT", push CountPush { keys = 0, counts = 1, rank = 2 }
+}
+
+crate::gpu_interface! {
+    /// glsl/primitives/scatter.comp
+    pub ScatterIo / ScatterBufs: "SCATTER", push CountPush {
+        keys = 0, rank = 1, starts = 2, vals = 3, sorted_keys = 4, sorted_vals = 5,
+    }
+}
+
+crate::gpu_interface! {
+    /// glsl/primitives/gather.comp; push: n.
+    pub GatherIo / GatherBufs: "GATHER", push u32 { perm = 0, src = 1, dst = 2 }
+}
+
 pub struct CountingSort {
-    count: ComputePipeline,
-    scatter: ComputePipeline,
+    count: ComputePipeline<CountIo>,
+    scatter: ComputePipeline<ScatterIo>,
 }
 
 /// Buffers for up to `capacity` elements and `cells` cells.
@@ -56,11 +73,16 @@ impl CountingBuffers {
 
 impl CountingSort {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let desc = |name, shader, buffers| ComputeDesc::plain(name, shader, &[], 256, buffers, 8);
-        Ok(Self {
-            count: ComputePipeline::new(ctx, &desc("count", "primitives/count.comp", 3))?,
-            scatter: ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp", 6))?,
-        })
+        let desc = |name, shader| ComputeDesc::plain(name, shader, &[], 256);
+        let count = ComputePipeline::new(ctx, &desc("count", "primitives/count.comp"))?;
+        match ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp")) {
+            Ok(scatter) => Ok(Self { count, scatter }),
+            Err(e) => {
+                let mut count = count;
+                count.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
     /// Record the sort of `n` keys (< cells) with their values into sorted_keys/sorted_vals.
@@ -87,14 +109,17 @@ impl CountingSort {
             n: n as u32,
             cells: b.cells,
         };
-        unsafe {
-            ctx.device
-                .cmd_fill_buffer(cmd, b.counts.raw, 0, vk::WHOLE_SIZE, 0)
+        // Earlier sorts' scans still read the counts.
+        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
+        ctx.fill(cmd, &b.counts, 0);
+        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // zeroed counts -> count
+        let bufs = CountBufs {
+            keys,
+            counts: &b.counts,
+            rank: &b.rank,
         };
-        ctx.barrier(cmd);
-        self.count
-            .dispatch(ctx, cmd, &[keys, &b.counts, &b.rank], &push, n);
-        ctx.compute_barrier(cmd);
+        self.count.dispatch(ctx, cmd, &bufs, &push, n);
+        ctx.compute_barrier(cmd); // counts -> scan
         scan.record(
             ctx,
             cmd,
@@ -104,14 +129,16 @@ impl CountingSort {
             ScanKind::Exclusive,
             &b.scan,
         )?;
-        ctx.compute_barrier(cmd);
-        self.scatter.dispatch(
-            ctx,
-            cmd,
-            &[keys, &b.rank, &b.starts, vals, sorted_keys, sorted_vals],
-            &push,
-            n,
-        );
+        ctx.compute_barrier(cmd); // cell starts -> scatter
+        let bufs = ScatterBufs {
+            keys,
+            rank: &b.rank,
+            starts: &b.starts,
+            vals,
+            sorted_keys,
+            sorted_vals,
+        };
+        self.scatter.dispatch(ctx, cmd, &bufs, &push, n);
         Ok(())
     }
 
@@ -123,7 +150,7 @@ impl CountingSort {
 
 /// dst[i] = src[perm[i]] for vec4 attributes.
 pub struct GatherPass {
-    pipeline: ComputePipeline,
+    pipeline: ComputePipeline<GatherIo>,
 }
 
 impl GatherPass {
@@ -131,7 +158,7 @@ impl GatherPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc::plain("gather", "primitives/gather.comp", &[], 256, 3, 4),
+                &ComputeDesc::plain("gather", "primitives/gather.comp", &[], 256),
             )?,
         })
     }
@@ -146,7 +173,7 @@ impl GatherPass {
         n: u32,
     ) {
         self.pipeline
-            .dispatch(ctx, cmd, &[perm, src, dst], &n, n as u64);
+            .dispatch(ctx, cmd, &GatherBufs { perm, src, dst }, &n, n as u64);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

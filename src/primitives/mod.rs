@@ -7,3 +7,17 @@ pub mod morton;
 pub mod neighbors;
 pub mod scan;
 pub mod sort;
+
+crate::impl_destroy!(
+    scan::ScanPass,
+    scan::ScanScratch,
+    sort::NetworkSort,
+    counting::CountingSort,
+    counting::CountingBuffers,
+    counting::GatherPass,
+    bounds::BoundsPass,
+    bounds::BoundsBuffers,
+    morton::MortonPass,
+    neighbors::NeighborSearch,
+    neighbors::NeighborBuffers,
+);

@@ -3,8 +3,13 @@ use crate::error::Result;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
 use ash::vk;
 
+crate::gpu_interface! {
+    /// glsl/primitives/morton.comp; push: n.
+    pub MortonIo / MortonBufs: "MORTON", push u32 { pos = 0, bounds = 1, keys = 2, vals = 3 }
+}
+
 pub struct MortonPass {
-    pipeline: ComputePipeline,
+    pipeline: ComputePipeline<MortonIo>,
 }
 
 impl MortonPass {
@@ -14,7 +19,7 @@ impl MortonPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc::plain(Self::NAME, "primitives/morton.comp", &[], 256, 4, 4),
+                &ComputeDesc::plain(Self::NAME, "primitives/morton.comp", &[], 256),
             )?,
         })
     }
@@ -31,8 +36,13 @@ impl MortonPass {
         vals: &Buffer,
         n: u32,
     ) {
-        self.pipeline
-            .dispatch(ctx, cmd, &[pos, bounds, keys, vals], &n, n as u64);
+        let bufs = MortonBufs {
+            pos,
+            bounds,
+            keys,
+            vals,
+        };
+        self.pipeline.dispatch(ctx, cmd, &bufs, &n, n as u64);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -14,7 +14,7 @@ use super::scan::{ScanPass, ScanVariant};
 use super::sort::{Network, NetworkSort};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Scopes};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -76,6 +76,24 @@ pub struct NeighborPush {
 }
 const _: () = assert!(std::mem::size_of::<NeighborPush>() == 48);
 
+crate::gpu_interface! {
+    /// glsl/primitives/nb_keys.comp
+    pub NbKeysIo / NbKeysBufs: "NBK", push NeighborPush { pos = 0, keys = 1, vals = 2 }
+}
+
+crate::gpu_interface! {
+    /// glsl/primitives/nb_ranges.comp; push: n.
+    pub NbRangesIo / NbRangesBufs: "NBR", push u32 { keys = 0, start = 1, end = 2 }
+}
+
+crate::gpu_interface! {
+    /// glsl/primitives/nb_query.comp (neighbors.glsl's cell bindings are nb_*).
+    pub NbQueryIo / NbQueryBufs: "NBQ", push NeighborPush {
+        pos = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
+        counts = 5, list = 6, visited = 7,
+    }
+}
+
 /// The default sort of each strategy.
 pub fn default_sort(strategy: Neighbors) -> SortAlgo {
     match strategy {
@@ -90,18 +108,27 @@ enum Sorter {
     Counting(CountingSort),
 }
 
+impl crate::gpu::Destroy for Sorter {
+    fn destroy(&mut self, ctx: &Context) {
+        match self {
+            Sorter::Counting(c) => c.destroy(ctx),
+            Sorter::Network(s) => s.destroy(ctx),
+        }
+    }
+}
+
 /// Pipelines of one strategy + sort.
 pub struct NeighborSearch {
     pub strategy: Neighbors,
     pub sort: SortAlgo,
     scan: ScanPass,
     sorter: Sorter,
-    keys: Option<ComputePipeline>,
+    keys: Option<ComputePipeline<NbKeysIo>>,
     bounds: Option<BoundsPass>,
     morton: Option<MortonPass>,
-    ranges: ComputePipeline,
+    ranges: ComputePipeline<NbRangesIo>,
     gather: GatherPass,
-    query: ComputePipeline,
+    query: ComputePipeline<NbQueryIo>,
 }
 
 /// Sized buffers for up to `capacity` particles.
@@ -176,54 +203,52 @@ impl NeighborSearch {
                 "--neighbors morton sorts 30-bit codes: use --sort odd-even or bitonic (counting needs bounded cell keys)".into(),
             ));
         }
-        let scan = ScanPass::new(ctx, ScanVariant::Auto)?;
-        let sorter = match sort {
-            SortAlgo::Counting => Sorter::Counting(CountingSort::new(ctx)?),
-            SortAlgo::OddEven => Sorter::Network(NetworkSort::new(ctx, Network::OddEven)?),
-            SortAlgo::Bitonic => Sorter::Network(NetworkSort::new(ctx, Network::Bitonic)?),
-        };
         let defines = Self::defines_for(strategy, sort);
-        let push_size = std::mem::size_of::<NeighborPush>() as u32;
-        let desc = |name, shader, buffers, push_size| {
-            ComputeDesc::plain(name, shader, &defines, 128, buffers, push_size)
-        };
+        let desc = |name, shader| ComputeDesc::plain(name, shader, &defines, 128);
         let morton = strategy == Neighbors::Morton;
+        // Each part is released if a later one fails.
+        let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
+        let sorter = Guard::new(
+            ctx,
+            match sort {
+                SortAlgo::Counting => Sorter::Counting(CountingSort::new(ctx)?),
+                SortAlgo::OddEven => Sorter::Network(NetworkSort::new(ctx, Network::OddEven)?),
+                SortAlgo::Bitonic => Sorter::Network(NetworkSort::new(ctx, Network::Bitonic)?),
+            },
+        );
+        let keys = Guard::new(
+            ctx,
+            match morton {
+                true => None,
+                false => Some(ComputePipeline::new(
+                    ctx,
+                    &desc("cell keys", "primitives/nb_keys.comp"),
+                )?),
+            },
+        );
+        let bounds = Guard::new(ctx, morton.then(|| BoundsPass::new(ctx)).transpose()?);
+        let morton_pass = Guard::new(ctx, morton.then(|| MortonPass::new(ctx)).transpose()?);
+        let ranges = Guard::new(
+            ctx,
+            ComputePipeline::new(ctx, &desc("cell ranges", "primitives/nb_ranges.comp"))?,
+        );
+        let gather = Guard::new(ctx, GatherPass::new(ctx)?);
+        let query = ComputePipeline::new(ctx, &desc("neighbor query", "primitives/nb_query.comp"))?;
         Ok(Self {
             strategy,
             sort,
-            scan,
-            sorter,
-            keys: if morton {
-                None
-            } else {
-                Some(ComputePipeline::new(
-                    ctx,
-                    &desc("cell keys", "primitives/nb_keys.comp", 3, push_size),
-                )?)
-            },
-            bounds: if morton {
-                Some(BoundsPass::new(ctx)?)
-            } else {
-                None
-            },
-            morton: if morton {
-                Some(MortonPass::new(ctx)?)
-            } else {
-                None
-            },
-            ranges: ComputePipeline::new(
-                ctx,
-                &desc("cell ranges", "primitives/nb_ranges.comp", 3, 4),
-            )?,
-            gather: GatherPass::new(ctx)?,
-            query: ComputePipeline::new(
-                ctx,
-                &desc("neighbor query", "primitives/nb_query.comp", 8, push_size),
-            )?,
+            scan: scan.take(),
+            sorter: sorter.take(),
+            keys: keys.take(),
+            bounds: bounds.take(),
+            morton: morton_pass.take(),
+            ranges: ranges.take(),
+            gather: gather.take(),
+            query,
         })
     }
 
-    fn defines_for(strategy: Neighbors, sort: SortAlgo) -> Vec<(&'static str, String)> {
+    pub fn defines_for(strategy: Neighbors, sort: SortAlgo) -> Vec<(&'static str, String)> {
         let s = match strategy {
             Neighbors::Grid => 0,
             Neighbors::Hash => 1,
@@ -332,13 +357,18 @@ impl NeighborSearch {
         scopes.begin(ctx, cmd, "keys");
         if let (Some(bounds), Some(morton), Some(bb)) = (&self.bounds, &self.morton, &b.bounds) {
             bounds.record(ctx, cmd, pos, n as u64, bb)?;
-            ctx.compute_barrier(cmd);
+            ctx.compute_barrier(cmd); // box -> Morton codes
             morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
         } else if let Some(keys) = &self.keys {
-            keys.dispatch(ctx, cmd, &[pos, kd, vd], &push, n as u64);
+            let bufs = NbKeysBufs {
+                pos,
+                keys: kd,
+                vals: vd,
+            };
+            keys.dispatch(ctx, cmd, &bufs, &push, n as u64);
         }
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd);
+        ctx.compute_barrier(cmd); // keys -> sort
         scopes.begin(ctx, cmd, "sort");
         match &self.sorter {
             Sorter::Counting(c) => {
@@ -360,26 +390,26 @@ impl NeighborSearch {
             }
         }
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd);
         if !counting && self.strategy != Neighbors::Morton {
             scopes.begin(ctx, cmd, "ranges");
-            unsafe {
-                ctx.device
-                    .cmd_fill_buffer(cmd, b.starts.raw, 0, vk::WHOLE_SIZE, 0);
-                ctx.device
-                    .cmd_fill_buffer(cmd, b.ends.raw, 0, vk::WHOLE_SIZE, 0);
-            }
-            ctx.barrier(cmd);
-            self.ranges.dispatch(
-                ctx,
+            // Earlier steps' passes still read the cell ranges about to be cleared.
+            ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
+            ctx.fill(cmd, &b.starts, 0);
+            ctx.fill(cmd, &b.ends, 0);
+            // Cleared ranges and sorted keys -> the ranges pass.
+            ctx.barrier(
                 cmd,
-                &[&b.sorted_keys, &b.starts, &b.ends],
-                &n,
-                n as u64,
+                sync::TRANSFER_WRITE | sync::COMPUTE_WRITE,
+                sync::COMPUTE_READ,
             );
+            let bufs = NbRangesBufs {
+                keys: &b.sorted_keys,
+                start: &b.starts,
+                end: &b.ends,
+            };
+            self.ranges.dispatch(ctx, cmd, &bufs, &n, n as u64);
             scopes.end(ctx, cmd);
         }
-        ctx.barrier(cmd);
         Ok(())
     }
 
@@ -405,27 +435,23 @@ impl NeighborSearch {
         }
         let push = self.push(b, grid, radius, n);
         let (starts, ends) = b.cell_buffers();
+        ctx.compute_barrier(cmd); // the build's permutation and cell ranges -> query
         scopes.begin(ctx, cmd, "reorder");
         self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd);
+        ctx.compute_barrier(cmd); // sorted positions -> query
         scopes.begin(ctx, cmd, "query");
-        self.query.dispatch(
-            ctx,
-            cmd,
-            &[
-                &b.sorted_pos,
-                &b.sorted_keys,
-                starts,
-                ends,
-                b.box_buffer(),
-                &b.counts,
-                &b.list,
-                &b.visited,
-            ],
-            &push,
-            n as u64,
-        );
+        let bufs = NbQueryBufs {
+            pos: &b.sorted_pos,
+            nb_keys: &b.sorted_keys,
+            nb_start: starts,
+            nb_end: ends,
+            nb_box: b.box_buffer(),
+            counts: &b.counts,
+            list: &b.list,
+            visited: &b.visited,
+        };
+        self.query.dispatch(ctx, cmd, &bufs, &push, n as u64);
         scopes.end(ctx, cmd);
         Ok(())
     }

@@ -8,7 +8,7 @@
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{BindingDecl, Buffer, ComputeDesc, ComputePipeline, Context, Interface};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -37,7 +37,7 @@ pub enum ScanVariant {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct ScanPush {
+pub struct ScanPush {
     n: u32,
     /// Index of this segment's first chunk in the chunk sums.
     base: u32,
@@ -46,11 +46,62 @@ struct ScanPush {
 const _: () = assert!(std::mem::size_of::<ScanPush>() == 12);
 const INCLUSIVE: u32 = 1;
 
+/// The scan passes' interface (glsl/primitives/scan_io.glsl). Written out rather than
+/// declared with `gpu_interface!` because a level binds sub-ranges of raw buffers.
+pub struct ScanIo;
+
+/// The five views of one scan dispatch: input and output twice (uvec4 and uint), sums.
+pub struct ScanBufs {
+    pub in4: vk::DescriptorBufferInfo,
+    pub in1: vk::DescriptorBufferInfo,
+    pub out4: vk::DescriptorBufferInfo,
+    pub out1: vk::DescriptorBufferInfo,
+    pub sums: vk::DescriptorBufferInfo,
+}
+
+impl Interface for ScanIo {
+    const NAME: &'static str = "ScanIo";
+    const PREFIX: &'static str = "SCAN";
+    const BINDINGS: &'static [BindingDecl] = &[
+        BindingDecl {
+            name: "in4",
+            binding: 0,
+        },
+        BindingDecl {
+            name: "in1",
+            binding: 1,
+        },
+        BindingDecl {
+            name: "out4",
+            binding: 2,
+        },
+        BindingDecl {
+            name: "out1",
+            binding: 3,
+        },
+        BindingDecl {
+            name: "sums",
+            binding: 4,
+        },
+    ];
+    type Push = ScanPush;
+    type Bufs<'a> = ScanBufs;
+    fn buffers(b: &ScanBufs) -> Vec<(u32, vk::DescriptorBufferInfo)> {
+        vec![
+            (0, b.in4),
+            (1, b.in1),
+            (2, b.out4),
+            (3, b.out1),
+            (4, b.sums),
+        ]
+    }
+}
+
 /// Pipelines (size-independent).
 pub struct ScanPass {
-    chunk_reduce: ComputePipeline,
-    chunk_down: ComputePipeline,
-    top: ComputePipeline,
+    chunk_reduce: ComputePipeline<ScanIo>,
+    chunk_down: ComputePipeline<ScanIo>,
+    top: ComputePipeline<ScanIo>,
     pub uses_subgroups: bool,
 }
 
@@ -101,17 +152,7 @@ impl ScanPass {
             ("CHUNK", format!("{CHUNK}u")),
         ];
         let pipeline = |name, shader| {
-            ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain(
-                    name,
-                    shader,
-                    &defines,
-                    WG,
-                    5,
-                    std::mem::size_of::<ScanPush>() as u32,
-                ),
-            )
+            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, WG))
         };
         Ok(Self {
             chunk_reduce: pipeline("scan chunk sums", "primitives/scan_chunk_reduce.comp")?,
@@ -191,8 +232,14 @@ impl ScanPass {
                 flags: inclusive,
             };
             let (i, o) = (range(input, 0, n), range(output, 0, n));
-            self.top
-                .dispatch_groups(ctx, cmd, &[i, i, o, o, i], &push, 1);
+            let bufs = ScanBufs {
+                in4: i,
+                in1: i,
+                out4: o,
+                out1: o,
+                sums: i,
+            };
+            self.top.dispatch_groups(ctx, cmd, &bufs, &push, 1);
             return;
         }
         let chunk = CHUNK as u64;
@@ -203,7 +250,7 @@ impl ScanPass {
         };
         // Segments: the most whole blocks one binding may cover.
         let seg = (ctx.max_storage_range() / 4 / BLOCK).max(1) * BLOCK;
-        let dispatch = |p: &ComputePipeline, flags: u32| {
+        let dispatch = |p: &ComputePipeline<ScanIo>, flags: u32| {
             for s in 0..n.div_ceil(seg) {
                 let (start, len) = (s * seg, seg.min(n - s * seg));
                 let push = ScanPush {
@@ -213,11 +260,18 @@ impl ScanPass {
                 };
                 let (i, o) = (range(input, start, len), range(output, start, len));
                 let groups = len.div_ceil(chunk).div_ceil(WG as u64);
-                p.dispatch_groups(ctx, cmd, &[i, i, o, o, sums], &push, groups);
+                let bufs = ScanBufs {
+                    in4: i,
+                    in1: i,
+                    out4: o,
+                    out1: o,
+                    sums,
+                };
+                p.dispatch_groups(ctx, cmd, &bufs, &push, groups);
             }
         };
         dispatch(&self.chunk_reduce, 0);
-        ctx.compute_barrier(cmd);
+        ctx.compute_barrier(cmd); // chunk sums -> their scan
         let next = scratch.levels[level].raw;
         let chunks = n.div_ceil(chunk);
         self.level(
@@ -230,7 +284,7 @@ impl ScanPass {
             scratch,
             level + 1,
         );
-        ctx.compute_barrier(cmd);
+        ctx.compute_barrier(cmd); // scanned chunk sums -> the chunks' scan
         dispatch(&self.chunk_down, inclusive);
     }
 

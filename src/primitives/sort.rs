@@ -18,7 +18,7 @@ pub enum Network {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct SortPush {
+pub struct SortPush {
     n: u32,
     p: u32,
     k: u32,
@@ -29,8 +29,13 @@ const LOCAL_SORT: u32 = 0;
 const GLOBAL: u32 = 1;
 const LOCAL_MERGE: u32 = 2;
 
+crate::gpu_interface! {
+    /// glsl/primitives/sort_common.glsl (oddeven.comp, bitonic.comp)
+    pub SortIo / SortBufs: "SORT", push SortPush { keys = 0, vals = 1 }
+}
+
 pub struct NetworkSort {
-    pipeline: ComputePipeline,
+    pipeline: ComputePipeline<SortIo>,
     pub network: Network,
 }
 
@@ -49,8 +54,6 @@ impl NetworkSort {
                     defines: &[],
                     local_size: WG,
                     spec: &[BLOCK],
-                    buffers: 2,
-                    push_size: 16,
                 },
             )?,
             network,
@@ -80,14 +83,16 @@ impl NetworkSort {
             return Ok(0);
         }
         let n32 = n as u32;
-        let infos = [keys.info(), vals.info()];
+        let bufs = SortBufs { keys, vals };
         let tiles = n.div_ceil(BLOCK as u64);
         let pow2 = n.next_power_of_two();
         let mut dispatches = 0;
         let mut run = |push: SortPush, groups: u64| {
-            ctx.compute_barrier(cmd);
+            if dispatches > 0 {
+                ctx.compute_barrier(cmd); // the previous comparator stage's swaps
+            }
             self.pipeline
-                .dispatch_groups(ctx, cmd, &infos, &push, groups);
+                .dispatch_groups(ctx, cmd, &bufs, &push, groups);
             dispatches += 1;
         };
         let local = |mode| SortPush {

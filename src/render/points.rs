@@ -27,12 +27,17 @@ impl PointsPush {
     }
 }
 
+crate::gpu_interface! {
+    /// glsl/render/points.vert
+    pub PointsIo / PointsBufs: "PTS", push PointsPush { pos = 0, color = 1 }
+}
+
 pub struct PointsView {
-    pipeline: GraphicsPipeline,
+    pipeline: GraphicsPipeline<PointsIo>,
 }
 
 impl PointsView {
-    pub const NAME: &'static str = "draw";
+    pub const NAME: &'static str = "points";
 
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
@@ -43,8 +48,6 @@ impl PointsView {
                     vertex: "render/points.vert",
                     fragment: "render/points.frag",
                     defines: &[],
-                    buffers: 2,
-                    push_size: std::mem::size_of::<PointsPush>() as u32,
                     color_format: Some(COLOR_FORMAT),
                     depth_format: Some(DEPTH_FORMAT),
                     blend: false,
@@ -64,11 +67,13 @@ impl PointsView {
         n: u32,
         push: &PointsPush,
     ) {
-        self.pipeline.bind(ctx, cmd, &[pos, color], push);
-        unsafe { ctx.device.cmd_draw(cmd, 6, n, 0, 0) };
+        self.pipeline
+            .bind(ctx, cmd, &PointsBufs { pos, color }, push);
+        ctx.draw(cmd, 6, n);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
     }
 }
+crate::impl_destroy!(PointsView);

@@ -1,6 +1,6 @@
 //! Test scene: particles orbiting an attractor inside a box, moved by one compute pass.
 use crate::error::Result;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use rand::{Rng, SeedableRng};
@@ -81,9 +81,14 @@ pub fn step_cpu(pos: &mut [[f32; 4]], vel: &mut [[f32; 4]], push: &OrbitsPush) {
     }
 }
 
+crate::gpu_interface! {
+    /// glsl/scene/orbits.comp
+    pub OrbitsIo / OrbitsBufs: "ORB", push OrbitsPush { pos = 0, vel = 1 }
+}
+
 /// The size-independent part: the step pipeline.
 pub struct OrbitsPass {
-    pipeline: ComputePipeline,
+    pipeline: ComputePipeline<OrbitsIo>,
 }
 
 impl OrbitsPass {
@@ -93,14 +98,7 @@ impl OrbitsPass {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
-                &ComputeDesc::plain(
-                    Self::NAME,
-                    "scene/orbits.comp",
-                    &[],
-                    256,
-                    2,
-                    std::mem::size_of::<OrbitsPush>() as u32,
-                ),
+                &ComputeDesc::plain(Self::NAME, "scene/orbits.comp", &[], 256),
             )?,
         })
     }
@@ -112,8 +110,11 @@ impl OrbitsPass {
             eps: EPS,
             n: s.n,
         };
-        self.pipeline
-            .dispatch(ctx, cmd, &[&s.pos, &s.vel], &push, s.n as u64);
+        let bufs = OrbitsBufs {
+            pos: &s.pos,
+            vel: &s.vel,
+        };
+        self.pipeline.dispatch(ctx, cmd, &bufs, &push, s.n as u64);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -133,16 +134,25 @@ impl Orbits {
     pub fn new(ctx: &Context, state: &OrbitsState) -> Result<Self> {
         let n = state.pos.len();
         let bytes = (n * 16) as u64;
-        let mut s = Self {
-            pos: ctx.storage_buffer("particle positions", bytes)?,
-            vel: ctx.storage_buffer("particle velocities", bytes)?,
-            color: ctx.storage_buffer("particle colours", bytes)?,
+        let mut bufs = Guard::new(ctx, Vec::new());
+        for (name, data) in [
+            ("particle positions", &state.pos),
+            ("particle velocities", &state.vel),
+            ("particle colours", &state.color),
+        ] {
+            let mut b = ctx.storage_buffer(name, bytes)?;
+            let r = ctx.upload(&mut b, 0, data);
+            bufs.push(b);
+            r?;
+        }
+        let mut v = bufs.take().into_iter();
+        let mut next = || v.next().expect("three buffers");
+        Ok(Self {
+            pos: next(),
+            vel: next(),
+            color: next(),
             n: n as u32,
-        };
-        ctx.upload(&mut s.pos, 0, &state.pos)?;
-        ctx.upload(&mut s.vel, 0, &state.vel)?;
-        ctx.upload(&mut s.color, 0, &state.color)?;
-        Ok(s)
+        })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -151,3 +161,4 @@ impl Orbits {
         ctx.destroy_buffer(&mut self.color);
     }
 }
+crate::impl_destroy!(OrbitsPass, Orbits);

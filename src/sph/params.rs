@@ -6,11 +6,22 @@ use std::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[repr(u32)]
 pub enum Eos {
     /// p = k (rho - rho_0) (Kelager's ideal-gas form).
-    Ideal,
+    Ideal = 0,
     /// p = B ((rho / rho_0)^gamma - 1), B = rho_0 c^2 / gamma (weakly compressible).
-    Tait,
+    Tait = 1,
+}
+
+impl Eos {
+    /// `EOS_IDEAL`, `EOS_TAIT` for glsl/sph/common.glsl.
+    pub fn defines() -> Vec<(String, String)> {
+        crate::gpu::interface::enum_defines(
+            "EOS",
+            &[("ideal", Eos::Ideal as u32), ("tait", Eos::Tait as u32)],
+        )
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -232,7 +243,7 @@ impl SphGpuParams {
             tension: f.surface_tension,
             tension_threshold: f.tension_threshold,
             gamma: f.gamma,
-            eos: (f.eos == Eos::Tait) as u32,
+            eos: f.eos as u32,
             clamp_negative: f.clamp_negative_pressure as u32,
             colliders,
             pad: 0,
@@ -244,7 +255,7 @@ impl SphGpuParams {
     }
 }
 
-/// Mirror of `Collider` in glsl/sph/integrate.comp.
+/// Mirror of `Collider` in glsl/sph/common.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuCollider {

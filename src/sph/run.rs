@@ -3,10 +3,10 @@
 use super::scene::Scene;
 use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, Context, MemoryLocation, Profiler};
+use crate::gpu::{sync, Buffer, Context, MemoryLocation, Profiler};
 use crate::primitives::bounds::{BoundsBuffers, BoundsPass};
 use ash::vk;
-use serde_json::{json, Value};
+use serde::{Deserialize, Serialize};
 
 /// Chooses steps per frame. With `cfl`, a step never exceeds cfl * h / max(c, v_max),
 /// v_max bounded by the velocity box read back from the latest finished frame.
@@ -79,24 +79,12 @@ impl Stepper {
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
         if st.fluid.cfl.is_some() {
-            prof.begin(ctx, cmd, "cfl");
+            prof.begin(ctx, cmd, "sph-cfl");
             self.bounds
                 .record(ctx, cmd, st.vel(), st.n as u64, &self.boxes)?;
-            ctx.barrier(cmd);
-            let region = vk::BufferCopy {
-                src_offset: 0,
-                dst_offset: 0,
-                size: 32,
-            };
-            unsafe {
-                ctx.device.cmd_copy_buffer(
-                    cmd,
-                    self.boxes.result.raw,
-                    self.readbacks[slot].raw,
-                    &[region],
-                )
-            };
-            ctx.barrier(cmd);
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // velocity box -> copy
+            ctx.copy(cmd, &self.boxes.result, 0, &self.readbacks[slot], 0, 32);
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // copy -> the host
             prof.end(ctx, cmd);
         }
         Ok(())
@@ -125,8 +113,32 @@ impl Stepper {
     }
 }
 
+/// Physics checks of a state (the physical part of `stats` in summary.json).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PhysicsStats {
+    pub particles: usize,
+    /// Particles with a non-finite position or velocity.
+    pub nan: usize,
+    pub outside_domain: usize,
+    pub density_mean: f64,
+    pub density_mean_over_rest: f64,
+    pub density_min: f64,
+    pub density_max: f64,
+    pub max_speed: f64,
+}
+
+/// `stats` of an SPH run.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SphRunStats {
+    #[serde(flatten)]
+    pub physics: PhysicsStats,
+    pub steps: u64,
+    pub simulated_seconds: f64,
+    pub render: crate::viewer::RenderSummary,
+}
+
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.
-pub fn physics_stats(d: &StateDump, scene: &Scene) -> Value {
+pub fn physics_stats(d: &StateDump, scene: &Scene) -> PhysicsStats {
     let n = d.pos.len();
     let (lo, hi) = (scene.domain.min, scene.domain.max);
     let nan = d
@@ -145,27 +157,33 @@ pub fn physics_stats(d: &StateDump, scene: &Scene) -> Value {
     let speed = d
         .vel
         .iter()
-        .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
-        .fold(0.0f32, f32::max);
+        .map(|v| ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt())
+        .fold(0.0f64, |a, b| {
+            if b.is_nan() || a.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        });
     let rho0 = scene.fluid.rest_density as f64;
-    json!({
-        "particles": n,
-        "nan": nan,
-        "outside_domain": outside,
-        "density_mean": mean,
-        "density_mean_over_rest": mean / rho0,
-        "density_min": rho.iter().cloned().fold(f64::INFINITY, f64::min),
-        "density_max": rho.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
-        "max_speed": speed,
-    })
+    PhysicsStats {
+        particles: n,
+        nan,
+        outside_domain: outside,
+        density_mean: mean,
+        density_mean_over_rest: mean / rho0,
+        density_min: rho.iter().cloned().fold(f64::INFINITY, f64::min),
+        density_max: rho.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        max_speed: speed,
+    }
 }
 
 /// Fail when the state has NaNs or particles outside the domain.
-pub fn check(stats: &Value) -> Result<()> {
-    if stats["nan"].as_u64() != Some(0) || stats["outside_domain"].as_u64() != Some(0) {
+pub fn check(stats: &PhysicsStats) -> Result<()> {
+    if stats.nan != 0 || stats.outside_domain != 0 {
         return Err(Error::Unsupported(format!(
             "the simulation became invalid: {} NaN particle(s), {} outside the domain",
-            stats["nan"], stats["outside_domain"]
+            stats.nan, stats.outside_domain
         )));
     }
     Ok(())

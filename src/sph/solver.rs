@@ -1,35 +1,88 @@
-//! The GPU SPH step: arrange (neighbour keys, sort, cell ranges, reorder every particle
-//! attribute into sorted order), density, forces, integrate. Every pass a compute shader.
-//! Extra force terms (control particles) add into `acc` between forces and integrate.
+//! The GPU SPH step: pre-arrange hooks, arrange (neighbour keys, sort, cell ranges, every
+//! reordered attribute into sorted order), density, forces, extra force terms, integrate.
+//! Every pass a compute shader. Particle state is a registry (particles.rs): a hook adds
+//! its own attribute with one `register` call and its pass with `add_force` or
+//! `add_pre_arrange` (hooks.rs).
+use super::hooks::SphHook;
 use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
 use super::scene::{Particles, Scene};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Scopes};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::particles::{AttrId, AttributeDecl, ParticleStore};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
 use ash::vk;
 
-/// Bindings of the SPH passes (glsl/sph/common.glsl).
-const BINDINGS: u32 = 11;
+crate::gpu_interface! {
+    /// glsl/sph/common.glsl: every SPH pass declares all of these.
+    pub SphIo / SphBufs: "SPH", push NeighborPush {
+        params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
+        pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
+    }
+}
+
+/// The solver's attributes, registered in this order.
+pub const POS: AttrId = AttrId(0);
+pub const VEL: AttrId = AttrId(1);
+pub const VHALF: AttrId = AttrId(2);
+/// Group and colour.
+pub const ATTR: AttrId = AttrId(3);
+/// (density, pressure), recomputed every step.
+pub const RHO_P: AttrId = AttrId(4);
+/// Acceleration, recomputed every step.
+pub const ACC: AttrId = AttrId(5);
+const ATTRIBUTES: [AttributeDecl; 6] = [
+    AttributeDecl {
+        name: "positions",
+        bytes: 16,
+        reorder: true,
+    },
+    AttributeDecl {
+        name: "velocities",
+        bytes: 16,
+        reorder: true,
+    },
+    AttributeDecl {
+        name: "half-step velocities",
+        bytes: 16,
+        reorder: true,
+    },
+    AttributeDecl {
+        name: "attributes",
+        bytes: 16,
+        reorder: true,
+    },
+    AttributeDecl {
+        name: "density pressure",
+        bytes: 8,
+        reorder: false,
+    },
+    AttributeDecl {
+        name: "accelerations",
+        bytes: 16,
+        reorder: false,
+    },
+];
+
+/// Local size of the per-particle passes.
+pub const LOCAL_SIZE: u32 = 128;
 
 pub struct SphSolver {
     pub search: NeighborSearch,
     gather: GatherPass,
-    density: ComputePipeline,
-    forces: ComputePipeline,
-    integrate: ComputePipeline,
+    density: ComputePipeline<SphIo>,
+    forces: ComputePipeline<SphIo>,
+    integrate: ComputePipeline<SphIo>,
+    /// Extra force terms, between forces and integrate (control particles).
+    force_hooks: Vec<Box<dyn SphHook>>,
+    /// Extra per-particle passes before arrange (emission, skinning).
+    pre_arrange: Vec<Box<dyn SphHook>>,
 }
 
-/// Particle state (double-buffered for the reorder) and scratch for up to `capacity`.
+/// Particle state and scratch for up to `particles.capacity` particles.
 pub struct SphState {
-    pos: [Buffer; 2],
-    vel: [Buffer; 2],
-    vhalf: [Buffer; 2],
-    attr: [Buffer; 2],
-    cur: usize,
-    pub rho_p: Buffer,
-    pub acc: Buffer,
+    pub particles: ParticleStore,
     params: Buffer,
     colliders: Buffer,
     pub nb: NeighborBuffers,
@@ -44,13 +97,41 @@ pub struct SphState {
 
 impl SphState {
     pub fn pos(&self) -> &Buffer {
-        &self.pos[self.cur]
+        self.particles.get(POS)
     }
     pub fn vel(&self) -> &Buffer {
-        &self.vel[self.cur]
+        self.particles.get(VEL)
     }
     pub fn attr(&self) -> &Buffer {
-        &self.attr[self.cur]
+        self.particles.get(ATTR)
+    }
+    pub fn acc(&self) -> &Buffer {
+        self.particles.get(ACC)
+    }
+    pub fn rho_p(&self) -> &Buffer {
+        self.particles.get(RHO_P)
+    }
+    /// The parameters buffer (SphParams) of the current step.
+    pub fn params(&self) -> &Buffer {
+        &self.params
+    }
+
+    /// The buffers every SPH pass binds, in the current order.
+    pub fn bufs(&self) -> SphBufs<'_> {
+        let (nb_start, nb_end) = self.nb.cell_buffers();
+        SphBufs {
+            params: &self.params,
+            nb_keys: &self.nb.sorted_keys,
+            nb_start,
+            nb_end,
+            nb_box: self.nb.box_buffer(),
+            pos: self.pos(),
+            vel: self.vel(),
+            rho_p: self.rho_p(),
+            acc: self.acc(),
+            vhalf: self.particles.get(VHALF),
+            colliders: &self.colliders,
+        }
     }
 
     /// Replace the colliders (moving colliders: call before each step with new positions
@@ -80,34 +161,20 @@ impl SphState {
     /// current (sorted) order.
     pub fn read(&self, ctx: &Context) -> Result<StateDump> {
         let n = self.n as usize;
+        let p = &self.particles;
         Ok(StateDump {
-            pos: ctx.readback(self.pos(), 0, n)?,
-            vel: ctx.readback(self.vel(), 0, n)?,
-            attr: ctx.readback(self.attr(), 0, n)?,
-            rho_p: ctx.readback(&self.rho_p, 0, n)?,
-            acc: ctx.readback(&self.acc, 0, n)?,
+            pos: p.read(ctx, POS, n)?,
+            vel: p.read(ctx, VEL, n)?,
+            attr: p.read(ctx, ATTR, n)?,
+            rho_p: p.read(ctx, RHO_P, n)?,
+            acc: p.read(ctx, ACC, n)?,
         })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for pair in [
-            &mut self.pos,
-            &mut self.vel,
-            &mut self.vhalf,
-            &mut self.attr,
-        ] {
-            for b in pair.iter_mut() {
-                ctx.destroy_buffer(b);
-            }
-        }
-        for b in [
-            &mut self.rho_p,
-            &mut self.acc,
-            &mut self.params,
-            &mut self.colliders,
-        ] {
-            ctx.destroy_buffer(b);
-        }
+        self.particles.destroy(ctx);
+        ctx.destroy_buffer(&mut self.params);
+        ctx.destroy_buffer(&mut self.colliders);
         self.nb.destroy(ctx);
     }
 }
@@ -122,22 +189,36 @@ pub struct StateDump {
 
 impl SphSolver {
     pub fn new(ctx: &Context, neighbors: Neighbors, sort: Option<SortAlgo>) -> Result<Self> {
-        let search = NeighborSearch::new(ctx, neighbors, sort)?;
-        let defines = search.defines();
-        let push_size = std::mem::size_of::<NeighborPush>() as u32;
+        let search = Guard::new(ctx, NeighborSearch::new(ctx, neighbors, sort)?);
+        let eos = super::params::Eos::defines();
+        let mut refs = search.defines();
+        refs.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
         let pipeline = |name, shader| {
-            ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain(name, shader, &defines, 128, BINDINGS, push_size),
-            )
+            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &refs, LOCAL_SIZE))
         };
+        let density = Guard::new(ctx, pipeline("density", "sph/density.comp")?);
+        let forces = Guard::new(ctx, pipeline("forces", "sph/forces.comp")?);
+        let integrate = Guard::new(ctx, pipeline("integrate", "sph/integrate.comp")?);
+        let gather = GatherPass::new(ctx)?;
         Ok(Self {
-            density: pipeline("density", "sph/density.comp")?,
-            forces: pipeline("forces", "sph/forces.comp")?,
-            integrate: pipeline("integrate", "sph/integrate.comp")?,
-            gather: GatherPass::new(ctx)?,
-            search,
+            density: density.take(),
+            forces: forces.take(),
+            integrate: integrate.take(),
+            gather,
+            search: search.take(),
+            force_hooks: Vec::new(),
+            pre_arrange: Vec::new(),
         })
+    }
+
+    /// Add an extra force term, run after the forces pass (it adds into `acc`).
+    pub fn add_force(&mut self, hook: Box<dyn SphHook>) {
+        self.force_hooks.push(hook);
+    }
+
+    /// Add a per-particle pass run at the start of every step, before arrange.
+    pub fn add_pre_arrange(&mut self, hook: Box<dyn SphHook>) {
+        self.pre_arrange.push(hook);
     }
 
     /// Buffers for the scene's particles, uploaded.
@@ -155,88 +236,62 @@ impl SphSolver {
         }
         let f = &scene.fluid;
         let grid = GridSpec::covering(scene.domain.min, scene.domain.max, f.h)?;
-        let vec4s = (n * 16) as u64;
-        let pair = |name: &str| -> Result<[Buffer; 2]> {
-            Ok([
-                ctx.storage_buffer(&format!("{name} A"), vec4s)?,
-                ctx.storage_buffer(&format!("{name} B"), vec4s)?,
-            ])
-        };
         let colliders: Vec<GpuCollider> = scene
             .colliders
             .iter()
             .map(|c| c.to_gpu())
             .collect::<Result<_>>()?;
-        let mut st = SphState {
-            pos: pair("sph positions")?,
-            vel: pair("sph velocities")?,
-            vhalf: pair("sph half-step velocities")?,
-            attr: pair("sph attributes")?,
-            cur: 0,
-            rho_p: ctx.storage_buffer("sph density pressure", (n * 8) as u64)?,
-            acc: ctx.storage_buffer("sph accelerations", vec4s)?,
-            params: ctx.storage_buffer("sph params", std::mem::size_of::<SphGpuParams>() as u64)?,
-            colliders: ctx.storage_buffer("sph colliders", (MAX_COLLIDERS * 48) as u64)?,
-            nb: self.search.buffers(ctx, n as u64, &grid, 0)?,
+        let mut store = Guard::new(ctx, ParticleStore::new(ctx, "sph", n as u64)?);
+        for d in ATTRIBUTES {
+            store.register(ctx, d)?;
+        }
+        store.set_live(ctx, n as u32, LOCAL_SIZE)?;
+        store.upload(ctx, POS, &particles.pos)?;
+        store.upload(ctx, VEL, &particles.vel)?;
+        store.upload(ctx, VHALF, &particles.vel)?;
+        store.upload(ctx, ATTR, &particles.attr)?;
+        let params = Guard::new(
+            ctx,
+            ctx.storage_buffer("sph params", std::mem::size_of::<SphGpuParams>() as u64)?,
+        );
+        let colliders_buf = Guard::new(
+            ctx,
+            ctx.storage_buffer(
+                "sph colliders",
+                (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
+            )?,
+        );
+        let nb = self.search.buffers(ctx, n as u64, &grid, 0)?;
+        Ok(SphState {
+            particles: store.take(),
+            params: params.take(),
+            colliders: colliders_buf.take(),
+            nb,
             n: n as u32,
             grid,
             fluid: f.clone(),
             domain: (scene.domain.min, scene.domain.max),
             collider_list: colliders,
             dt: f.dt,
-        };
-        ctx.upload(&mut st.pos[0], 0, &particles.pos)?;
-        ctx.upload(&mut st.vel[0], 0, &particles.vel)?;
-        ctx.upload(&mut st.vhalf[0], 0, &particles.vel)?;
-        ctx.upload(&mut st.attr[0], 0, &particles.attr)?;
-        Ok(st)
+        })
     }
 
     fn push(&self, st: &SphState) -> NeighborPush {
         self.search.push(&st.nb, &st.grid, st.fluid.h, st.n)
     }
 
-    fn infos(&self, st: &SphState) -> Vec<vk::DescriptorBufferInfo> {
-        let (starts, ends) = st.nb.cell_buffers();
-        let c = st.cur;
-        [
-            &st.params,
-            &st.nb.sorted_keys,
-            starts,
-            ends,
-            st.nb.box_buffer(),
-            &st.pos[c],
-            &st.vel[c],
-            &st.rho_p,
-            &st.acc,
-            &st.vhalf[c],
-            &st.colliders,
-        ]
-        .iter()
-        .map(|b| b.info())
-        .collect()
-    }
-
     /// Upload parameters and colliders for the next step (inside the command buffer).
     pub fn record_params(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) {
         let p = st.gpu_params();
-        ctx.barrier(cmd); // earlier steps (in submission order) may still read them
-        unsafe {
-            ctx.device
-                .cmd_update_buffer(cmd, st.params.raw, 0, bytemuck::bytes_of(&p));
-            if !st.collider_list.is_empty() {
-                ctx.device.cmd_update_buffer(
-                    cmd,
-                    st.colliders.raw,
-                    0,
-                    bytemuck::cast_slice(&st.collider_list),
-                );
-            }
-        }
-        ctx.barrier(cmd);
+        // Earlier steps' passes (in submission order) may still read them.
+        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
+        ctx.update(cmd, &st.params, 0, &[p]);
+        ctx.update(cmd, &st.colliders, 0, &st.collider_list);
+        // New parameters -> every pass of the step.
+        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
     }
 
-    /// Neighbour structure and every attribute reordered into sorted order.
+    /// Neighbour structure and every reordered attribute in sorted order.
     pub fn record_arrange(
         &self,
         ctx: &Context,
@@ -245,19 +300,13 @@ impl SphSolver {
         st: &mut SphState,
     ) -> Result<()> {
         scopes.begin(ctx, cmd, "arrange");
-        let (a, b) = (st.cur, 1 - st.cur);
         self.search
-            .record_build(ctx, cmd, scopes, &st.nb, &st.pos[a], st.n, &st.grid)?;
-        ctx.compute_barrier(cmd);
-        scopes.begin(ctx, cmd, "reorder");
-        for pair in [&st.pos, &st.vel, &st.vhalf, &st.attr] {
-            self.gather
-                .record(ctx, cmd, &st.nb.perm, &pair[a], &pair[b], st.n);
-        }
+            .record_build(ctx, cmd, scopes, &st.nb, st.pos(), st.n, &st.grid)?;
+        ctx.compute_barrier(cmd); // permutation -> reorder
+        st.particles
+            .record_reorder(ctx, cmd, scopes, &self.gather, &st.nb.perm);
         scopes.end(ctx, cmd);
-        st.cur = b;
-        scopes.end(ctx, cmd);
-        ctx.barrier(cmd);
+        ctx.compute_barrier(cmd); // sorted attributes and cell ranges -> density
         Ok(())
     }
 
@@ -269,6 +318,7 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.density, "density");
+        ctx.compute_barrier(cmd); // density, pressure -> forces
     }
 
     pub fn record_forces(
@@ -279,6 +329,7 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.forces, "forces");
+        ctx.compute_barrier(cmd); // accelerations -> extra forces, integrate
     }
 
     pub fn record_integrate(
@@ -289,6 +340,9 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.integrate, "integrate");
+        // New positions and velocities -> the next step's arrange (or the renderer, whose
+        // caller orders its own copy).
+        ctx.compute_barrier(cmd);
     }
 
     fn run(
@@ -297,17 +351,31 @@ impl SphSolver {
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
-        p: &ComputePipeline,
+        p: &ComputePipeline<SphIo>,
         name: &str,
     ) {
         scopes.begin(ctx, cmd, name);
-        let groups = (st.n as u64).div_ceil(p.local_size as u64);
-        p.dispatch_groups(ctx, cmd, &self.infos(st), &self.push(st), groups);
+        p.dispatch(ctx, cmd, &st.bufs(), &self.push(st), st.n as u64);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd);
     }
 
-    /// One full step.
+    fn run_hooks(
+        hooks: &[Box<dyn SphHook>],
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()> {
+        for h in hooks {
+            scopes.begin(ctx, cmd, h.name());
+            h.record(ctx, cmd, st)?;
+            scopes.end(ctx, cmd);
+            ctx.compute_barrier(cmd); // the hook's writes -> the next pass
+        }
+        Ok(())
+    }
+
+    /// One full step, in the scope `sph`.
     pub fn record_step(
         &self,
         ctx: &Context,
@@ -315,11 +383,15 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &mut SphState,
     ) -> Result<()> {
+        scopes.begin(ctx, cmd, "sph");
         self.record_params(ctx, cmd, st);
+        Self::run_hooks(&self.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
         self.record_density(ctx, cmd, scopes, st);
         self.record_forces(ctx, cmd, scopes, st);
+        Self::run_hooks(&self.force_hooks, ctx, cmd, scopes, st)?;
         self.record_integrate(ctx, cmd, scopes, st);
+        scopes.end(ctx, cmd);
         Ok(())
     }
 
@@ -329,5 +401,14 @@ impl SphSolver {
         self.density.destroy(ctx);
         self.forces.destroy(ctx);
         self.integrate.destroy(ctx);
+        for h in self
+            .force_hooks
+            .iter_mut()
+            .chain(self.pre_arrange.iter_mut())
+        {
+            h.destroy(ctx);
+        }
     }
 }
+
+crate::impl_destroy!(SphSolver, SphState);

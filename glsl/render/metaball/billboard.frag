@@ -14,10 +14,10 @@ void main() {
     atomicAdd(offsets[p], 1u);
 #elif PASS == 1
     uint slot = atomicAdd(offsets[p], 1u);
-    if (slot < P.list_capacity) list[slot] = v_id; else atomicAdd(stats[2], 1u);
+    if (slot < P.list_capacity) list[slot] = v_id; else atomicAdd(stats.overflow, 1u);
 #else
-    uint node = atomicAdd(stats[0], 1u);
+    uint node = atomicAdd(stats.abuffer_nodes, 1u);
     if (node < P.list_capacity) nodes[node] = uvec2(v_id, atomicExchange(heads[p], node));
-    else atomicAdd(stats[2], 1u);
+    else atomicAdd(stats.overflow, 1u);
 #endif
 }

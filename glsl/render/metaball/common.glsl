@@ -1,21 +1,11 @@
 // Metaball rendering (seed 000, section 4): parameters, bindings, density functions and
-// the per-pixel metaball lists. Mirrors src/render/metaball/gpu.rs (RenderParams).
-// Defines: LIST 0 none | 1 abuffer | 2 sbuffer; SORTED 1: S-buffer ranges sorted by depth; DENSITY 0 blinn | 1 wyvill | 2 nishimura
-// | 3 murakami; MATERIAL 0 phong | 1 glass | 2 tinted | 3 metal.
+// the per-pixel metaball lists. Bindings: MetaballIo in src/render/metaball/renderer.rs
+// (MB_B_* defines); RenderParams and RenderStats mirror src/render/metaball/settings.rs
+// and stats.rs (field offsets tested). Defines from Rust: LIST (LIST_NONE | LIST_ABUFFER |
+// LIST_SBUFFER), SORTED (1: S-buffer ranges sorted by depth), DENSITY (DENSITY_BLINN |
+// _WYVILL | _NISHIMURA | _MURAKAMI), MATERIAL (MATERIAL_PHONG | _GLASS | _TINTED | _METAL).
 #ifndef METABALL_COMMON_GLSL
 #define METABALL_COMMON_GLSL
-#ifndef LIST
-#define LIST 2
-#endif
-#ifndef DENSITY
-#define DENSITY 1
-#endif
-#ifndef MATERIAL
-#define MATERIAL 0
-#endif
-#ifndef SORTED
-#define SORTED 0
-#endif
 
 struct RenderParams {
     mat4 view_proj;
@@ -41,22 +31,30 @@ struct RenderParams {
     uint pad;
 };
 const uint NIL = 0xFFFFFFFFu;
-// stats: [0] A-buffer node counter, [1] longest list, [2] list overflows, [3] off-screen
-// secondary samples, [4] S-buffer fragments (its total)
+struct RenderStats {
+    uint abuffer_nodes;      // A-buffer node counter
+    uint longest;            // longest list met by a primary ray
+    uint overflow;           // list entries that did not fit
+    uint offscreen_samples;  // secondary samples off screen
+    uint sbuffer_fragments;  // S-buffer total (copied from the scan)
+    uint budget_pixels;      // pixels whose loops were cut short
+    uint pad0;
+    uint pad1;
+};
 // S-buffer: one array of W*H + 1: counts, scanned in place into starts, then advanced by
 // the fill to each pixel's end, so pixel p's range is [p == 0 ? 0 : offsets[p-1], offsets[p]).
-layout(std430, binding = 0) readonly buffer Params { RenderParams P; };  // binding 0
-layout(std430, binding = 1) readonly buffer Centers { vec4 centers[]; };   // binding 1: xyz
-layout(std430, binding = 2) readonly buffer Bounds { vec4 bounds[]; };     // binding 2: min, max
-layout(std430, binding = 3) buffer Offsets { uint offsets[]; };            // binding 3: S offsets
-layout(std430, binding = 4) buffer List { uint list[]; };                  // binding 4: S ranges
-layout(std430, binding = 5) buffer Heads { uint heads[]; };                // binding 5: A heads
-layout(std430, binding = 6) buffer Nodes { uvec2 nodes[]; };               // binding 6: A (id, next)
-layout(std430, binding = 7) buffer Stats { uint stats[]; };                // binding 7
-layout(std430, binding = 8) writeonly buffer Pixels { uint pixels[]; };    // binding 8: RGBA8
-layout(std430, binding = 9) writeonly buffer Debug { vec4 debug_out[]; };  // binding 9: t, normal
-layout(std430, binding = 10) readonly buffer Sky { uint sky[]; };          // binding 10: RGBA8
-layout(std430, binding = 11) buffer Depths { float depths[]; };            // binding 11: view depths
+layout(std430, binding = MB_B_PARAMS) readonly buffer Params { RenderParams P; };
+layout(std430, binding = MB_B_CENTERS) readonly buffer Centers { vec4 centers[]; };  // xyz
+layout(std430, binding = MB_B_BOUNDS) readonly buffer Bounds { vec4 bounds[]; };  // min, max
+layout(std430, binding = MB_B_OFFSETS) buffer Offsets { uint offsets[]; };  // S offsets
+layout(std430, binding = MB_B_LIST) buffer List { uint list[]; };  // S ranges
+layout(std430, binding = MB_B_HEADS) buffer Heads { uint heads[]; };  // A heads
+layout(std430, binding = MB_B_NODES) buffer Nodes { uvec2 nodes[]; };  // A (id, next)
+layout(std430, binding = MB_B_STATS) buffer Stats { RenderStats stats; };
+layout(std430, binding = MB_B_PIXELS) writeonly buffer Pixels { uint pixels[]; };  // RGBA8
+layout(std430, binding = MB_B_DEBUG) writeonly buffer Debug { vec4 debug_out[]; };  // t, normal
+layout(std430, binding = MB_B_SKY) readonly buffer Sky { uint sky[]; };  // RGBA8
+layout(std430, binding = MB_B_DEPTHS) buffer Depths { float depths[]; };  // view depths
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
 
@@ -74,12 +72,12 @@ float density2(float r2) {
     float R = radius();
     float q2 = r2 / (R * R);
     if (q2 >= 1.0) return 0.0;
-#if DENSITY == 0
+#if DENSITY == DENSITY_BLINN
     float fl = exp(-BLINN_A);
     return (exp(-BLINN_A * q2) - fl) / (1.0 - fl);
-#elif DENSITY == 1
+#elif DENSITY == DENSITY_WYVILL
     return 1.0 - 4.0 / 9.0 * q2 * q2 * q2 + 17.0 / 9.0 * q2 * q2 - 22.0 / 9.0 * q2;
-#elif DENSITY == 2
+#elif DENSITY == DENSITY_NISHIMURA
     float q = sqrt(q2);
     return q <= 1.0 / 3.0 ? 1.0 - 3.0 * q2 : 1.5 * (1.0 - q) * (1.0 - q);
 #else
@@ -93,12 +91,12 @@ float density_grad_over_r(float r2) {
     float q2 = r2 / (R * R);
     if (q2 >= 1.0) return 0.0;
     float inv = 1.0 / (R * R);
-#if DENSITY == 0
+#if DENSITY == DENSITY_BLINN
     float fl = exp(-BLINN_A);
     return -2.0 * BLINN_A * exp(-BLINN_A * q2) / (1.0 - fl) * inv;
-#elif DENSITY == 1
+#elif DENSITY == DENSITY_WYVILL
     return (-24.0 / 9.0 * q2 * q2 + 68.0 / 9.0 * q2 - 44.0 / 9.0) * inv;
-#elif DENSITY == 2
+#elif DENSITY == DENSITY_NISHIMURA
     float q = sqrt(q2);
     if (q <= 1.0 / 3.0) return -6.0 * inv;
     return q > 1e-12 ? -3.0 * (1.0 - q) / q * inv : 0.0;

@@ -14,7 +14,7 @@ uint offscreen_samples = 0u;
 uint longest = 0u;
 // llvmpipe stops a batch's loops after about 65535 iterations in total (hang protection);
 // every later loop then exits at once. Each loop below checks on exit that it ended by
-// its own condition (CUT_UNLESS, the negated loop condition); pixels where one did not are counted in stats[5], so a
+// its own condition (CUT_UNLESS, the negated loop condition); pixels where one did not are counted in stats.budget_pixels, so a
 // cut-short frame is reported, never silently wrong. Never set on a real GPU.
 bool cut = false;
 #define CUT_UNLESS(ended) if (!(ended)) cut = true;
@@ -33,14 +33,14 @@ bool cut = false;
                 if (j_ < P.n) { vec3 d = x - centers[j_].xyz; ACC += TERM; } } } \
         CUT_UNLESS(!(b_ < P.n)) \
     } else { SUM_LIST(x, p, ACC, TERM) } }
-#if LIST == 1
+#if LIST == LIST_ABUFFER
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint n_ = heads[p]; \
     for (; n_ != NIL;) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } } \
     CUT_UNLESS(n_ == NIL) }
-#elif LIST == 2 && SORTED
+#elif LIST == LIST_SBUFFER && SORTED
 // Sorted ranges: a binary search (on depths.comp's keys) finds the first centre at depth
 // >= z - R, and the walk stops past z + R (the depth recomputed from the centre it loads
 // anyway). Exact: |x - c| >= |depth(x) - depth(c)|, so every metaball outside the window
@@ -63,7 +63,7 @@ bool cut = false;
                 if (view_depth(c_) > z_ + r_) more_ = false; \
                 else { vec3 d = x - c_; ACC += TERM; } } } } \
     CUT_UNLESS(!(more_ && b_ < e_)) }
-#elif LIST == 2
+#elif LIST == LIST_SBUFFER
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint e_ = min(offsets[p], P.list_capacity); \
     uint b_ = range_start(p); \
@@ -77,7 +77,7 @@ bool cut = false;
 #endif
 
 float field(vec3 x, uint p) {
-#if LIST == 0
+#if LIST == LIST_NONE
     p = ALL;
 #endif
     float f = 0.0;
@@ -86,7 +86,7 @@ float field(vec3 x, uint p) {
 }
 
 vec3 gradient(vec3 x, uint p) {
-#if LIST == 0
+#if LIST == LIST_NONE
     p = ALL;
 #endif
     vec3 g = vec3(0.0);
@@ -115,12 +115,12 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
     float R2 = radius() * radius();
     vec2 iv = vec2(1e30, -1e30);
     uint len = 0u;
-#if LIST == 1
+#if LIST == LIST_ABUFFER
     uint node = heads[p];
     for (; node != NIL; node = nodes[node].y) {
         vec3 oc = o - centers[nodes[node].x].xyz;
         len++;
-#elif LIST == 2
+#elif LIST == LIST_SBUFFER
     uint s = range_start(p), e = min(offsets[p], P.list_capacity);
     for (; s < e; ++s) {
         vec3 oc = o - centers[list[s]].xyz;
@@ -133,9 +133,9 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
         float disc = b * b - (dot(oc, oc) - R2);
         if (disc > 0.0) { float q = sqrt(disc); iv = vec2(min(iv.x, -b - q), max(iv.y, -b + q)); }
     }
-#if LIST == 1
+#if LIST == LIST_ABUFFER
     CUT_UNLESS(node == NIL)
-#elif LIST == 2
+#elif LIST == LIST_SBUFFER
     CUT_UNLESS(!(s < e))
 #endif
     longest = max(longest, len);
@@ -245,7 +245,7 @@ void main() {
     vec3 o = P.eye.xyz;
     vec3 d = normalize(b.xyz / b.w - a.xyz / a.w);
 
-#if LIST == 0
+#if LIST == LIST_NONE
     vec2 iv = ray_box(o, d, box_lo(), box_hi());
 #else
     vec2 iv = list_interval(o, d, id);
@@ -268,18 +268,18 @@ void main() {
         vec3 x = r.o + r.d * t;
         vec3 n = normal_at(x, primary ? id : NIL);
         if (primary) dbg = vec4(t, n);
-#if MATERIAL == 0
+#if MATERIAL == MATERIAL_PHONG
         color += r.w * phong(n, -r.d);
 #else
         vec3 w = r.w;
-#if MATERIAL == 2
+#if MATERIAL == MATERIAL_TINTED
         if (r.inside) w *= exp(-P.absorb.rgb * t);  // Beer-Lambert along the inside path
 #endif
         vec3 nn = r.inside ? -n : n;  // facing the incoming ray
         float cos_i = clamp(-dot(r.d, nn), 0.0, 1.0);
         vec3 rd = reflect(r.d, nn);
         float eps = 0.05 * radius();
-#if MATERIAL == 3
+#if MATERIAL == MATERIAL_METAL
         vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
         Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
         if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd);
@@ -304,7 +304,7 @@ void main() {
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
     if (P.debug != 0u) debug_out[id] = dbg;
-    if (longest > 0u) atomicMax(stats[1], longest);
-    if (offscreen_samples > 0u) atomicAdd(stats[3], offscreen_samples);
-    if (cut) atomicAdd(stats[5], 1u);
+    if (longest > 0u) atomicMax(stats.longest, longest);
+    if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);
+    if (cut) atomicAdd(stats.budget_pixels, 1u);
 }

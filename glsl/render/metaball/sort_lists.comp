@@ -52,5 +52,5 @@ void main() {
         sift(base, 0u, m - 1u);
     }
     if (m > 1u) cut = true;
-    if (cut) atomicAdd(stats[5], 1u);
+    if (cut) atomicAdd(stats.budget_pixels, 1u);
 }

@@ -1,13 +1,17 @@
 //! Metaball rendering (seed 000, section 4): finite-support radial density functions,
 //! billboards into per-pixel metaball lists (none, A-buffer, S-buffer), ray marching with
 //! six materials, and a CPU reference ray marcher the GPU passes are checked against.
+pub mod buffers;
 pub mod density;
 pub mod reference;
 pub mod renderer;
 pub mod settings;
+pub mod stats;
 
-pub use renderer::{FrameStats, MetaballBuffers, MetaballRenderer};
+pub use buffers::MetaballBuffers;
+pub use renderer::MetaballRenderer;
 pub use settings::MetaballSettings;
+pub use stats::{FrameStats, GpuStats};
 
 /// A resting blob: the `n` points of a cubic lattice of the given spacing nearest to the
 /// origin (the thesis's 2048 particles, until characters exist).

@@ -6,7 +6,7 @@ use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct MetaballSettings {
     pub list: ListKind,
     pub density: DensityFn,
@@ -54,6 +54,16 @@ fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
 }
 
 /// Reflectance at normal incidence from a complex index: ((n-1)^2 + k^2) / ((n+1)^2 + k^2).
+/// MATERIAL in the shaders: the metals share one path.
+pub fn material_index(m: Material) -> u32 {
+    match m {
+        Material::Phong => 0,
+        Material::Glass => 1,
+        Material::Tinted => 2,
+        Material::Gold | Material::Copper | Material::Aluminium => 3,
+    }
+}
+
 pub fn f0_from_nk(n: f32, k: f32) -> f32 {
     ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
 }
@@ -159,6 +169,54 @@ impl MetaballSettings {
             Material::Tinted => 2,
             Material::Gold | Material::Copper | Material::Aluminium => 3,
         }
+    }
+
+    /// LIST, DENSITY, MATERIAL and SORTED with the named values the shaders compare
+    /// against (`LIST_SBUFFER`, ...), all from here.
+    pub fn shader_defines(&self) -> Vec<(String, String)> {
+        Self::defines_for(self.list, self.density, self.material, self.sorts_lists())
+    }
+
+    /// The defines of one configuration (also the shader registry's variants).
+    pub fn defines_for(
+        list: ListKind,
+        density: DensityFn,
+        material: Material,
+        sorted: bool,
+    ) -> Vec<(String, String)> {
+        use crate::gpu::interface::enum_defines;
+        let probe = |l| match l {
+            ListKind::None => 0,
+            ListKind::Abuffer => 1,
+            ListKind::Sbuffer => 2,
+        };
+        let mut d = vec![
+            ("LIST".to_string(), probe(list).to_string()),
+            ("DENSITY".to_string(), density.index().to_string()),
+            ("MATERIAL".to_string(), material_index(material).to_string()),
+            (
+                "SORTED".to_string(),
+                ((sorted && list == ListKind::Sbuffer) as u32).to_string(),
+            ),
+        ];
+        d.extend(enum_defines(
+            "LIST",
+            &[("none", 0), ("abuffer", 1), ("sbuffer", 2)],
+        ));
+        d.extend(enum_defines(
+            "DENSITY",
+            &[
+                ("blinn", 0),
+                ("wyvill", 1),
+                ("nishimura", 2),
+                ("murakami", 3),
+            ],
+        ));
+        d.extend(enum_defines(
+            "MATERIAL",
+            &[("phong", 0), ("glass", 1), ("tinted", 2), ("metal", 3)],
+        ));
+        d
     }
 
     pub fn list_index(&self) -> u32 {

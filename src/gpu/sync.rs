@@ -1,0 +1,165 @@
+//! Barriers that say what they protect.
+//!
+//! The rule: **the code that sequences two commands issues the barrier between them**,
+//! from the first one's stage and access to the second one's, because it alone knows both.
+//! A pass's `record` orders its own dispatches and leaves its last writes unguarded; the
+//! caller that chains passes (the SPH step, the metaball frame, the frame's work) orders
+//! them, read-after-write and write-after-read (a buffer overwritten while earlier commands
+//! may still read it); the frame loop issues one barrier at every frame boundary. Each call
+//! carries a comment naming what it protects.
+use super::Context;
+use ash::vk;
+use std::ops::BitOr;
+
+/// One side of a dependency: pipeline stages and the memory accesses in them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Access {
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+}
+
+impl BitOr for Access {
+    type Output = Access;
+    fn bitor(self, o: Access) -> Access {
+        Access {
+            stage: self.stage | o.stage,
+            access: self.access | o.access,
+        }
+    }
+}
+
+const fn acc(stage: vk::PipelineStageFlags2, access: vk::AccessFlags2) -> Access {
+    Access { stage, access }
+}
+
+/// Storage writes of compute shaders.
+pub const COMPUTE_WRITE: Access = acc(
+    vk::PipelineStageFlags2::COMPUTE_SHADER,
+    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+);
+/// Storage reads of compute shaders (and their writes, ordered after earlier writes).
+pub const COMPUTE_READ: Access = acc(
+    vk::PipelineStageFlags2::COMPUTE_SHADER,
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+    ),
+);
+/// Copies, fills and updates writing a buffer.
+pub const TRANSFER_WRITE: Access = acc(
+    vk::PipelineStageFlags2::ALL_TRANSFER,
+    vk::AccessFlags2::TRANSFER_WRITE,
+);
+/// Copies reading a buffer (and transfer writes ordered after earlier writes).
+pub const TRANSFER_READ: Access = acc(
+    vk::PipelineStageFlags2::ALL_TRANSFER,
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::TRANSFER_READ.as_raw() | vk::AccessFlags2::TRANSFER_WRITE.as_raw(),
+    ),
+);
+/// Storage writes of fragment shaders (per-pixel lists).
+pub const FRAGMENT_WRITE: Access = acc(
+    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+);
+/// Storage reads (and writes) of vertex and fragment shaders.
+pub const GRAPHICS_READ: Access = acc(
+    vk::PipelineStageFlags2::from_raw(
+        vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
+            | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
+    ),
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+    ),
+);
+/// Indirect dispatch and draw arguments.
+pub const INDIRECT_READ: Access = acc(
+    vk::PipelineStageFlags2::DRAW_INDIRECT,
+    vk::AccessFlags2::INDIRECT_COMMAND_READ,
+);
+/// Colour and depth attachment writes of a draw.
+pub const ATTACHMENT_WRITE: Access = acc(
+    vk::PipelineStageFlags2::from_raw(
+        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT.as_raw()
+            | vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+    ),
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw()
+            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+    ),
+);
+/// The host reading a mapped buffer after the fence.
+pub const HOST_READ: Access = acc(vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ);
+
+impl Context {
+    /// A memory dependency from `from` (earlier commands) to `to` (later commands).
+    pub fn barrier(&self, cmd: vk::CommandBuffer, from: Access, to: Access) {
+        let b = [vk::MemoryBarrier2::default()
+            .src_stage_mask(from.stage)
+            .src_access_mask(from.access)
+            .dst_stage_mask(to.stage)
+            .dst_access_mask(to.access)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&b);
+        unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    /// Compute writes visible to later compute reads and writes: the common case.
+    pub fn compute_barrier(&self, cmd: vk::CommandBuffer) {
+        self.barrier(cmd, COMPUTE_WRITE, COMPUTE_READ);
+    }
+
+    /// Copy `size` bytes from `src` at `src_offset` to `dst` at `dst_offset`.
+    pub fn copy(
+        &self,
+        cmd: vk::CommandBuffer,
+        src: &super::Buffer,
+        src_offset: u64,
+        dst: &super::Buffer,
+        dst_offset: u64,
+        size: u64,
+    ) {
+        let region = vk::BufferCopy {
+            src_offset,
+            dst_offset,
+            size,
+        };
+        unsafe {
+            self.device
+                .cmd_copy_buffer(cmd, src.raw, dst.raw, &[region])
+        };
+    }
+
+    /// Fill the whole buffer with a u32 value.
+    pub fn fill(&self, cmd: vk::CommandBuffer, b: &super::Buffer, value: u32) {
+        unsafe {
+            self.device
+                .cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, value)
+        };
+    }
+
+    /// Write `data` (at most 65536 bytes) into `b` at byte `offset`, in command order.
+    pub fn update<T: bytemuck::Pod>(
+        &self,
+        cmd: vk::CommandBuffer,
+        b: &super::Buffer,
+        offset: u64,
+        data: &[T],
+    ) {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        if !bytes.is_empty() {
+            unsafe { self.device.cmd_update_buffer(cmd, b.raw, offset, bytes) };
+        }
+    }
+
+    /// End a dynamic-rendering scope.
+    pub fn end_rendering(&self, cmd: vk::CommandBuffer) {
+        unsafe { self.device.cmd_end_rendering(cmd) };
+    }
+
+    /// Non-indexed draw of `vertices` x `instances` (inside a rendering scope).
+    pub fn draw(&self, cmd: vk::CommandBuffer, vertices: u32, instances: u32) {
+        unsafe { self.device.cmd_draw(cmd, vertices, instances, 0, 0) };
+    }
+}

@@ -1,0 +1,214 @@
+//! The metaball renderer's sized buffers: lists for width x height, up to `n_capacity`
+//! metaballs, per-slot readbacks. Apart from the pipelines (renderer.rs), so a sweep over
+//! sizes rebuilds buffers only.
+use super::settings::{MetaballSettings, RenderParams};
+use super::stats::GpuStats;
+use crate::config::ListKind;
+use crate::error::{Error, Result};
+use crate::gpu::{Buffer, Context, Guard, MemoryLocation};
+use crate::primitives::bounds::BoundsBuffers;
+use crate::primitives::scan::{ScanPass, ScanScratch};
+use ash::vk;
+
+/// Sized buffers: lists for width x height, up to `n_capacity` metaballs, per-slot readbacks.
+pub struct MetaballBuffers {
+    pub(super) params: Buffer,
+    pub(super) offsets: Buffer,
+    pub(super) list: Buffer,
+    pub(super) heads: Buffer,
+    pub(super) nodes: Buffer,
+    pub(super) stats: Buffer,
+    pub pixels: Buffer,
+    pub(super) debug: Buffer,
+    pub(super) sky: Buffer,
+    /// Sorted S-buffer: every metaball's view depth.
+    pub(super) depths: Buffer,
+    pub(super) sky_size: (u32, u32),
+    pub(super) bounds: BoundsBuffers,
+    pub(super) scan: ScanScratch,
+    pub(super) stats_readback: Vec<Buffer>,
+    pub(super) pixels_readback: Vec<Buffer>,
+    /// Entries of the S-buffer list or the A-buffer node pool.
+    pub list_capacity: u64,
+    pub debug_on: bool,
+}
+
+/// Bytes of one list entry: an S-buffer metaball index, an A-buffer (index, next) node.
+pub fn entry_bytes(list: ListKind) -> u64 {
+    if list == ListKind::Abuffer {
+        8
+    } else {
+        4
+    }
+}
+
+fn load_sky(path: &str) -> Result<(u32, u32, Vec<u32>)> {
+    let img = image::open(path).map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let rgba = img.to_rgba8();
+    let (w, h) = rgba.dimensions();
+    let px = rgba.pixels().map(|p| u32::from_le_bytes(p.0)).collect();
+    Ok((w, h, px))
+}
+
+impl MetaballBuffers {
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [
+            &mut self.params,
+            &mut self.offsets,
+            &mut self.list,
+            &mut self.heads,
+            &mut self.nodes,
+            &mut self.stats,
+            &mut self.pixels,
+            &mut self.debug,
+            &mut self.sky,
+            &mut self.depths,
+        ] {
+            ctx.destroy_buffer(b);
+        }
+        for b in self
+            .stats_readback
+            .iter_mut()
+            .chain(self.pixels_readback.iter_mut())
+        {
+            ctx.destroy_buffer(b);
+        }
+        self.bounds.destroy(ctx);
+        self.scan.destroy(ctx);
+    }
+
+    /// RGBA8 pixels of the frame last rendered in `slot` (after its fence).
+    pub fn pixels(&self, slot: usize) -> &[u8] {
+        self.pixels_readback[slot].mapped().expect("mapped")
+    }
+
+    pub fn new(
+        ctx: &Context,
+        s: &MetaballSettings,
+        scan: &ScanPass,
+        n_capacity: u64,
+        slots: usize,
+        debug: bool,
+    ) -> Result<MetaballBuffers> {
+        Self::with_capacity(ctx, s, scan, n_capacity, slots, debug, s.pixels() * 4)
+    }
+
+    /// As `buffers`, with the list's first capacity in entries (it grows on overflow).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_capacity(
+        ctx: &Context,
+        s: &MetaballSettings,
+        scan: &ScanPass,
+        n_capacity: u64,
+        slots: usize,
+        debug: bool,
+        capacity: u64,
+    ) -> Result<MetaballBuffers> {
+        let px = s.pixels();
+        let (sky_w, sky_h, sky_px) = match &s.sky {
+            Some(p) => load_sky(p)?,
+            None => (0, 0, vec![0u32]),
+        };
+        let entry = entry_bytes(s.list);
+        let list_capacity = match s.list {
+            ListKind::None => 0,
+            _ => capacity.max(1).min(ctx.max_storage_range() / entry),
+        };
+        // Buffers a configuration does not use stay bound, at a token size.
+        let only = |used: bool, bytes: u64| if used { bytes } else { 16 };
+        let (sbuf, abuf) = (s.list == ListKind::Sbuffer, s.list == ListKind::Abuffer);
+        // Every buffer is guarded: a failure halfway releases the ones made before it.
+        let buf =
+            |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let params = buf("render params", std::mem::size_of::<RenderParams>() as u64)?;
+        let offsets = buf("sbuffer offsets", only(sbuf, (px + 1) * 4))?;
+        let list = buf("sbuffer list", only(sbuf, list_capacity * 4))?;
+        let heads = buf("abuffer heads", only(abuf, px * 4))?;
+        let nodes = buf("abuffer nodes", only(abuf, list_capacity * 8))?;
+        let stats = buf("render stats", GpuStats::SIZE)?;
+        let pixels = buf("render pixels", px * 4)?;
+        let debug_buf = buf("render debug", only(debug, px * 16))?;
+        let sky = buf("sky image", sky_px.len() as u64 * 4)?;
+        let depths = buf(
+            "metaball depths",
+            only(s.sorts_lists(), n_capacity.max(1) * 4),
+        )?;
+        let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
+        let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);
+        let mut stats_readback = Guard::new(ctx, Vec::new());
+        let mut pixels_readback = Guard::new(ctx, Vec::new());
+        for _ in 0..slots {
+            stats_readback.push(ctx.create_buffer(
+                "render stats readback",
+                GpuStats::SIZE,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+            pixels_readback.push(ctx.create_buffer(
+                "render pixels readback",
+                px * 4,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
+        }
+        let mut b = Guard::new(
+            ctx,
+            MetaballBuffers {
+                params: params.take(),
+                offsets: offsets.take(),
+                list: list.take(),
+                heads: heads.take(),
+                nodes: nodes.take(),
+                stats: stats.take(),
+                pixels: pixels.take(),
+                debug: debug_buf.take(),
+                sky: sky.take(),
+                depths: depths.take(),
+                sky_size: (sky_w, sky_h),
+                bounds: bounds.take(),
+                scan: scan.take(),
+                stats_readback: stats_readback.take(),
+                pixels_readback: pixels_readback.take(),
+                list_capacity,
+                debug_on: debug,
+            },
+        );
+        ctx.upload(&mut b.sky, 0, &sky_px)?;
+        Ok(b.take())
+    }
+
+    /// Reallocate the list for `needed` entries: exactly (S-buffer) or with 25% headroom
+    /// (A-buffer, whose count is only known after the pass).
+    pub fn grow(&mut self, ctx: &Context, list: ListKind, needed: u64) -> Result<()> {
+        let b = self;
+        let fits = ctx.max_storage_range() / entry_bytes(list);
+        if needed > fits {
+            return Err(Error::Memory(format!(
+                "the {} needs {needed} entries, more than one storage binding addresses on this \
+                 device ({fits}); lower the resolution, the metaball radius or the particle count",
+                list.as_str()
+            )));
+        }
+        match list {
+            ListKind::None => Ok(()),
+            ListKind::Sbuffer => {
+                ctx.destroy_buffer(&mut b.list);
+                b.list = ctx.storage_buffer("sbuffer list", needed.max(1) * 4)?;
+                b.list_capacity = needed.max(1);
+                Ok(())
+            }
+            ListKind::Abuffer => {
+                let cap = (needed + needed / 4 + 1).min(fits);
+                ctx.destroy_buffer(&mut b.nodes);
+                b.nodes = ctx.storage_buffer("abuffer nodes", cap * 8)?;
+                b.list_capacity = cap;
+                Ok(())
+            }
+        }
+    }
+}
+
+crate::impl_destroy!(MetaballBuffers);

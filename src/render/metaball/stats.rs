@@ -1,0 +1,45 @@
+//! The renderer's GPU counters (mirror of `RenderStats` in glsl/render/metaball/common.glsl,
+//! field offsets tested) and the per-frame statistics built from them.
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq, Eq)]
+pub struct GpuStats {
+    /// A-buffer node counter: entries the A-buffer pushed (fragments).
+    pub abuffer_nodes: u32,
+    pub longest: u32,
+    pub overflow: u32,
+    pub offscreen_samples: u32,
+    /// The S-buffer's total, copied from the end of its scanned offsets.
+    pub sbuffer_fragments: u32,
+    pub budget_pixels: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+impl GpuStats {
+    pub const SIZE: u64 = std::mem::size_of::<GpuStats>() as u64;
+    /// Where the S-buffer's total is copied.
+    pub const SBUFFER_FRAGMENTS_OFFSET: u64 =
+        std::mem::offset_of!(GpuStats, sbuffer_fragments) as u64;
+}
+
+/// One frame's list statistics (the thesis's memory column is `list_bytes`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct FrameStats {
+    /// Billboard fragments: list entries of the frame.
+    pub fragments: u64,
+    /// Longest per-pixel list met by a primary ray.
+    pub longest: u32,
+    /// List entries that did not fit (the frame must be redone).
+    pub overflow: u32,
+    /// Secondary-ray samples that left the screen.
+    pub offscreen_samples: u32,
+    /// Pixels whose rays were cut short: a loop stopped before its own exit condition, as
+    /// llvmpipe's loop budget (about 65535 iterations per batch) does. Nonzero: wrong frame.
+    pub budget_pixels: u32,
+    /// Bytes the list structure needs for this frame (S: offsets + list, sorted: plus the
+    /// metaball depths; A: heads + nodes + counter; none: 0).
+    pub list_bytes: u64,
+}

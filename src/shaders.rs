@@ -1,0 +1,97 @@
+//! Every shader with the defines the code compiles it with: its interface's bindings and
+//! each set of feature defines a pass uses. One registration line per pass; the shader
+//! test compiles every entry and fails on a GLSL file registered nowhere.
+use crate::config::{DensityFn, ListKind, Material, Neighbors, SortAlgo};
+use crate::gpu::Interface;
+use crate::render::metaball::MetaballSettings;
+use clap::ValueEnum;
+
+/// (file under glsl/, defines).
+pub type Variant = (&'static str, Vec<(String, String)>);
+
+fn with<I: Interface>(file: &'static str, extra: &[(String, String)]) -> Variant {
+    let mut d = I::defines();
+    d.extend(extra.iter().cloned());
+    (file, d)
+}
+
+fn kv(k: &str, v: impl ToString) -> (String, String) {
+    (k.to_string(), v.to_string())
+}
+
+pub fn variants() -> Vec<Variant> {
+    use crate::primitives::{bounds, counting, morton, neighbors, scan, sort};
+    let mut v = vec![
+        with::<bounds::BoundsIo>("primitives/bounds.comp", &[]),
+        with::<morton::MortonIo>("primitives/morton.comp", &[]),
+        with::<counting::CountIo>("primitives/count.comp", &[]),
+        with::<counting::ScatterIo>("primitives/scatter.comp", &[]),
+        with::<counting::GatherIo>("primitives/gather.comp", &[]),
+        with::<sort::SortIo>("primitives/oddeven.comp", &[]),
+        with::<sort::SortIo>("primitives/bitonic.comp", &[]),
+        with::<crate::particles::LiveArgsIo>("common/live_args.comp", &[]),
+        with::<crate::sph::hooks::ConstantForceIo>("sph/constant_force.comp", &[]),
+        with::<crate::scene::orbits::OrbitsIo>("scene/orbits.comp", &[]),
+        with::<crate::render::points::PointsIo>("render/points.vert", &[]),
+        with::<crate::render::points::PointsIo>("render/points.frag", &[]),
+    ];
+    for sub in [0, 1] {
+        let d = [kv("SUBGROUP", sub), kv("IPT", "16u"), kv("CHUNK", "64u")];
+        for f in ["scan_chunk_reduce", "scan_chunk_down", "scan_block"] {
+            let file: &'static str = match f {
+                "scan_chunk_reduce" => "primitives/scan_chunk_reduce.comp",
+                "scan_chunk_down" => "primitives/scan_chunk_down.comp",
+                _ => "primitives/scan_block.comp",
+            };
+            v.push(with::<scan::ScanIo>(file, &d));
+        }
+    }
+    for nb in [Neighbors::Grid, Neighbors::Hash, Neighbors::Morton] {
+        for sort in [SortAlgo::Counting, SortAlgo::OddEven, SortAlgo::Bitonic] {
+            let d: Vec<(String, String)> = neighbors::NeighborSearch::defines_for(nb, sort)
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect();
+            v.push(with::<neighbors::NbKeysIo>("primitives/nb_keys.comp", &d));
+            v.push(with::<neighbors::NbRangesIo>(
+                "primitives/nb_ranges.comp",
+                &d,
+            ));
+            v.push(with::<neighbors::NbQueryIo>("primitives/nb_query.comp", &d));
+            let mut sph = d.clone();
+            sph.extend(crate::sph::params::Eos::defines());
+            for f in ["sph/density.comp", "sph/forces.comp", "sph/integrate.comp"] {
+                v.push(with::<crate::sph::solver::SphIo>(f, &sph));
+            }
+        }
+    }
+    use crate::render::metaball::renderer::MetaballIo;
+    for list in [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer] {
+        for material in [
+            Material::Phong,
+            Material::Glass,
+            Material::Tinted,
+            Material::Gold,
+        ] {
+            for density in DensityFn::value_variants() {
+                for sorted in [false, true] {
+                    let d = MetaballSettings::defines_for(list, *density, material, sorted);
+                    for f in [
+                        "render/metaball/march.comp",
+                        "render/metaball/depths.comp",
+                        "render/metaball/sort_lists.comp",
+                    ] {
+                        v.push(with::<MetaballIo>(f, &d));
+                    }
+                    for pass in 0..3 {
+                        let mut d = d.clone();
+                        d.push(kv("PASS", pass));
+                        v.push(with::<MetaballIo>("render/metaball/billboard.vert", &d));
+                        v.push(with::<MetaballIo>("render/metaball/billboard.frag", &d));
+                    }
+                }
+            }
+        }
+    }
+    v
+}

@@ -1,0 +1,70 @@
+//! Named hooks into the SPH step: extra force terms (between forces and integrate; they add
+//! into `acc`) and extra per-particle passes (before arrange). A hook is its own module
+//! with its GLSL beside it; `SphSolver::add_force` / `add_pre_arrange` register it.
+use super::solver::SphState;
+use crate::error::Result;
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+
+pub trait SphHook {
+    /// Timestamp scope and debug label (under `sph/`).
+    fn name(&self) -> &str;
+    /// Record the hook's passes for the state's `n` particles; the solver orders them
+    /// after the previous pass and before the next.
+    fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) -> Result<()>;
+    fn destroy(&mut self, ctx: &Context);
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ConstantForcePush {
+    /// xyz: acceleration added to every particle, m/s^2.
+    pub accel: [f32; 4],
+    pub n: u32,
+}
+
+crate::gpu_interface! {
+    /// glsl/sph/constant_force.comp
+    pub ConstantForceIo / ConstantForceBufs: "CF", push ConstantForcePush { acc = 0 }
+}
+
+/// A uniform extra acceleration (a steady wind, a tilted gravity): the smallest force
+/// term, the reference for how one plugs into the step.
+pub struct ConstantForce {
+    pipeline: ComputePipeline<ConstantForceIo>,
+    pub accel: [f32; 3],
+}
+
+impl ConstantForce {
+    pub fn new(ctx: &Context, accel: [f32; 3]) -> Result<Self> {
+        Ok(Self {
+            pipeline: ComputePipeline::new(
+                ctx,
+                &ComputeDesc::plain("constant force", "sph/constant_force.comp", &[], 128),
+            )?,
+            accel,
+        })
+    }
+}
+
+impl SphHook for ConstantForce {
+    fn name(&self) -> &str {
+        "constant-force"
+    }
+
+    fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) -> Result<()> {
+        let push = ConstantForcePush {
+            accel: [self.accel[0], self.accel[1], self.accel[2], 0.0],
+            n: st.n,
+        };
+        let acc: &Buffer = st.acc();
+        self.pipeline
+            .dispatch(ctx, cmd, &ConstantForceBufs { acc }, &push, st.n as u64);
+        Ok(())
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}
