@@ -105,7 +105,7 @@ impl ParticleStore {
             cur: 0,
             capacity,
             live: 0,
-            count: ctx.storage_buffer(&format!("{name} live count"), 32)?,
+            count: ctx.indirect_buffer(&format!("{name} live count"), 32)?,
             name: name.to_string(),
         })
     }

@@ -49,11 +49,29 @@ pub(crate) fn create_instance(
     } else {
         vec![]
     };
-    let ext_ptrs = if has_debug {
+    let mut ext_ptrs = if has_debug {
         vec![ash::ext::debug_utils::NAME.as_ptr()]
     } else {
         vec![]
     };
+    if validation {
+        // VkValidationFeaturesEXT is read only with this extension, which the layer provides.
+        let layer_exts =
+            unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                .ctx("list validation layer extensions")?;
+        let name = ash::ext::validation_features::NAME;
+        if !layer_exts
+            .iter()
+            .any(|e| e.extension_name_as_c_str().ok() == Some(name))
+        {
+            return Err(Error::Unsupported(
+                "--validation: the validation layer lacks VK_EXT_validation_features, needed \
+                 for synchronization validation"
+                    .into(),
+            ));
+        }
+        ext_ptrs.push(name.as_ptr());
+    }
     // With validation, also synchronization validation: narrow barriers must not hide
     // hazards (every hazard is reported as an error).
     let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];

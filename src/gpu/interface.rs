@@ -276,3 +276,55 @@ pub fn enum_defines(prefix: &str, values: &[(&str, u32)]) -> Vec<(String, String
         })
         .collect()
 }
+
+/// (member name, byte offset) of the struct type `name` in a SPIR-V module, as the GLSL
+/// compiler laid it out: the field-offset check of Rust mirrors of GPU structs.
+pub fn member_offsets(spv: &[u32], name: &str) -> Vec<(String, u32)> {
+    const NAME: u32 = 5;
+    let text = |w: &[u32]| {
+        let bytes: Vec<u8> = bytemuck::cast_slice(w).to_vec();
+        let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+        String::from_utf8_lossy(&bytes[..end]).into_owned()
+    };
+    let mut ins = Vec::new();
+    let mut i = 5;
+    while i < spv.len() {
+        let count = (spv[i] >> 16).max(1) as usize;
+        ins.push(&spv[i..(i + count).min(spv.len())]);
+        i += count;
+    }
+    let ids: Vec<u32> = ins
+        .iter()
+        .filter(|w| w[0] & 0xffff == NAME && w.len() >= 3 && text(&w[2..]) == name)
+        .map(|w| w[1])
+        .collect();
+    // The optimizer may copy a struct into a function-local type of the same name with no
+    // layout: take the one that carries offsets.
+    ids.iter()
+        .map(|&id| layout_of(&ins, id, &text))
+        .find(|l| !l.is_empty())
+        .unwrap_or_default()
+}
+
+fn layout_of(ins: &[&[u32]], id: u32, text: &dyn Fn(&[u32]) -> String) -> Vec<(String, u32)> {
+    const MEMBER_NAME: u32 = 6;
+    const MEMBER_DECORATE: u32 = 72;
+    const OFFSET: u32 = 35;
+    let mut names = BTreeMap::new();
+    let mut offsets = BTreeMap::new();
+    for w in ins {
+        match w[0] & 0xffff {
+            MEMBER_NAME if w.len() >= 4 && w[1] == id => {
+                names.insert(w[2], text(&w[3..]));
+            }
+            MEMBER_DECORATE if w.len() >= 5 && w[1] == id && w[3] == OFFSET => {
+                offsets.insert(w[2], w[4]);
+            }
+            _ => {}
+        }
+    }
+    names
+        .into_iter()
+        .filter_map(|(m, n)| Some((n, *offsets.get(&m)?)))
+        .collect()
+}

@@ -61,6 +61,16 @@ impl Context {
         self.create_buffer(name, size, STORAGE, MemoryLocation::GpuOnly)
     }
 
+    /// A storage buffer that also holds indirect-dispatch or draw arguments.
+    pub fn indirect_buffer(&self, name: &str, size: u64) -> Result<Buffer> {
+        self.create_buffer(
+            name,
+            size,
+            STORAGE | vk::BufferUsageFlags::INDIRECT_BUFFER,
+            MemoryLocation::GpuOnly,
+        )
+    }
+
     pub fn create_buffer(
         &self,
         name: &str,

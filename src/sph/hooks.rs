@@ -48,6 +48,27 @@ impl ConstantForce {
     }
 }
 
+impl ConstantForce {
+    /// Add the acceleration to `acc` over as many groups as the GPU-side count's indirect
+    /// arguments say (`args` at `offset`); `bound` is the bounds check (the capacity).
+    pub fn record_indirect(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        acc: &Buffer,
+        bound: u32,
+        args: &Buffer,
+        offset: u64,
+    ) {
+        let push = ConstantForcePush {
+            accel: [self.accel[0], self.accel[1], self.accel[2], 0.0],
+            n: bound,
+        };
+        self.pipeline
+            .dispatch_indirect(ctx, cmd, &ConstantForceBufs { acc }, &push, args, offset);
+    }
+}
+
 impl SphHook for ConstantForce {
     fn name(&self) -> &str {
         "constant-force"

@@ -20,9 +20,10 @@ pub fn finish(ctx: &Context) {
         ctx.validation_messages()
     );
     assert!(
-        ctx.memory_bytes().is_empty(),
-        "GPU objects leaked: {:?}",
-        ctx.memory_bytes()
+        ctx.memory_bytes().is_empty() && ctx.live_objects().is_empty(),
+        "GPU objects leaked: {:?} {:?}",
+        ctx.memory_bytes(),
+        ctx.live_objects()
     );
 }
 
