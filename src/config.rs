@@ -72,32 +72,68 @@ pub const METABALL_SWITCHES: &[&str] = &[
 /// Camera switches of rendered scenes.
 pub const CAMERA_SWITCHES: &[&str] = &["eye", "target", "fov"];
 
-/// Every switch of DESIGN.md's command line. Unset optional switches take the default of
-/// whatever uses them; `config` in summary.json records what was used.
-#[derive(Args, Clone, Debug, Serialize)]
-pub struct Switches {
+/// The device, validation, seed and size: every command takes these.
+#[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
+pub struct CommonArgs {
     /// Device index or name substring (see `fluidform devices`)
     #[arg(long)]
     pub device: Option<String>,
+    /// Khronos validation layer on; the run fails on any validation error
+    #[arg(long)]
+    pub validation: bool,
+    /// Seed of every random choice (initial particles, test data)
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Particle count
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
+    pub particles: Option<u32>,
+}
+
+/// Size of rendered frames.
+#[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
+pub struct FrameArgs {
     /// Frame width in pixels
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: u32,
     /// Frame height in pixels
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: u32,
-    /// Seed of every random choice (initial particles, test data)
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Khronos validation layer on; the run fails on any validation error
-    #[arg(long)]
-    pub validation: bool,
-    /// Particle count
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
-    pub particles: Option<u32>,
+}
+
+/// The sort of the neighbour search and the sort benchmark.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct SortArgs {
     #[arg(long, value_enum)]
     pub sort: Option<SortAlgo>,
+}
+
+/// Neighbour search strategy.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct NeighborArgs {
     #[arg(long, value_enum)]
     pub neighbors: Option<Neighbors>,
+}
+
+/// SPH parameters.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct FluidArgs {
+    /// Override a fluid parameter of an SPH scene, e.g. --fluid viscosity=1.5
+    /// --fluid eos=tait (repeatable; the keys of a scene file's [fluid] table)
+    #[arg(long = "fluid", value_name = "KEY=VALUE")]
+    pub fluid: Vec<String>,
+}
+
+/// How `run` draws SPH particles.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct ViewArgs {
+    /// How `run` draws particles: ray-marched metaballs (default for SPH scenes) or spheres
+    #[arg(long, value_enum)]
+    pub render: Option<RenderKind>,
+}
+
+/// The metaball renderer (seed 000, section 4).
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct MetaballArgs {
     #[arg(long, value_enum)]
     pub list: Option<ListKind>,
     #[arg(long, value_enum)]
@@ -116,6 +152,35 @@ pub struct Switches {
     pub depth: Option<u32>,
     #[arg(long, value_enum)]
     pub material: Option<Material>,
+    /// Equirectangular sky image (PNG, JPEG, ...) instead of the procedural sky
+    #[arg(long, value_name = "FILE")]
+    pub sky: Option<String>,
+    /// Secondary-ray samples off screen: use every metaball (all) or end the path (end)
+    #[arg(long, value_enum)]
+    pub offscreen: Option<Offscreen>,
+    /// S-buffer ranges sorted by depth, so each sample reads only the metaballs within R of
+    /// its depth (default: on for glass and tinted; off: the thesis's unsorted S-buffer)
+    #[arg(long, value_enum)]
+    pub list_sort: Option<OnOff>,
+}
+
+/// Camera of rendered scenes.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct CameraArgs {
+    /// Camera position x,y,z (overrides the scene's)
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub eye: Option<[f32; 3]>,
+    /// Camera target x,y,z (overrides the scene's)
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
+    pub target: Option<[f32; 3]>,
+    /// Vertical field of view in degrees
+    #[arg(long, value_parser = parse_fov)]
+    pub fov: Option<f32>,
+}
+
+/// Characters and control particles: not built yet, each fails naming what brings it.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct ControlArgs {
     #[arg(long, value_enum)]
     pub placement: Option<Placement>,
     #[arg(long, value_enum)]
@@ -127,32 +192,64 @@ pub struct Switches {
     pub adaptive: Option<OnOff>,
     #[arg(long, value_enum)]
     pub bone_weights: Option<BoneWeights>,
-    /// How `run` draws particles: ray-marched metaballs (default for SPH scenes) or spheres
-    #[arg(long, value_enum)]
-    pub render: Option<RenderKind>,
-    /// Equirectangular sky image (PNG, JPEG, ...) instead of the procedural sky
-    #[arg(long, value_name = "FILE")]
-    pub sky: Option<String>,
-    /// Secondary-ray samples off screen: use every metaball (all) or end the path (end)
-    #[arg(long, value_enum)]
-    pub offscreen: Option<Offscreen>,
-    /// S-buffer ranges sorted by depth, so each sample reads only the metaballs within R of
-    /// its depth (default: on for glass and tinted; off: the thesis's unsorted S-buffer)
-    #[arg(long, value_enum)]
-    pub list_sort: Option<OnOff>,
-    /// Camera position x,y,z (overrides the scene's)
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
-    pub eye: Option<[f32; 3]>,
-    /// Camera target x,y,z (overrides the scene's)
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3)]
-    pub target: Option<[f32; 3]>,
-    /// Vertical field of view in degrees
-    #[arg(long, value_parser = parse_fov)]
-    pub fov: Option<f32>,
-    /// Override a fluid parameter of an SPH scene, e.g. --fluid viscosity=1.5
-    /// --fluid eos=tait (repeatable; the keys of a scene file's [fluid] table)
-    #[arg(long = "fluid", value_name = "KEY=VALUE")]
-    pub fluid: Vec<String>,
+}
+
+/// Every switch of DESIGN.md's command line, grouped per subsystem. `run` takes all of
+/// them (its scene is chosen at run time, so `reject_unimplemented` refuses those a scene
+/// does not use); each `bench` takes only its groups, so the parser refuses the others.
+/// Unset optional switches take the default of whatever uses them; `config.switches` in
+/// summary.json (flat) records what was used.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct Switches {
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub common: CommonArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub frame: FrameArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub sorting: SortArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub search: NeighborArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub fluid_args: FluidArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub view: ViewArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub metaball: MetaballArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub camera: CameraArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub control: ControlArgs,
+}
+
+impl Default for CommonArgs {
+    /// The parser's defaults.
+    fn default() -> Self {
+        Self {
+            device: None,
+            validation: false,
+            seed: 1,
+            particles: None,
+        }
+    }
+}
+
+impl Default for FrameArgs {
+    /// The parser's defaults.
+    fn default() -> Self {
+        Self {
+            width: 512,
+            height: 512,
+        }
+    }
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<[f32; 3], String> {
@@ -181,7 +278,7 @@ impl Switches {
     /// Fail for every set switch that `supported` does not list, naming the feature that
     /// will bring it: a switch never silently does nothing.
     pub fn reject_unimplemented(&self, what: &str, supported: &[&str]) -> Result<()> {
-        if !self.fluid.is_empty() && !supported.contains(&"fluid") {
+        if !self.fluid_args.fluid.is_empty() && !supported.contains(&"fluid") {
             return Err(Error::Unsupported(format!(
                 "--fluid does not apply to {what}: it sets SPH parameters (run with an SPH scene, bench sph, bench stability)"
             )));
@@ -190,68 +287,72 @@ impl Switches {
         let elsewhere: [(&str, bool, &str); 16] = [
             (
                 "sort",
-                self.sort.is_some(),
+                self.sorting.sort.is_some(),
                 "neighbour search (SPH scenes, bench sort/neighbors/sph)",
             ),
             (
                 "neighbors",
-                self.neighbors.is_some(),
+                self.search.neighbors.is_some(),
                 "neighbour search (SPH scenes, bench neighbors/sph)",
             ),
             (
                 "list",
-                self.list.is_some(),
+                self.metaball.list.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "density",
-                self.density.is_some(),
+                self.metaball.density.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "threshold",
-                self.threshold.is_some(),
+                self.metaball.threshold.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "radius",
-                self.radius.is_some(),
+                self.metaball.radius.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "refine",
-                self.refine.is_some(),
+                self.metaball.refine.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "depth",
-                self.depth.is_some(),
+                self.metaball.depth.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "material",
-                self.material.is_some(),
+                self.metaball.material.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "sky",
-                self.sky.is_some(),
+                self.metaball.sky.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "offscreen",
-                self.offscreen.is_some(),
+                self.metaball.offscreen.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
             (
                 "list-sort",
-                self.list_sort.is_some(),
+                self.metaball.list_sort.is_some(),
                 "the metaball renderer (SPH scenes, bench render)",
             ),
-            ("render", self.render.is_some(), "run with an SPH scene"),
-            ("eye", self.eye.is_some(), "rendered scenes"),
-            ("target", self.target.is_some(), "rendered scenes"),
-            ("fov", self.fov.is_some(), "rendered scenes"),
+            (
+                "render",
+                self.view.render.is_some(),
+                "run with an SPH scene",
+            ),
+            ("eye", self.camera.eye.is_some(), "rendered scenes"),
+            ("target", self.camera.target.is_some(), "rendered scenes"),
+            ("fov", self.camera.fov.is_some(), "rendered scenes"),
         ];
         for (name, is_set, owner) in elsewhere {
             if is_set && !supported.contains(&name) {
@@ -261,17 +362,29 @@ impl Switches {
             }
         }
         let later: [(&str, bool, &str); 5] = [
-            ("placement", self.placement.is_some(), "control particles"),
-            ("skinning", self.skinning.is_some(), "character skinning"),
             (
-                "control-pressure",
-                self.control_pressure.is_some(),
+                "placement",
+                self.control.placement.is_some(),
                 "control particles",
             ),
-            ("adaptive", self.adaptive.is_some(), "control particles"),
+            (
+                "skinning",
+                self.control.skinning.is_some(),
+                "character skinning",
+            ),
+            (
+                "control-pressure",
+                self.control.control_pressure.is_some(),
+                "control particles",
+            ),
+            (
+                "adaptive",
+                self.control.adaptive.is_some(),
+                "control particles",
+            ),
             (
                 "bone-weights",
-                self.bone_weights.is_some(),
+                self.control.bone_weights.is_some(),
                 "control particles",
             ),
         ];

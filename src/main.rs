@@ -1,7 +1,9 @@
 //! The command line: devices | run | bench | experiment.
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
-use fluidform::config::Switches;
+use fluidform::config::{
+    CameraArgs, CommonArgs, FluidArgs, FrameArgs, MetaballArgs, NeighborArgs, SortArgs, Switches,
+};
 use fluidform::gpu::list_devices;
 use fluidform::run::{run, RunOptions, DEFAULT_SCENE};
 use std::path::PathBuf;
@@ -47,23 +49,21 @@ enum Command {
         #[command(flatten)]
         switches: Switches,
     },
-    /// Benchmark an algorithm: scan, sort, neighbors, sph, stability, render.
-    /// Without --particles it sweeps N = 8K..1M (scan adds 16M).
+    /// Benchmark an algorithm. Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
-        what: String,
-        #[arg(long, default_value = "out/bench")]
+        #[command(subcommand)]
+        what: BenchWhat,
+        #[arg(long, global = true, default_value = "out/bench")]
         out: PathBuf,
         /// Timed repetitions per configuration
-        #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..))]
+        #[arg(long, global = true, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..))]
         frames: u64,
         /// Untimed warm-up repetitions
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, global = true, default_value_t = 5)]
         warmup: u64,
         /// Seconds one configuration may take; slower ones get fewer repetitions (>= 3)
-        #[arg(long, default_value_t = 300.0)]
+        #[arg(long, global = true, default_value_t = 300.0)]
         budget_s: f64,
-        #[command(flatten)]
-        switches: Switches,
     },
     /// Reproduce a table of the papers
     Experiment {
@@ -71,6 +71,141 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+}
+
+/// The benchmarks, each with only the switches it uses.
+#[derive(Subcommand)]
+enum BenchWhat {
+    /// Exclusive scan of u32, beside a copy of the same bytes
+    Scan {
+        #[command(flatten)]
+        common: CommonArgs,
+    },
+    /// Key/value sorts: odd-even merge, bitonic, counting (or --sort)
+    Sort {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+    },
+    /// Fixed-radius neighbour search per strategy (or --neighbors, --sort)
+    Neighbors {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+        #[command(flatten)]
+        search: NeighborArgs,
+    },
+    /// One SPH step of the dam break scaled to N, per neighbour strategy
+    Sph {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+        #[command(flatten)]
+        search: NeighborArgs,
+        #[command(flatten)]
+        fluid_args: FluidArgs,
+    },
+    /// The 32K dam break for 10 000 steps, with physics checkpoints
+    Stability {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+        #[command(flatten)]
+        search: NeighborArgs,
+        #[command(flatten)]
+        fluid_args: FluidArgs,
+    },
+    /// The metaball renderer on a resting blob, per list (or --list)
+    Render {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        metaball: MetaballArgs,
+        #[command(flatten)]
+        camera: CameraArgs,
+    },
+}
+
+impl BenchWhat {
+    /// The benchmark's name and its switches (groups it does not take at their defaults).
+    fn into_parts(self) -> (&'static str, Switches) {
+        let d = Switches::default;
+        match self {
+            BenchWhat::Scan { common } => ("scan", Switches { common, ..d() }),
+            BenchWhat::Sort { common, sorting } => (
+                "sort",
+                Switches {
+                    common,
+                    sorting,
+                    ..d()
+                },
+            ),
+            BenchWhat::Neighbors {
+                common,
+                sorting,
+                search,
+            } => (
+                "neighbors",
+                Switches {
+                    common,
+                    sorting,
+                    search,
+                    ..d()
+                },
+            ),
+            BenchWhat::Sph {
+                common,
+                sorting,
+                search,
+                fluid_args,
+            } => (
+                "sph",
+                Switches {
+                    common,
+                    sorting,
+                    search,
+                    fluid_args,
+                    ..d()
+                },
+            ),
+            BenchWhat::Stability {
+                common,
+                sorting,
+                search,
+                fluid_args,
+            } => (
+                "stability",
+                Switches {
+                    common,
+                    sorting,
+                    search,
+                    fluid_args,
+                    ..d()
+                },
+            ),
+            BenchWhat::Render {
+                common,
+                frame,
+                metaball,
+                camera,
+            } => (
+                "render",
+                Switches {
+                    common,
+                    frame,
+                    metaball,
+                    camera,
+                    ..d()
+                },
+            ),
+        }
+    }
 }
 
 fn main() -> Result<()> {
@@ -116,10 +251,10 @@ fn main() -> Result<()> {
             frames,
             warmup,
             budget_s,
-            switches,
         } => {
+            let (what, switches) = what.into_parts();
             let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
-                what,
+                what: what.to_string(),
                 out: out.clone(),
                 frames,
                 warmup,
@@ -165,28 +300,21 @@ fn devices(json: bool) -> Result<()> {
     Ok(())
 }
 
-fn print_summary(s: &serde_json::Value, out: &std::path::Path) {
+fn print_summary(s: &fluidform::run::RunSummary, out: &std::path::Path) {
     println!(
         "device: {}  frames: {}  GPU frame median {:.3} ms",
-        s["device"]["name"].as_str().unwrap_or("?"),
-        s["frames"],
-        s["frame_ms"]["median"].as_f64().unwrap_or(f64::NAN)
+        s.device.name,
+        s.frames,
+        s.frame_ms.map(|f| f.median).unwrap_or(f64::NAN)
     );
-    if let Some(passes) = s["pass_ms"].as_object() {
-        for (name, st) in passes {
-            println!(
-                "  {name:<12} median {:8.3} ms  min {:8.3}  max {:8.3}",
-                st["median"].as_f64().unwrap_or(f64::NAN),
-                st["min"].as_f64().unwrap_or(f64::NAN),
-                st["max"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
-    }
-    if let Some(v) = s.get("validation") {
+    for (name, st) in &s.pass_ms.0 {
         println!(
-            "validation: {} errors, {} warnings",
-            v["errors"], v["warnings"]
+            "  {name:<24} median {:8.3} ms  min {:8.3}  max {:8.3}",
+            st.median, st.min, st.max
         );
+    }
+    if let Some(v) = &s.validation {
+        println!("validation: {} errors, {} warnings", v.errors, v.warnings);
     }
     println!("wrote {}", out.display());
 }

@@ -1,12 +1,11 @@
 //! Output contract (DESIGN.md): timings.csv (frame,pass,ms) and summary.json.
 use crate::error::{Error, Result};
 use crate::gpu::{DeviceInfo, FrameTiming};
-use serde::Serialize;
-use serde_json::{json, Map, Value};
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Stat {
     pub median: f64,
     pub min: f64,
@@ -55,8 +54,95 @@ pub fn pass_stats(timings: &[FrameTiming]) -> Vec<(String, Stat)> {
         .collect()
 }
 
-pub fn device_json(d: &DeviceInfo) -> Value {
-    json!({ "name": d.name, "type": d.kind, "driver": d.driver, "api": d.api })
+/// `device` in summary.json.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DeviceSummary {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub driver: String,
+    pub api: String,
+}
+
+impl DeviceSummary {
+    pub fn of(d: &DeviceInfo) -> Self {
+        Self {
+            name: d.name.clone(),
+            kind: d.kind.clone(),
+            driver: d.driver.clone(),
+            api: d.api.clone(),
+        }
+    }
+}
+
+/// `validation` in summary.json.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ValidationCounts {
+    pub errors: u32,
+    pub warnings: u32,
+}
+
+/// `pass_ms`: per-pass statistics by scope key, in the order the passes first ran.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PassTimes(pub Vec<(String, Stat)>);
+
+impl PassTimes {
+    pub fn get(&self, key: &str) -> Option<&Stat> {
+        self.0.iter().find(|(k, _)| k == key).map(|(_, s)| s)
+    }
+}
+
+impl Serialize for PassTimes {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for (k, v) in &self.0 {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for PassTimes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = PassTimes;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a map of pass keys to statistics")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> std::result::Result<PassTimes, A::Error> {
+                let mut v = Vec::new();
+                while let Some(e) = a.next_entry::<String, Stat>()? {
+                    v.push(e);
+                }
+                Ok(PassTimes(v))
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+/// summary.json (DESIGN.md's output contract): `C` the command's configuration, `S` its
+/// area's statistics.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary<C, S> {
+    pub device: DeviceSummary,
+    pub config: C,
+    pub frames: usize,
+    pub pass_ms: PassTimes,
+    pub frame_ms: Option<Stat>,
+    /// 1000 / median GPU frame time.
+    pub fps: Option<f64>,
+    pub memory_bytes: BTreeMap<String, u64>,
+    pub stats: S,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timing_caveat: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation: Option<ValidationCounts>,
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
@@ -67,57 +153,48 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
 }
 
 /// What one `run` or `bench` measured.
-pub struct Report<'a> {
+pub struct Report<'a, C, S> {
     pub device: &'a DeviceInfo,
-    pub config: Value,
+    pub config: C,
     pub timings: &'a [FrameTiming],
     pub memory: BTreeMap<String, u64>,
-    pub stats: Value,
+    pub stats: S,
     pub validation: Option<(u32, u32)>,
 }
 
-impl Report<'_> {
-    pub fn summary(&self) -> Value {
-        let mut pass_ms = Map::new();
-        for (name, s) in pass_stats(self.timings) {
-            pass_ms.insert(name, json!(s));
-        }
+impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
+    pub fn summary(&self) -> Summary<C, S> {
         let frame: Vec<f64> = self.timings.iter().map(|t| t.frame_ms).collect();
         let frame_ms = stat(&frame);
-        let fps = frame_ms
-            .filter(|s| s.median > 0.0)
-            .map(|s| 1000.0 / s.median);
-        let mut v = json!({
-            "device": device_json(self.device),
-            "config": self.config,
-            "frames": self.timings.len(),
-            "pass_ms": pass_ms,
-            "frame_ms": frame_ms,
-            "fps": fps,
-            "memory_bytes": self.memory,
-            "stats": self.stats,
-        });
-        if self.device.name.contains("llvmpipe")
-            && self
-                .timings
-                .iter()
-                .any(|t| t.passes.iter().any(|(n, _)| n == "draw"))
-        {
+        let drew = self
+            .timings
+            .iter()
+            .any(|t| t.passes.iter().any(|(n, _)| n == "draw"));
+        Summary {
+            device: DeviceSummary::of(self.device),
+            config: self.config.clone(),
+            frames: self.timings.len(),
+            pass_ms: PassTimes(pass_stats(self.timings)),
+            frame_ms,
+            fps: frame_ms
+                .filter(|s| s.median > 0.0)
+                .map(|s| 1000.0 / s.median),
+            memory_bytes: self.memory.clone(),
+            stats: self.stats.clone(),
             // Measured here: once a framebuffer is bound, llvmpipe resolves some later
             // timestamps inside its rasterizer scene, so compute scopes of frames after a
             // draw can read near zero while frame_ms stays right.
-            v["timing_caveat"] = json!(
-                "llvmpipe: per-pass compute times after a draw are unreliable (frame_ms is right); use `fluidform bench` for per-pass times"
-            );
+            timing_caveat: (self.device.name.contains("llvmpipe") && drew).then(|| {
+                "llvmpipe: per-pass compute times after a draw are unreliable (frame_ms is right); use `fluidform bench` for per-pass times".to_string()
+            }),
+            validation: self
+                .validation
+                .map(|(errors, warnings)| ValidationCounts { errors, warnings }),
         }
-        if let Some((errors, warnings)) = self.validation {
-            v["validation"] = json!({ "errors": errors, "warnings": warnings });
-        }
-        v
     }
 
     /// Write timings.csv and summary.json into `dir` (created if missing).
-    pub fn write(&self, dir: &Path) -> Result<Value> {
+    pub fn write(&self, dir: &Path) -> Result<Summary<C, S>> {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let csv_path = dir.join("timings.csv");
         let mut w = csv::Writer::from_path(&csv_path).map_err(|e| Error::Io {
@@ -141,7 +218,10 @@ impl Report<'_> {
         w.flush().map_err(io(&csv_path))?;
         let summary = self.summary();
         let path = dir.join("summary.json");
-        let text = serde_json::to_string_pretty(&summary).expect("json");
+        let text = serde_json::to_string_pretty(&summary).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            source: e.into(),
+        })?;
         std::fs::write(&path, text + "\n").map_err(io(&path))?;
         Ok(summary)
     }

@@ -1,15 +1,18 @@
 //! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
 //! Every scene kind is a `FrameWork` played by `session::play`.
 use crate::config::Switches;
+use crate::config::{Neighbors, RenderKind, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
 use crate::render::{points::PointsPush, Camera, PointsView};
-use crate::report::Report;
+use crate::report::{Report, Summary};
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
 pub use crate::session::{camera_with_switches, check_validation, SLOTS};
 use crate::session::{open, play};
+use crate::sph::run::SphRunStats;
+use crate::sph::FluidParams;
 use ash::vk;
-use serde_json::json;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 pub struct RunOptions {
@@ -24,9 +27,44 @@ pub struct RunOptions {
 
 pub const DEFAULT_SCENE: &str = "dam-break";
 
+/// `config` of a run's summary.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunConfig {
+    pub command: String,
+    pub scene: String,
+    pub frames: u64,
+    pub save_every: u64,
+    pub particles: u64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub neighbors: Option<Neighbors>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sort: Option<SortAlgo>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub render: Option<RenderKind>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fluid: Option<FluidParams>,
+    pub switches: Switches,
+}
+
+/// `stats` of the orbits scene.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct OrbitsStats {
+    pub particles: u32,
+}
+
+/// `stats` of a run, by scene kind.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum RunStats {
+    Sph(Box<SphRunStats>),
+    Orbits(OrbitsStats),
+}
+
+pub type RunSummary = Summary<RunConfig, RunStats>;
+
 /// The run's outcome: the summary written and the frames saved.
 pub struct RunResult {
-    pub summary: serde_json::Value,
+    pub summary: RunSummary,
     pub pngs: Vec<PathBuf>,
 }
 
@@ -125,19 +163,19 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     let sw = &opts.switches;
     sw.reject_unimplemented("the orbits scene", &[])?;
     let ctx = open(sw)?;
-    let particles = sw.particles.unwrap_or(4096);
+    let particles = sw.common.particles.unwrap_or(4096);
     let frame_count = opts.frames.unwrap_or(120);
-    let state = orbits::initial_state(particles as usize, sw.seed);
+    let state = orbits::initial_state(particles as usize, sw.common.seed);
     let cam = Camera::look_at(
         glam::Vec3::new(0.0, 0.8, 3.2),
         glam::Vec3::ZERO,
         45.0,
-        sw.width as f32 / sw.height as f32,
+        sw.frame.width as f32 / sw.frame.height as f32,
     );
     let pass = Guard::new(&ctx, OrbitsPass::new(&ctx)?);
     let view = Guard::new(&ctx, PointsView::new(&ctx)?);
     let scene = Guard::new(&ctx, Orbits::new(&ctx, &state)?);
-    let target = ColorTarget::new(&ctx, sw.width, sw.height, SLOTS)?;
+    let target = ColorTarget::new(&ctx, sw.frame.width, sw.frame.height, SLOTS)?;
     let mut work = OrbitsWork {
         pass: pass.take(),
         view: view.take(),
@@ -154,21 +192,25 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     let timings = play(&ctx, frame_count, &mut work);
     work.destroy(&ctx);
     let timings = timings?;
-    let config = json!({
-        "command": "run",
-        "scene": opts.scene,
-        "frames": frame_count,
-        "save_every": opts.save_every,
-        "particles": particles,
-        "switches": sw,
-    });
+    let config = RunConfig {
+        command: "run".into(),
+        scene: opts.scene.clone(),
+        frames: frame_count,
+        save_every: opts.save_every,
+        particles: particles as u64,
+        neighbors: None,
+        sort: None,
+        render: None,
+        fluid: None,
+        switches: sw.clone(),
+    };
     let report = Report {
         device: &ctx.info,
         config,
         timings: &timings,
         memory,
-        stats: json!({ "particles": particles }),
-        validation: sw.validation.then(|| ctx.validation_counts()),
+        stats: RunStats::Orbits(OrbitsStats { particles }),
+        validation: sw.common.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;
     check_validation(&ctx)?;
@@ -227,12 +269,11 @@ impl SphWork<'_> {
 }
 
 fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
-    use crate::config::{Neighbors, RenderKind};
-    use crate::sph::run::{check, physics_stats, SphRunStats, Stepper};
+    use crate::sph::run::{check, physics_stats, Stepper};
     use crate::sph::SphSolver;
     use crate::viewer::{MetaballViewer, PointsViewer, View};
     let sw = &opts.switches;
-    let render = sw.render.unwrap_or(RenderKind::Metaballs);
+    let render = sw.view.render.unwrap_or(RenderKind::Metaballs);
     let mut allowed = vec!["sort", "neighbors", "fluid", "render"];
     allowed.extend(crate::config::CAMERA_SWITCHES);
     if render == RenderKind::Metaballs {
@@ -243,18 +284,18 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         &allowed,
     )?;
     let mut scene = scene;
-    scene.fluid = scene.fluid.with_overrides(&sw.fluid)?;
-    let scene = match sw.particles {
+    scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
+    let scene = match sw.common.particles {
         Some(n) => scene.with_particles(n),
         None => scene,
     };
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
-    let neighbors = sw.neighbors.unwrap_or(Neighbors::Grid);
-    let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sort)?);
-    let parts = scene.particles(sw.seed);
+    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+    let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
+    let parts = scene.particles(sw.common.seed);
     let st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
-    let aspect = sw.width as f32 / sw.height as f32;
+    let aspect = sw.frame.width as f32 / sw.frame.height as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
         None => {
@@ -319,29 +360,30 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         simulated_seconds,
         render: render_stats,
     };
-    let config = json!({
-        "command": "run",
-        "scene": scene.name,
-        "frames": frame_count,
-        "save_every": opts.save_every,
-        "particles": stats.physics.particles,
-        "neighbors": neighbors.as_str(),
-        "sort": sort.as_str(),
-        "render": render.as_str(),
-        "fluid": scene.fluid,
-        "switches": sw,
-    });
+    let config = RunConfig {
+        command: "run".into(),
+        scene: scene.name.clone(),
+        frames: frame_count,
+        save_every: opts.save_every,
+        particles: stats.physics.particles as u64,
+        neighbors: Some(neighbors),
+        sort: Some(sort),
+        render: Some(render),
+        fluid: Some(scene.fluid.clone()),
+        switches: sw.clone(),
+    };
+    let physics = stats.physics.clone();
     let report = Report {
         device: &ctx.info,
         config,
         timings: &timings,
         memory,
-        stats: serde_json::to_value(&stats).expect("stats serialise"),
-        validation: sw.validation.then(|| ctx.validation_counts()),
+        stats: RunStats::Sph(Box::new(stats)),
+        validation: sw.common.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;
     check_validation(&ctx)?;
-    check(&stats.physics)?;
+    check(&physics)?;
     Ok(RunResult {
         summary,
         pngs: work.frames.pngs,

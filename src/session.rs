@@ -10,8 +10,8 @@ pub const SLOTS: usize = 2;
 
 pub fn open(sw: &Switches) -> Result<Context> {
     Context::new(&ContextOptions {
-        device: sw.device.clone(),
-        validation: sw.validation,
+        device: sw.common.device.clone(),
+        validation: sw.common.validation,
     })
 }
 
@@ -32,13 +32,13 @@ pub fn check_validation(ctx: &Context) -> Result<()> {
 
 /// The camera with --eye, --target and --fov applied.
 pub fn camera_with_switches(mut cam: Camera, sw: &Switches) -> Camera {
-    if let Some(e) = sw.eye {
+    if let Some(e) = sw.camera.eye {
         cam.eye = e.into();
     }
-    if let Some(t) = sw.target {
+    if let Some(t) = sw.camera.target {
         cam.target = t.into();
     }
-    if let Some(f) = sw.fov {
+    if let Some(f) = sw.camera.fov {
         cam.fov_y_deg = f;
     }
     cam

@@ -64,7 +64,7 @@ impl PointsViewer {
         slots: usize,
     ) -> Result<Self> {
         let view = Guard::new(ctx, PointsView::new(ctx)?);
-        let target = ColorTarget::new(ctx, sw.width, sw.height, slots)?;
+        let target = ColorTarget::new(ctx, sw.frame.width, sw.frame.height, slots)?;
         Ok(Self {
             view: view.take(),
             target,
@@ -190,10 +190,7 @@ impl View for MetaballViewer {
         let mut st = self.renderer.frame_stats(&self.buffers, slot);
         if st.overflow > 0 {
             // Buffers of frames still in flight are about to be replaced.
-            unsafe { ctx.device.device_wait_idle() }.map_err(|e| crate::Error::Vulkan {
-                context: "wait idle before growing the lists".into(),
-                result: e,
-            })?;
+            ctx.wait_idle()?;
             let list = self.renderer.settings.list;
             self.buffers.grow(ctx, list, st.fragments)?;
             let (again, redos) = self.renderer.render_sync(

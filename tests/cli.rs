@@ -237,7 +237,19 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
             vec!["bench", "render", "--out", d, "--radius=-1"],
             "--radius must be positive",
         ),
-        (vec!["bench", "nothing", "--out", d], "unknown benchmark"),
+        (
+            vec!["bench", "nothing", "--out", d],
+            "unrecognized subcommand 'nothing'",
+        ),
+        // Each benchmark takes only its switches: the parser refuses the others.
+        (
+            vec!["bench", "sph", "--out", d, "--list", "sbuffer"],
+            "unexpected argument '--list'",
+        ),
+        (
+            vec!["bench", "scan", "--out", d, "--neighbors", "grid"],
+            "unexpected argument '--neighbors'",
+        ),
         (vec!["experiment", "table2"], "not implemented yet"),
     ] {
         let o = fluidform(&args);
@@ -248,8 +260,13 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
     }
 }
 
+/// The run's summary.json, also read back typed (the whole schema must parse).
 fn summary(dir: &std::path::Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let typed: fluidform::run::RunSummary =
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("typed summary: {e}\n{text}"));
+    assert_eq!(typed.frames as u64, typed.config.frames);
+    serde_json::from_str(&text).unwrap()
 }
 
 /// `run` with `args`, no frames saved, validation on, into `dir`: must succeed; the summary.

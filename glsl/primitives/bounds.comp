@@ -3,8 +3,8 @@
 // (min, max) pair; pass 1 (one workgroup) reduces those pairs to the final box.
 #include "common/index.glsl"
 layout(constant_id = 1) const uint ITEMS = 8;
-layout(std430, binding = BOUNDS_B_SRC) readonly buffer Src{ vec4 src[]; };  // binding 0: positions or pairs
-layout(std430, binding = BOUNDS_B_DST) writeonly buffer Dst{ vec4 dst[]; }; // binding 1: (min, max) pairs
+layout(std430, binding = BOUNDS_B_SRC) readonly buffer Src{ vec4 src[]; };  // positions or pairs
+layout(std430, binding = BOUNDS_B_DST) writeonly buffer Dst{ vec4 dst[]; };  // (min, max) pairs
 layout(push_constant) uniform Push { uint n; uint pairs; } pc;    // pairs: src holds pairs
 const float BIG = 3.402823e38;
 shared vec3 s_min[gl_WorkGroupSize.x];

@@ -3,9 +3,9 @@
 // the returned in-cell rank. Keys >= cells are clamped to the last cell and counted in
 // counts[cells] so the output is still a permutation and the misuse is reported.
 #include "common/index.glsl"
-layout(std430, binding = COUNT_B_KEYS) readonly buffer Keys { uint keys[]; };  // binding 0: cell keys
-layout(std430, binding = COUNT_B_COUNTS) buffer Counts { uint counts[]; };       // binding 1: cells + 1
-layout(std430, binding = COUNT_B_RANK) writeonly buffer Rank { uint rank[]; }; // binding 2: in-cell rank
+layout(std430, binding = COUNT_B_KEYS) readonly buffer Keys { uint keys[]; };  // cell keys
+layout(std430, binding = COUNT_B_COUNTS) buffer Counts { uint counts[]; };  // cells + 1
+layout(std430, binding = COUNT_B_RANK) writeonly buffer Rank { uint rank[]; };  // in-cell rank
 layout(push_constant) uniform Push { uint n; uint cells; } pc;
 void main() {
     uint i = global_id();

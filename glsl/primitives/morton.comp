@@ -2,10 +2,10 @@
 // Morton code of each position relative to the box from the bounds pass; value = index.
 #include "common/index.glsl"
 #include "morton.glsl"
-layout(std430, binding = MORTON_B_POS) readonly buffer Pos { vec4 pos[]; };     // binding 0: positions
-layout(std430, binding = MORTON_B_BOUNDS) readonly buffer Bounds { vec4 box[]; };     // binding 1: min, max
-layout(std430, binding = MORTON_B_KEYS) writeonly buffer Keys { uint keys[]; };  // binding 2: codes
-layout(std430, binding = MORTON_B_VALS) writeonly buffer Vals { uint vals[]; };  // binding 3: indices
+layout(std430, binding = MORTON_B_POS) readonly buffer Pos { vec4 pos[]; };  // positions
+layout(std430, binding = MORTON_B_BOUNDS) readonly buffer Bounds { vec4 box[]; };  // min, max
+layout(std430, binding = MORTON_B_KEYS) writeonly buffer Keys { uint keys[]; };  // codes
+layout(std430, binding = MORTON_B_VALS) writeonly buffer Vals { uint vals[]; };  // indices
 layout(push_constant) uniform Push { uint n; } pc;
 void main() {
     uint i = global_id();

@@ -4,9 +4,9 @@
 #include "nb_common.glsl"
 #define NB_CELL_ONLY
 #include "neighbors.glsl"
-layout(std430, binding = NBK_B_POS) readonly buffer Pos { vec4 pos[]; };     // binding 0: positions
-layout(std430, binding = NBK_B_KEYS) writeonly buffer Keys { uint keys[]; };  // binding 1: cell keys
-layout(std430, binding = NBK_B_VALS) writeonly buffer Vals { uint vals[]; };  // binding 2: indices
+layout(std430, binding = NBK_B_POS) readonly buffer Pos { vec4 pos[]; };  // positions
+layout(std430, binding = NBK_B_KEYS) writeonly buffer Keys { uint keys[]; };  // cell keys
+layout(std430, binding = NBK_B_VALS) writeonly buffer Vals { uint vals[]; };  // indices
 void main() {
     uint i = global_id();
     if (i >= pc.n) return;

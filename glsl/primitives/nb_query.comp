@@ -9,10 +9,10 @@
 #define NB_B_END NBQ_B_NB_END
 #define NB_B_BOX NBQ_B_NB_BOX
 #include "neighbors.glsl"
-layout(std430, binding = NBQ_B_POS) readonly buffer Pos { vec4 pos[]; };        // binding 0: sorted positions
-layout(std430, binding = NBQ_B_COUNTS) writeonly buffer Counts { uint counts[]; };    // binding 5
-layout(std430, binding = NBQ_B_LIST) writeonly buffer List { uint list[]; };     // binding 6
-layout(std430, binding = NBQ_B_VISITED) writeonly buffer Visited { uint visited[]; };   // binding 7
+layout(std430, binding = NBQ_B_POS) readonly buffer Pos { vec4 pos[]; };  // sorted positions
+layout(std430, binding = NBQ_B_COUNTS) writeonly buffer Counts { uint counts[]; };
+layout(std430, binding = NBQ_B_LIST) writeonly buffer List { uint list[]; };
+layout(std430, binding = NBQ_B_VISITED) writeonly buffer Visited { uint visited[]; };
 void main() {
     uint i = global_id();
     if (i >= pc.n) return;

@@ -9,15 +9,8 @@
 #ifndef PRIMITIVES_NEIGHBORS_GLSL
 #define PRIMITIVES_NEIGHBORS_GLSL
 #extension GL_EXT_control_flow_attributes : require
-#define NB_GRID 0
-#define NB_HASH 1
-#define NB_MORTON 2
-#ifndef NB_STRATEGY
-#define NB_STRATEGY NB_GRID
-#endif
-#ifndef NB_CELL_COUNTS
-#define NB_CELL_COUNTS 0
-#endif
+// NB_GRID, NB_HASH, NB_MORTON, NB_STRATEGY and NB_CELL_COUNTS come from
+// NeighborSearch::defines_for in src/primitives/neighbors.rs.
 #include "morton.glsl"
 
 ivec3 nb_cell_of(vec3 p) { return ivec3(floor((p - NB_ORIGIN) / NB_CELL)); }

@@ -2,12 +2,12 @@
 // Counting sort pass 3: element i goes to start[key] + rank: sorted keys and the
 // permutation (sorted slot -> value of the element, its original index by default).
 #include "common/index.glsl"
-layout(std430, binding = SCATTER_B_KEYS) readonly buffer Keys { uint keys[]; };     // binding 0: keys
-layout(std430, binding = SCATTER_B_RANK) readonly buffer Rank { uint rank[]; };     // binding 1: in-cell rank
-layout(std430, binding = SCATTER_B_STARTS) readonly buffer Starts { uint starts[]; }; // binding 2: cell starts
-layout(std430, binding = SCATTER_B_VALS) readonly buffer Vals { uint vals[]; };     // binding 3: values
-layout(std430, binding = SCATTER_B_SORTED_KEYS) writeonly buffer SortedKeys { uint sorted_keys[]; };  // binding 4
-layout(std430, binding = SCATTER_B_SORTED_VALS) writeonly buffer SortedVals { uint sorted_vals[]; };  // binding 5
+layout(std430, binding = SCATTER_B_KEYS) readonly buffer Keys { uint keys[]; };  // keys
+layout(std430, binding = SCATTER_B_RANK) readonly buffer Rank { uint rank[]; };  // in-cell rank
+layout(std430, binding = SCATTER_B_STARTS) readonly buffer Starts { uint starts[]; };  // cell starts
+layout(std430, binding = SCATTER_B_VALS) readonly buffer Vals { uint vals[]; };  // values
+layout(std430, binding = SCATTER_B_SORTED_KEYS) writeonly buffer SortedKeys { uint sorted_keys[]; };
+layout(std430, binding = SCATTER_B_SORTED_VALS) writeonly buffer SortedVals { uint sorted_vals[]; };
 layout(push_constant) uniform Push { uint n; uint cells; } pc;
 void main() {
     uint i = global_id();

@@ -4,8 +4,8 @@
 #ifndef PRIMITIVES_SORT_COMMON_GLSL
 #define PRIMITIVES_SORT_COMMON_GLSL
 layout(constant_id = 1) const uint BLOCK = 2048;  // elements per shared-memory tile
-layout(std430, binding = SORT_B_KEYS) buffer Keys { uint keys[]; };  // binding 0: keys
-layout(std430, binding = SORT_B_VALS) buffer Vals { uint vals[]; };  // binding 1: values
+layout(std430, binding = SORT_B_KEYS) buffer Keys { uint keys[]; };  // keys
+layout(std430, binding = SORT_B_VALS) buffer Vals { uint vals[]; };  // values
 layout(push_constant) uniform Push { uint n; uint p; uint k; uint mode; } pc;
 const uint MODE_LOCAL_SORT = 0u, MODE_GLOBAL = 1u, MODE_LOCAL_MERGE = 2u;
 

@@ -1,7 +1,7 @@
 #version 450
 // Particle view: one camera-facing quad per particle (6 vertices, no vertex buffer).
-layout(std430, binding = PTS_B_POS) readonly buffer Pos { vec4 pos[]; };    // binding 0: xyz, w = radius or 0
-layout(std430, binding = PTS_B_COLOR) readonly buffer Color { vec4 color[]; };  // binding 1: rgba
+layout(std430, binding = PTS_B_POS) readonly buffer Pos { vec4 pos[]; };  // xyz, w = radius or 0
+layout(std430, binding = PTS_B_COLOR) readonly buffer Color { vec4 color[]; };  // rgba
 layout(push_constant) uniform Push {
     mat4 view_proj;
     vec4 right;  // camera right in world space, w = radius scale (the radius when pos.w = 0)

@@ -2,8 +2,8 @@
 // Test scene: particles fall towards an attractor at the origin (force ~ 1/(r^2 + eps),
 // the "local attractor" of seed 003), explicit Euler, reflected by the box [-1, 1]^3.
 #include "common/index.glsl"
-layout(std430, binding = ORB_B_POS) buffer Pos { vec4 pos[]; };  // binding 0: xyz, w = radius
-layout(std430, binding = ORB_B_VEL) buffer Vel { vec4 vel[]; };  // binding 1: xyz, w unused
+layout(std430, binding = ORB_B_POS) buffer Pos { vec4 pos[]; };  // xyz, w = radius
+layout(std430, binding = ORB_B_VEL) buffer Vel { vec4 vel[]; };  // xyz, w unused
 layout(push_constant) uniform Push { float dt; float strength; float eps; uint n; } pc;
 void main() {
     uint i = global_id();

@@ -1,9 +1,9 @@
 #version 450
 // Self-test of the compute path: y[i] = a * x[i] + y[i], plus an integer mix.
 #include "common/index.glsl"
-layout(std430, binding = 0) readonly buffer X { float x[]; };  // binding 0: x
-layout(std430, binding = 1) buffer Y { float y[]; };           // binding 1: y (in/out)
-layout(std430, binding = 2) buffer U { uint u[]; };            // binding 2: u (in/out)
+layout(std430, binding = 0) readonly buffer X { float x[]; };  // x
+layout(std430, binding = 1) buffer Y { float y[]; };  // y (in/out)
+layout(std430, binding = 2) buffer U { uint u[]; };  // u (in/out)
 layout(push_constant) uniform Push { float a; uint n; } pc;
 void main() {
     uint i = global_id();

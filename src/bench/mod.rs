@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler, RecordOnly};
 use crate::report::{stat, Report, Stat};
 use ash::vk;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::path::PathBuf;
 
 pub struct BenchOptions {
@@ -24,6 +24,24 @@ pub struct BenchOptions {
     pub budget_s: f64,
     pub switches: Switches,
 }
+
+/// `config` of one benchmark configuration's summary.json.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct BenchConfig {
+    pub command: String,
+    pub what: String,
+    pub variant: String,
+    pub n: u64,
+    pub frames: u64,
+    pub warmup: u64,
+    pub switches: Switches,
+    /// The benchmark's own description of the configuration (scene, sizes, settings).
+    pub detail: Value,
+}
+
+/// `stats` of a benchmark configuration: none beyond the timings.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct NoStats {}
 
 pub const WHATS: &[&str] = &["scan", "sort", "neighbors", "sph", "stability", "render"];
 
@@ -56,8 +74,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     }
     let sw = &opts.switches;
     let ctx = Context::new(&ContextOptions {
-        device: sw.device.clone(),
-        validation: sw.validation,
+        device: sw.common.device.clone(),
+        validation: sw.common.validation,
     })?;
     let rows = match opts.what.as_str() {
         "scan" => {
@@ -98,13 +116,13 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     };
     let notes = primitives::notes(&opts.what, &rows);
     write_sweep(&ctx, opts, &rows, &notes)?;
-    crate::run::check_validation(&ctx)?;
+    crate::session::check_validation(&ctx)?;
     Ok(rows)
 }
 
 /// Particle counts to measure: --particles, or the default sweep.
 pub fn counts(opts: &BenchOptions) -> Vec<u32> {
-    match opts.switches.particles {
+    match opts.switches.common.particles {
         Some(n) => vec![n],
         None => SWEEP.to_vec(),
     }
@@ -143,20 +161,24 @@ pub fn measure(
     let label = format!("{variant}-{n}");
     let report = Report {
         device: &ctx.info,
-        config: json!({
-            "command": "bench",
-            "what": opts.what,
-            "variant": variant,
-            "n": n,
-            "frames": reps,
-            "warmup": warmup + 1,
-            "switches": opts.switches,
-            "detail": config,
-        }),
+        config: BenchConfig {
+            command: "bench".into(),
+            what: opts.what.clone(),
+            variant: variant.to_string(),
+            n,
+            frames: reps,
+            warmup: warmup + 1,
+            switches: opts.switches.clone(),
+            detail: config,
+        },
         timings: &timings,
         memory: ctx.memory_bytes(),
-        stats: json!({}),
-        validation: opts.switches.validation.then(|| ctx.validation_counts()),
+        stats: NoStats {},
+        validation: opts
+            .switches
+            .common
+            .validation
+            .then(|| ctx.validation_counts()),
     };
     report.write(&opts.out.join("runs").join(&label))?;
     let passes = crate::report::pass_stats(&timings);

@@ -24,7 +24,7 @@ fn upload(ctx: &Context, name: &str, data: &[u32]) -> Result<Buffer> {
 /// Exclusive scan of N u32 beside a plain copy of the same bytes, in the same frame.
 pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut ns = counts(opts);
-    if opts.switches.particles.is_none() {
+    if opts.switches.common.particles.is_none() {
         ns.push(16 << 20);
     }
     let mut pass = ScanPass::new(ctx, ScanVariant::Auto)?;
@@ -35,7 +35,7 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     };
     let mut rows = Vec::new();
     for n in ns {
-        let mut rng = rand_pcg::Pcg32::seed_from_u64(opts.switches.seed);
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(opts.switches.common.seed);
         let data: Vec<u32> = (0..n).map(|_| rng.random_range(0..16)).collect();
         let mut input = upload(ctx, "bench scan input", &data)?;
         let mut output = ctx.storage_buffer("bench scan output", n as u64 * 4)?;
@@ -116,7 +116,7 @@ fn cell_keys(n: u32, seed: u64) -> (Vec<u32>, u32) {
 }
 
 pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
-    let algos = match opts.switches.sort {
+    let algos = match opts.switches.sorting.sort {
         Some(s) => vec![s],
         None => vec![SortAlgo::OddEven, SortAlgo::Bitonic, SortAlgo::Counting],
     };
@@ -130,7 +130,7 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             SortAlgo::Counting => None,
         };
         for n in counts(opts) {
-            let (keys, cells) = cell_keys(n, opts.switches.seed);
+            let (keys, cells) = cell_keys(n, opts.switches.common.seed);
             let vals: Vec<u32> = (0..n).collect();
             let bytes = n as u64 * 4;
             let mut pk = upload(ctx, "bench pristine keys", &keys)?;
@@ -191,8 +191,8 @@ pub fn radius_for(n: u32, k: f64) -> f32 {
 
 pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let sw = &opts.switches;
-    let combos: Vec<(Neighbors, SortAlgo)> = match sw.neighbors {
-        Some(s) => vec![(s, sw.sort.unwrap_or(default_sort(s)))],
+    let combos: Vec<(Neighbors, SortAlgo)> = match sw.search.neighbors {
+        Some(s) => vec![(s, sw.sorting.sort.unwrap_or(default_sort(s)))],
         None => vec![
             (Neighbors::Grid, SortAlgo::Counting),
             (Neighbors::Hash, SortAlgo::Bitonic),
@@ -206,7 +206,7 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         for n in counts(opts) {
             let radius = radius_for(n, 30.0);
             let grid = GridSpec::covering([0.0; 3], [1.0; 3], radius)?;
-            let mut rng = rand_pcg::Pcg32::seed_from_u64(sw.seed);
+            let mut rng = rand_pcg::Pcg32::seed_from_u64(sw.common.seed);
             let pos: Vec<[f32; 4]> = (0..n)
                 .map(|_| [rng.random(), rng.random(), rng.random(), 1.0])
                 .collect();

@@ -11,7 +11,7 @@ use serde_json::json;
 
 pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let sw = &opts.switches;
-    let n = sw.particles.unwrap_or(2048) as usize;
+    let n = sw.common.particles.unwrap_or(2048) as usize;
     let spacing = FluidParams::default().spacing();
     let pts = blob(n, spacing);
     let mut centers = ctx.storage_buffer("metaball centers", (n * 16) as u64)?;
@@ -19,7 +19,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     // (list, sorted): every list when --list is unset, the S-buffer both unsorted (the
     // thesis's) and sorted (ours) unless --list-sort picks one.
     let sorted = MetaballSettings::from_switches(sw)?.sorted;
-    let lists = match (sw.list, sw.list_sort) {
+    let lists = match (sw.metaball.list, sw.metaball.list_sort) {
         (Some(l), _) => vec![(l, sorted)],
         (None, Some(_)) => vec![
             (ListKind::None, false),
@@ -40,7 +40,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             settings.list = list;
             settings.sorted = sorted;
             let name = settings.list_name();
-            let cam = crate::run::camera_with_switches(
+            let cam = crate::session::camera_with_switches(
                 blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
                 sw,
             );

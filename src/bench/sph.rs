@@ -12,8 +12,8 @@ use serde_json::json;
 
 fn strategies(opts: &BenchOptions) -> Vec<(Neighbors, SortAlgo)> {
     let sw = &opts.switches;
-    match sw.neighbors {
-        Some(s) => vec![(s, sw.sort.unwrap_or(default_sort(s)))],
+    match sw.search.neighbors {
+        Some(s) => vec![(s, sw.sorting.sort.unwrap_or(default_sort(s)))],
         None => vec![
             (Neighbors::Grid, SortAlgo::Counting),
             (Neighbors::Hash, SortAlgo::Bitonic),
@@ -25,13 +25,13 @@ fn strategies(opts: &BenchOptions) -> Vec<(Neighbors, SortAlgo)> {
 /// One SPH step per frame on the dam break scaled to N particles.
 pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut base = Scene::built_in("dam-break").expect("built-in");
-    base.fluid = base.fluid.with_overrides(&opts.switches.fluid)?;
+    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args.fluid)?;
     let mut rows = Vec::new();
     for (strategy, sort) in strategies(opts) {
         let mut solver = SphSolver::new(ctx, strategy, Some(sort))?;
         for n in counts(opts) {
             let scene = base.with_particles(n);
-            let parts = scene.particles(opts.switches.seed);
+            let parts = scene.particles(opts.switches.common.seed);
             let mut st = solver.state(ctx, &scene, &parts)?;
             let actual = st.n as u64;
             let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
@@ -71,13 +71,15 @@ pub const STABILITY_STEPS: u64 = 10_000;
 /// the domain, the settled pool's mean density within 5% of rho_0.
 pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut scene = Scene::built_in("dam-break").expect("built-in");
-    scene.fluid = scene.fluid.with_overrides(&opts.switches.fluid)?;
-    if let Some(n) = opts.switches.particles {
+    scene.fluid = scene
+        .fluid
+        .with_overrides(&opts.switches.fluid_args.fluid)?;
+    if let Some(n) = opts.switches.common.particles {
         scene = scene.with_particles(n);
     }
     let (strategy, sort) = strategies(opts)[0];
     let mut solver = SphSolver::new(ctx, strategy, Some(sort))?;
-    let parts = scene.particles(opts.switches.seed);
+    let parts = scene.particles(opts.switches.common.seed);
     let mut st = solver.state(ctx, &scene, &parts)?;
     let per_frame = 50u64;
     let mut frames = FrameLoop::new(ctx, 2)?;

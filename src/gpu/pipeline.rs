@@ -359,10 +359,7 @@ impl<I: Interface> GraphicsPipeline<I> {
         let (set_layout, layout) = layouts(ctx, I::BINDINGS, push_size, stages_flags, d.name)?;
         let modules = shader_module(ctx, &spv[0], d.vertex).and_then(|v| {
             shader_module(ctx, &spv[1], d.fragment)
-                .map_err(|e| {
-                    unsafe { ctx.device.destroy_shader_module(v, None) };
-                    e
-                })
+                .inspect_err(|_| unsafe { ctx.device.destroy_shader_module(v, None) })
                 .map(|f| (v, f))
         });
         let (vsm, fsm) = match modules {

@@ -153,6 +153,12 @@ impl Context {
         }
     }
 
+    /// Wait until the device is idle (before replacing buffers frames in flight use).
+    pub fn wait_idle(&self) -> crate::error::Result<()> {
+        use crate::error::VkContext;
+        unsafe { self.device.device_wait_idle() }.ctx("wait for the device to be idle")
+    }
+
     /// End a dynamic-rendering scope.
     pub fn end_rendering(&self, cmd: vk::CommandBuffer) {
         unsafe { self.device.cmd_end_rendering(cmd) };

@@ -249,18 +249,26 @@ impl NeighborSearch {
     }
 
     pub fn defines_for(strategy: Neighbors, sort: SortAlgo) -> Vec<(&'static str, String)> {
-        let s = match strategy {
-            Neighbors::Grid => 0,
-            Neighbors::Hash => 1,
-            Neighbors::Morton => 2,
-        };
-        vec![
+        // The strategy's values, emitted for neighbors.glsl's #if chains.
+        let ids = [
+            (Neighbors::Grid, "NB_GRID"),
+            (Neighbors::Hash, "NB_HASH"),
+            (Neighbors::Morton, "NB_MORTON"),
+        ];
+        let mut d: Vec<(&'static str, String)> = ids
+            .iter()
+            .enumerate()
+            .map(|(i, (_, name))| (*name, i.to_string()))
+            .collect();
+        let s = ids.iter().position(|(k, _)| *k == strategy).unwrap_or(0);
+        d.extend([
             ("NB_STRATEGY", s.to_string()),
             (
                 "NB_CELL_COUNTS",
                 ((sort == SortAlgo::Counting) as u32).to_string(),
             ),
-        ]
+        ]);
+        d
     }
 
     /// Defines for shaders that include neighbors.glsl.

@@ -72,34 +72,38 @@ impl MetaballSettings {
     /// The thesis's defaults (Wyvill, T = 0.9, R = 0.04, I = 2, Phong, S-buffer),
     /// overridden by the switches that are set.
     pub fn from_switches(sw: &Switches) -> Result<Self> {
-        let radius = sw.radius.unwrap_or(0.04);
+        let radius = sw.metaball.radius.unwrap_or(0.04);
         let s = Self {
-            list: sw.list.unwrap_or(ListKind::Sbuffer),
-            density: sw.density.unwrap_or(DensityFn::Wyvill),
-            material: sw.material.unwrap_or(Material::Phong),
-            threshold: sw.threshold.unwrap_or(0.9),
+            list: sw.metaball.list.unwrap_or(ListKind::Sbuffer),
+            density: sw.metaball.density.unwrap_or(DensityFn::Wyvill),
+            material: sw.metaball.material.unwrap_or(Material::Phong),
+            threshold: sw.metaball.threshold.unwrap_or(0.9),
             radius,
-            refine: sw.refine.unwrap_or(2),
-            depth: sw.depth.unwrap_or(1),
+            refine: sw.metaball.refine.unwrap_or(2),
+            depth: sw.metaball.depth.unwrap_or(1),
             step: radius / 8.0,
             max_steps: 2048,
             offscreen_end: sw
+                .metaball
                 .offscreen
                 .map(|o| o == crate::config::Offscreen::End)
                 .unwrap_or(false),
             // Sorting pays where rays read the lists many times: inside glass and tinted.
-            sorted: match sw.list_sort {
+            sorted: match sw.metaball.list_sort {
                 Some(o) => o == crate::config::OnOff::On,
-                None => matches!(sw.material, Some(Material::Glass) | Some(Material::Tinted)),
+                None => matches!(
+                    sw.metaball.material,
+                    Some(Material::Glass) | Some(Material::Tinted)
+                ),
             },
-            width: sw.width,
-            height: sw.height,
+            width: sw.frame.width,
+            height: sw.frame.height,
             ior: 1.33,
             absorb: [6.0, 2.0, 0.8],
             base: [0.08, 0.06, 0.05],
-            sky: sw.sky.clone(),
+            sky: sw.metaball.sky.clone(),
         };
-        if sw.list_sort.is_some() && s.list != ListKind::Sbuffer {
+        if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
             return Err(Error::Param(format!(
                 "--list-sort applies to the S-buffer's contiguous ranges, not --list {}",
                 s.list.as_str()
