@@ -56,6 +56,16 @@ pub fn stage_of(path: &str) -> Result<shaderc::ShaderKind> {
 
 type Key = (String, Vec<(String, String)>);
 
+fn key(path: &str, defines: &[(&str, String)]) -> Key {
+    (
+        path.to_string(),
+        defines
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect(),
+    )
+}
+
 /// Compiles and caches SPIR-V per (file, defines).
 pub struct ShaderCompiler {
     compiler: Mutex<shaderc::Compiler>,
@@ -76,13 +86,7 @@ impl ShaderCompiler {
 
     /// Compile glsl/`path` with `#define NAME VALUE` for each define.
     pub fn compile(&self, path: &str, defines: &[(&str, String)]) -> Result<Arc<Vec<u32>>> {
-        let key: Key = (
-            path.to_string(),
-            defines
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.clone()))
-                .collect(),
-        );
+        let key = key(path, defines);
         if let Some(spv) = self.cache.lock().unwrap().get(&key) {
             return Ok(spv.clone());
         }
@@ -113,13 +117,7 @@ impl ShaderCompiler {
     /// the optimizer drops bindings a shader declares but does not use, and a pipeline is
     /// checked against everything its GLSL declares (gpu/interface.rs).
     pub fn declared(&self, path: &str, defines: &[(&str, String)]) -> Result<Arc<Reflected>> {
-        let key: Key = (
-            path.to_string(),
-            defines
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.clone()))
-                .collect(),
-        );
+        let key = key(path, defines);
         if let Some(r) = self.declared.lock().unwrap().get(&key) {
             return Ok(r.clone());
         }
