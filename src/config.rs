@@ -56,22 +56,6 @@ switch_enum!(BoneWeights { Eq8, Eq9 });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
 
-/// Switches of the metaball renderer (for `reject_unimplemented`).
-pub const METABALL_SWITCHES: &[&str] = &[
-    "list",
-    "density",
-    "threshold",
-    "radius",
-    "refine",
-    "depth",
-    "material",
-    "sky",
-    "offscreen",
-    "list-sort",
-];
-/// Camera switches of rendered scenes.
-pub const CAMERA_SWITCHES: &[&str] = &["eye", "target", "fov"];
-
 /// The device, validation, seed and size: every command takes these.
 #[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
 pub struct CommonArgs {
@@ -274,126 +258,78 @@ fn parse_fov(s: &str) -> std::result::Result<f32, String> {
     }
 }
 
+/// A switch group, for `Switches::reject_unused`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Group {
+    Sort,
+    Neighbors,
+    Fluid,
+    View,
+    Metaball,
+    Camera,
+}
+
+/// The switches of `g` that differ from the group's defaults, as written on the command
+/// line (`--list-sort`), found through the group's serialisation: adding a switch to a
+/// group needs no list here.
+fn set_in<T: Serialize + Default>(g: &T) -> Vec<String> {
+    let (now, default) = (serde_json::to_value(g), serde_json::to_value(T::default()));
+    let (Ok(serde_json::Value::Object(now)), Ok(serde_json::Value::Object(default))) =
+        (now, default)
+    else {
+        return Vec::new();
+    };
+    now.iter()
+        .filter(|(k, v)| default.get(*k) != Some(*v))
+        .map(|(k, _)| format!("--{}", k.replace('_', "-")))
+        .collect()
+}
+
 impl Switches {
-    /// Fail for every set switch that `supported` does not list, naming the feature that
-    /// will bring it: a switch never silently does nothing.
-    pub fn reject_unimplemented(&self, what: &str, supported: &[&str]) -> Result<()> {
-        if !self.fluid_args.fluid.is_empty() && !supported.contains(&"fluid") {
+    /// Fail for every set switch of a group that `what` does not use, naming where it
+    /// applies, and for every control switch (not built yet), naming what brings it: a
+    /// switch never silently does nothing. The common and frame groups always apply.
+    pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
+        let groups: [(Group, Vec<String>, &str); 6] = [
+            (
+                Group::Sort,
+                set_in(&self.sorting),
+                "neighbour search and sorts (SPH scenes, bench sort/neighbors/sph/stability)",
+            ),
+            (
+                Group::Neighbors,
+                set_in(&self.search),
+                "neighbour search (SPH scenes, bench neighbors/sph/stability)",
+            ),
+            (
+                Group::Fluid,
+                set_in(&self.fluid_args),
+                "SPH parameters (SPH scenes, bench sph/stability)",
+            ),
+            (Group::View, set_in(&self.view), "run with an SPH scene"),
+            (
+                Group::Metaball,
+                set_in(&self.metaball),
+                "the metaball renderer (SPH scenes drawn as metaballs, bench render)",
+            ),
+            (
+                Group::Camera,
+                set_in(&self.camera),
+                "rendered SPH scenes and bench render",
+            ),
+        ];
+        for (g, set, owner) in groups {
+            if let Some(name) = set.first().filter(|_| !uses.contains(&g)) {
+                return Err(Error::Unsupported(format!(
+                    "{name} does not apply to {what}: it is used by {owner}"
+                )));
+            }
+        }
+        if let Some(name) = set_in(&self.control).first() {
             return Err(Error::Unsupported(format!(
-                "--fluid does not apply to {what}: it sets SPH parameters (run with an SPH scene, bench sph, bench stability)"
+                "{name} is not implemented yet: it arrives with characters and control \
+                 particles (issues 12 and 13)"
             )));
-        }
-        // Built, but used elsewhere: (switch, set, where it applies).
-        let elsewhere: [(&str, bool, &str); 16] = [
-            (
-                "sort",
-                self.sorting.sort.is_some(),
-                "neighbour search (SPH scenes, bench sort/neighbors/sph)",
-            ),
-            (
-                "neighbors",
-                self.search.neighbors.is_some(),
-                "neighbour search (SPH scenes, bench neighbors/sph)",
-            ),
-            (
-                "list",
-                self.metaball.list.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "density",
-                self.metaball.density.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "threshold",
-                self.metaball.threshold.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "radius",
-                self.metaball.radius.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "refine",
-                self.metaball.refine.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "depth",
-                self.metaball.depth.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "material",
-                self.metaball.material.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "sky",
-                self.metaball.sky.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "offscreen",
-                self.metaball.offscreen.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "list-sort",
-                self.metaball.list_sort.is_some(),
-                "the metaball renderer (SPH scenes, bench render)",
-            ),
-            (
-                "render",
-                self.view.render.is_some(),
-                "run with an SPH scene",
-            ),
-            ("eye", self.camera.eye.is_some(), "rendered scenes"),
-            ("target", self.camera.target.is_some(), "rendered scenes"),
-            ("fov", self.camera.fov.is_some(), "rendered scenes"),
-        ];
-        for (name, is_set, owner) in elsewhere {
-            if is_set && !supported.contains(&name) {
-                return Err(Error::Unsupported(format!(
-                    "--{name} does not apply to {what}: it is used by {owner}"
-                )));
-            }
-        }
-        let later: [(&str, bool, &str); 5] = [
-            (
-                "placement",
-                self.control.placement.is_some(),
-                "control particles",
-            ),
-            (
-                "skinning",
-                self.control.skinning.is_some(),
-                "character skinning",
-            ),
-            (
-                "control-pressure",
-                self.control.control_pressure.is_some(),
-                "control particles",
-            ),
-            (
-                "adaptive",
-                self.control.adaptive.is_some(),
-                "control particles",
-            ),
-            (
-                "bone-weights",
-                self.control.bone_weights.is_some(),
-                "control particles",
-            ),
-        ];
-        for (name, is_set, owner) in later {
-            if is_set && !supported.contains(&name) {
-                return Err(Error::Unsupported(format!(
-                    "--{name} is not implemented yet: it arrives with {owner}"
-                )));
-            }
         }
         Ok(())
     }

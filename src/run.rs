@@ -161,7 +161,7 @@ impl OrbitsWork<'_> {
 
 fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     let sw = &opts.switches;
-    sw.reject_unimplemented("the orbits scene", &[])?;
+    sw.reject_unused("the orbits scene", &[])?;
     let ctx = open(sw)?;
     let particles = sw.common.particles.unwrap_or(4096);
     let frame_count = opts.frames.unwrap_or(120);
@@ -274,15 +274,18 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     use crate::viewer::{MetaballViewer, PointsViewer, View};
     let sw = &opts.switches;
     let render = sw.view.render.unwrap_or(RenderKind::Metaballs);
-    let mut allowed = vec!["sort", "neighbors", "fluid", "render"];
-    allowed.extend(crate::config::CAMERA_SWITCHES);
+    use crate::config::Group;
+    let mut uses = vec![
+        Group::Sort,
+        Group::Neighbors,
+        Group::Fluid,
+        Group::View,
+        Group::Camera,
+    ];
     if render == RenderKind::Metaballs {
-        allowed.extend(crate::config::METABALL_SWITCHES);
+        uses.push(Group::Metaball);
     }
-    sw.reject_unimplemented(
-        &format!("SPH scenes drawn as {}", render.as_str()),
-        &allowed,
-    )?;
+    sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     let mut scene = scene;
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
     let scene = match sw.common.particles {

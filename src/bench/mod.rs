@@ -5,7 +5,7 @@ pub mod primitives;
 pub mod render;
 pub mod sph;
 
-use crate::config::{Switches, CAMERA_SWITCHES, METABALL_SWITCHES};
+use crate::config::{Group, Switches};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler, RecordOnly};
 use crate::report::{stat, Report, Stat};
@@ -79,32 +79,30 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     })?;
     let rows = match opts.what.as_str() {
         "scan" => {
-            sw.reject_unimplemented("bench scan", &[])?;
+            sw.reject_unused("bench scan", &[])?;
             primitives::scan(&ctx, opts)?
         }
         "sort" => {
-            sw.reject_unimplemented("bench sort", &["sort"])?;
+            sw.reject_unused("bench sort", &[Group::Sort])?;
             primitives::sort(&ctx, opts)?
         }
         "neighbors" => {
-            sw.reject_unimplemented("bench neighbors", &["sort", "neighbors"])?;
+            sw.reject_unused("bench neighbors", &[Group::Sort, Group::Neighbors])?;
             primitives::neighbors(&ctx, opts)?
         }
         "sph" => {
-            sw.reject_unimplemented("bench sph", &["sort", "neighbors", "fluid"])?;
+            sw.reject_unused("bench sph", &[Group::Sort, Group::Neighbors, Group::Fluid])?;
             sph::steps(&ctx, opts)?
         }
         "stability" => {
-            sw.reject_unimplemented("bench stability", &["sort", "neighbors", "fluid"])?;
+            sw.reject_unused(
+                "bench stability",
+                &[Group::Sort, Group::Neighbors, Group::Fluid],
+            )?;
             sph::stability(&ctx, opts)?
         }
         "render" => {
-            let allowed: Vec<&str> = METABALL_SWITCHES
-                .iter()
-                .chain(CAMERA_SWITCHES)
-                .copied()
-                .collect();
-            sw.reject_unimplemented("bench render", &allowed)?;
+            sw.reject_unused("bench render", &[Group::Metaball, Group::Camera])?;
             render::render(&ctx, opts)?
         }
         other => {
