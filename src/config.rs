@@ -1,6 +1,6 @@
 //! Command-line switches shared by `run` and `bench` (names fixed by DESIGN.md).
 //! Values are closed enums so an unknown value is rejected by the parser; a switch whose
-//! algorithm is not built yet is rejected by `reject_unimplemented` with a clear message.
+//! algorithm is not built yet is rejected by `reject_unused` with a clear message.
 use crate::error::{Error, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -179,7 +179,7 @@ pub struct ControlArgs {
 }
 
 /// Every switch of DESIGN.md's command line, grouped per subsystem. `run` takes all of
-/// them (its scene is chosen at run time, so `reject_unimplemented` refuses those a scene
+/// them (its scene is chosen at run time, so `reject_unused` refuses those a scene
 /// does not use); each `bench` takes only its groups, so the parser refuses the others.
 /// Unset optional switches take the default of whatever uses them; `config.switches` in
 /// summary.json (flat) records what was used.

@@ -64,6 +64,22 @@ pub struct Checkpoint {
     pub physics: PhysicsStats,
 }
 
+/// stability.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StabilitySummary {
+    pub scene: String,
+    pub neighbors: Neighbors,
+    pub sort: SortAlgo,
+    pub particles: usize,
+    pub steps: u64,
+    pub dt: f32,
+    pub simulated_seconds: f64,
+    pub gpu_seconds: f64,
+    pub wall_seconds: f64,
+    pub checkpoints: Vec<Checkpoint>,
+    pub mean_density_within_5_percent: bool,
+}
+
 /// Steps the stability run takes.
 pub const STABILITY_STEPS: u64 = 10_000;
 
@@ -123,19 +139,19 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let ratio = last.density_mean_over_rest;
     let density_ok = (ratio - 1.0).abs() <= 0.05;
     let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
-    let summary = json!({
-        "scene": scene.name,
-        "neighbors": strategy.as_str(),
-        "sort": sort.as_str(),
-        "particles": last.particles,
-        "steps": STABILITY_STEPS,
-        "dt": scene.fluid.dt,
-        "simulated_seconds": STABILITY_STEPS as f64 * scene.fluid.dt as f64,
-        "gpu_seconds": gpu_ms / 1000.0,
-        "wall_seconds": started.elapsed().as_secs_f64(),
-        "checkpoints": checkpoints,
-        "mean_density_within_5_percent": density_ok,
-    });
+    let summary = StabilitySummary {
+        scene: scene.name.clone(),
+        neighbors: strategy,
+        sort,
+        particles: last.particles,
+        steps: STABILITY_STEPS,
+        dt: scene.fluid.dt,
+        simulated_seconds: STABILITY_STEPS as f64 * scene.fluid.dt as f64,
+        gpu_seconds: gpu_ms / 1000.0,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        checkpoints,
+        mean_density_within_5_percent: density_ok,
+    };
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
         path: opts.out.display().to_string(),
         source: e,
@@ -143,7 +159,10 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let path = opts.out.join("stability.json");
     std::fs::write(
         &path,
-        serde_json::to_string_pretty(&summary).expect("json") + "\n",
+        serde_json::to_string_pretty(&summary).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            source: e.into(),
+        })? + "\n",
     )
     .map_err(|e| Error::Io {
         path: path.display().to_string(),
