@@ -45,6 +45,12 @@ pub struct LiveCount {
 }
 const _: () = assert!(std::mem::size_of::<LiveCount>() == 32);
 
+/// Group counts split over y past 65535, as glsl/common/live_args.comp writes them.
+fn split_groups(total: u32) -> [u32; 3] {
+    let gx = total.min(crate::gpu::pipeline::MAX_GROUPS_X);
+    [gx, if gx == 0 { 1 } else { total.div_ceil(gx) }, 1]
+}
+
 impl LiveCount {
     /// Byte offset of the indirect-dispatch arguments.
     pub const ARGS_OFFSET: u64 = std::mem::offset_of!(LiveCount, groups) as u64;
@@ -174,7 +180,7 @@ impl ParticleStore {
             capacity: self.capacity as u32,
             local_size,
             pad: 0,
-            groups: [n.div_ceil(local_size.max(1)), 1, 1],
+            groups: split_groups(n.div_ceil(local_size.max(1))),
             pad2: 0,
         };
         ctx.upload(&mut self.count, 0, &[c])
@@ -210,8 +216,16 @@ impl ParticleStore {
         self.cur = b;
     }
 
-    /// Reallocate every attribute for `capacity` particles, keeping the live ones.
+    /// Reallocate every attribute for `capacity` particles, keeping the live ones. The
+    /// old buffers are destroyed: call it when no frame in flight uses them (after
+    /// `Context::wait_idle`).
     pub fn grow(&mut self, ctx: &Context, capacity: u64) -> Result<()> {
+        if capacity > u32::MAX as u64 {
+            return Err(Error::Param(format!(
+                "{}: particle capacity {capacity} over 2^32-1",
+                self.name
+            )));
+        }
         if capacity < self.live as u64 {
             return Err(Error::Param(format!(
                 "{}: cannot shrink below the {} live particles",

@@ -152,6 +152,9 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
     }
 }
 
+/// Scopes that rasterise (after which llvmpipe's compute timestamps are unreliable).
+pub const DRAW_SCOPES: &[&str] = &["points", "render/count", "render/fill"];
+
 /// What one `run` or `bench` measured.
 pub struct Report<'a, C, S> {
     pub device: &'a DeviceInfo,
@@ -166,10 +169,11 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
     pub fn summary(&self) -> Summary<C, S> {
         let frame: Vec<f64> = self.timings.iter().map(|t| t.frame_ms).collect();
         let frame_ms = stat(&frame);
-        let drew = self
-            .timings
-            .iter()
-            .any(|t| t.passes.iter().any(|(n, _)| n == "draw"));
+        let drew = self.timings.iter().any(|t| {
+            t.passes
+                .iter()
+                .any(|(n, _)| DRAW_SCOPES.contains(&n.as_str()))
+        });
         Summary {
             device: DeviceSummary::of(self.device),
             config: self.config.clone(),
@@ -224,5 +228,23 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
         })?;
         std::fs::write(&path, text + "\n").map_err(io(&path))?;
         Ok(summary)
+    }
+}
+
+/// JSON has no NaN or infinity: a non-finite value is written as null and read back as NaN,
+/// so a summary of a broken run still round-trips through its typed form.
+pub mod non_finite_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
     }
 }

@@ -46,8 +46,9 @@ pub struct RunConfig {
     pub switches: Switches,
 }
 
-/// `stats` of the orbits scene.
+/// `stats` of the orbits scene (strict, so an SPH block never reads back as this).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct OrbitsStats {
     pub particles: u32,
 }

@@ -2,7 +2,7 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
-use crate::gpu::{sync, Buffer, Context};
+use crate::gpu::{sync, Buffer, Context, Guard};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
@@ -210,11 +210,11 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let pos: Vec<[f32; 4]> = (0..n)
                 .map(|_| [rng.random(), rng.random(), rng.random(), 1.0])
                 .collect();
-            let mut p = ctx.storage_buffer("bench positions", n as u64 * 16)?;
+            let mut p = Guard::new(ctx, ctx.storage_buffer("bench positions", n as u64 * 16)?);
             ctx.upload(&mut p, 0, &pos)?;
             // Up to 64 listed neighbours, fewer where the lists would exceed one binding.
             let max_nb = (ctx.max_storage_range() / (n as u64 * 4)).min(64) as u32;
-            let mut b = search.buffers(ctx, n as u64, &grid, max_nb)?;
+            let b = Guard::new(ctx, search.buffers(ctx, n as u64, &grid, max_nb)?);
             let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
             let detail = json!({ "radius": radius, "grid": grid.dims, "max_neighbors": max_nb });
             let row = measure(
@@ -239,8 +239,8 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 let total = |x: &[u32]| x.iter().map(|&a| a as u64).sum::<u64>();
                 Ok((total(&c), total(&v) as f64 / n as f64))
             });
-            b.destroy(ctx);
-            ctx.destroy_buffer(&mut p);
+            drop(b);
+            drop(p);
             let mut row = row?;
             row.variant = variant;
             if let Some(s) = stats {

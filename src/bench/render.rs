@@ -4,7 +4,7 @@
 use super::{measure, BenchOptions, Row};
 use crate::config::ListKind;
 use crate::error::Result;
-use crate::gpu::Context;
+use crate::gpu::{Context, Guard};
 use crate::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
 use crate::sph::FluidParams;
 use serde_json::json;
@@ -44,8 +44,8 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
                 sw,
             );
-            let mut r = MetaballRenderer::new(ctx, settings.clone())?;
-            let mut b = r.buffers(ctx, n as u64, 2, false)?;
+            let r = Guard::new(ctx, MetaballRenderer::new(ctx, settings.clone())?);
+            let mut b = Guard::new(ctx, r.buffers(ctx, n as u64, 2, false)?);
             // Size the lists (and count the redos) before timing.
             let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0);
             let row = sized.and_then(|(st, redos)| {
@@ -82,8 +82,8 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 }
                 Ok(row)
             });
-            b.destroy(ctx);
-            r.destroy(ctx);
+            drop(b);
+            drop(r);
             rows.push(row?);
         }
         Ok(())

@@ -3,7 +3,7 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, FrameLoop, Labels, Profiler, RecordOnly};
+use crate::gpu::{Context, FrameLoop, Guard, Labels, Profiler, RecordOnly};
 use crate::primitives::neighbors::default_sort;
 use crate::sph::run::{check, physics_stats, PhysicsStats};
 use crate::sph::{Scene, SphSolver};
@@ -28,11 +28,12 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args.fluid)?;
     let mut rows = Vec::new();
     for (strategy, sort) in strategies(opts) {
-        let mut solver = SphSolver::new(ctx, strategy, Some(sort))?;
+        // Guards release the solver and state on every path, an early `?` included.
+        let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
         for n in counts(opts) {
             let scene = base.with_particles(n);
             let parts = scene.particles(opts.switches.common.seed);
-            let mut st = solver.state(ctx, &scene, &parts)?;
+            let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
             let actual = st.n as u64;
             let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
             let detail = json!({ "scene": "dam-break", "particles": actual, "dt": st.dt, "fluid": scene.fluid });
@@ -45,13 +46,12 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 detail,
                 |prof, cmd| solver.record_step(ctx, cmd, prof, &mut st),
             );
-            st.destroy(ctx);
+            drop(st);
             let mut row = row?;
             row.variant = variant;
             row.extra = vec![("steps/s".into(), format!("{:.1}", 1000.0 / row.main.median))];
             rows.push(row);
         }
-        solver.destroy(ctx);
     }
     Ok(rows)
 }
@@ -94,9 +94,9 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         scene = scene.with_particles(n);
     }
     let (strategy, sort) = strategies(opts)[0];
-    let mut solver = SphSolver::new(ctx, strategy, Some(sort))?;
+    let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
     let parts = scene.particles(opts.switches.common.seed);
-    let mut st = solver.state(ctx, &scene, &parts)?;
+    let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
     let per_frame = 50u64;
     let mut frames = FrameLoop::new(ctx, 2)?;
     let mut checkpoints: Vec<Checkpoint> = Vec::new();
@@ -129,8 +129,8 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     })();
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);
-    st.destroy(ctx);
-    solver.destroy(ctx);
+    drop(st);
+    drop(solver);
     result?;
     let last = checkpoints
         .last()

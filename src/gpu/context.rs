@@ -1,5 +1,6 @@
 //! The device owner: instance (with optional Khronos validation), physical-device choice,
-//! logical device, queue, allocator, shader compiler. The only GPU type that implements Drop.
+//! logical device, queue, allocator, shader compiler. The only GPU type that implements Drop
+//! (beside the construction guards of gpu/guard.rs).
 use super::device::{self, DeviceInfo};
 use super::instance::{create_instance, load_entry};
 use super::shader::ShaderCompiler;

@@ -54,6 +54,7 @@ impl FrameLoop {
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let pool = unsafe { ctx.device.create_command_pool(&info, None) }.ctx("frame pool")?;
+        ctx.count_object("command pool", 1);
         ctx.set_name(pool, "frame command pool");
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
@@ -74,6 +75,7 @@ impl FrameLoop {
                         .create_fence(&vk::FenceCreateInfo::default(), None)
                 }
                 .ctx("frame fence")?;
+                ctx.count_object("fence", 1);
                 ctx.set_name(cmd, &format!("frame slot {i}"));
                 ctx.set_name(fence, &format!("frame fence {i}"));
                 me.slots.push((cmd, fence, None));
@@ -111,7 +113,10 @@ impl FrameLoop {
             ctx.barrier(
                 cmd,
                 sync::COMPUTE_WRITE | sync::TRANSFER_WRITE | sync::FRAGMENT_WRITE,
-                sync::COMPUTE_READ | sync::TRANSFER_READ | sync::GRAPHICS_READ,
+                sync::COMPUTE_READ
+                    | sync::TRANSFER_READ
+                    | sync::GRAPHICS_READ
+                    | sync::INDIRECT_READ,
             );
             self.profiler.begin_frame(ctx, cmd, slot, frame);
             let recorded = work.record(ctx, cmd, &mut self.profiler, frame, slot);
@@ -148,8 +153,10 @@ impl FrameLoop {
             let _ = ctx.device.device_wait_idle();
             for (_, fence, _) in self.slots.drain(..) {
                 ctx.device.destroy_fence(fence, None);
+                ctx.count_object("fence", -1);
             }
             ctx.device.destroy_command_pool(self.pool, None);
+            ctx.count_object("command pool", -1);
         }
         self.profiler.destroy(ctx);
     }

@@ -14,6 +14,12 @@ impl Destroy for Buffer {
     }
 }
 
+impl Destroy for super::Image {
+    fn destroy(&mut self, ctx: &Context) {
+        ctx.destroy_image(self);
+    }
+}
+
 impl<T: Destroy> Destroy for Option<T> {
     fn destroy(&mut self, ctx: &Context) {
         if let Some(v) = self {

@@ -10,7 +10,8 @@ pub(crate) fn load_entry() -> Result<ash::Entry> {
     unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))
 }
 
-/// Create an instance; with `validation`, the Khronos layer and a messenger counting into `counts`.
+/// Create an instance; with `validation`, the Khronos layer with synchronization validation.
+/// Returns whether VK_EXT_debug_utils is on (the context adds its messenger).
 pub(crate) fn create_instance(
     entry: &ash::Entry,
     validation: bool,

@@ -284,11 +284,18 @@ impl Context {
                 )));
             }
         };
-        unsafe {
+        // A failed bind or view releases the image and its memory.
+        let release = |alloc| {
+            let _ = self.allocator().free(alloc);
+            unsafe { self.device.destroy_image(raw, None) };
+        };
+        if let Err(e) = unsafe {
             self.device
                 .bind_image_memory(raw, alloc.memory(), alloc.offset())
+        } {
+            release(alloc);
+            return Err(e).ctx(&format!("bind image '{name}'"));
         }
-        .ctx(&format!("bind image '{name}'"))?;
         let aspect = if format == vk::Format::D32_SFLOAT {
             vk::ImageAspectFlags::DEPTH
         } else {
@@ -299,9 +306,15 @@ impl Context {
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
             .subresource_range(subresource(aspect));
-        let view = unsafe { self.device.create_image_view(&view_info, None) }
-            .ctx(&format!("create view of '{name}'"))?;
+        let view = match unsafe { self.device.create_image_view(&view_info, None) } {
+            Ok(v) => v,
+            Err(e) => {
+                release(alloc);
+                return Err(e).ctx(&format!("create view of '{name}'"));
+            }
+        };
         self.set_name(raw, name);
+        self.count_object("image", 1);
         self.set_name(view, &format!("{name} view"));
         *self
             .memory
@@ -323,6 +336,7 @@ impl Context {
     pub fn destroy_image(&self, img: &mut Image) {
         if let Some(a) = img.alloc.take() {
             self.forget(&img.name, a.size());
+            self.count_object("image", -1);
             let _ = self.allocator().free(a);
             unsafe {
                 self.device.destroy_image_view(img.view, None);

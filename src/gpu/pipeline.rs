@@ -233,8 +233,7 @@ impl<I: Interface> ComputePipeline<I> {
         })
     }
 
-    /// Bind, push descriptors and constants, dispatch `groups` workgroups (split over y when
-    /// more than 65535; shaders linearise with `global_id()` from common/index.glsl).
+    /// Bind the pipeline, push its descriptors and constants.
     fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
         unsafe {
             ctx.device
@@ -259,6 +258,8 @@ impl<I: Interface> ComputePipeline<I> {
         }
     }
 
+    /// Dispatch `groups` workgroups (split over y when more than 65535; shaders linearise
+    /// with `global_id()` from common/index.glsl).
     pub fn dispatch_groups(
         &self,
         ctx: &Context,

@@ -106,6 +106,7 @@ impl Profiler {
             .query_type(vk::QueryType::TIMESTAMP)
             .query_count(POOL_QUERIES);
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.ctx("query pool")?;
+        ctx.count_object("query pool", 1);
         let s = &mut self.slots[slot];
         ctx.set_name(
             pool,
@@ -254,6 +255,7 @@ impl Profiler {
         for s in self.slots.drain(..) {
             for pool in s.pools {
                 unsafe { ctx.device.destroy_query_pool(pool, None) };
+                ctx.count_object("query pool", -1);
             }
         }
     }

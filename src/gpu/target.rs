@@ -1,6 +1,6 @@
 //! Headless render target: colour + depth images, a readback buffer per frame slot, PNG out.
 use super::memory::{subresource, Buffer, Image, MemoryLocation};
-use super::Context;
+use super::{Context, Guard};
 use crate::error::{Error, Result};
 use ash::vk;
 use std::path::Path;
@@ -37,23 +37,29 @@ fn image_barrier(
 
 impl ColorTarget {
     pub fn new(ctx: &Context, width: u32, height: u32, slots: usize) -> Result<Self> {
-        let color = ctx.create_image(
-            "color target",
-            width,
-            height,
-            COLOR_FORMAT,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT
-                | vk::ImageUsageFlags::TRANSFER_SRC
-                | vk::ImageUsageFlags::STORAGE,
-        )?;
-        let depth = ctx.create_image(
-            "depth target",
-            width,
-            height,
-            DEPTH_FORMAT,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        )?;
-        let mut readbacks = Vec::new();
+        let color = Guard::new(
+            ctx,
+            ctx.create_image(
+                "color target",
+                width,
+                height,
+                COLOR_FORMAT,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::STORAGE,
+            )?,
+        );
+        let depth = Guard::new(
+            ctx,
+            ctx.create_image(
+                "depth target",
+                width,
+                height,
+                DEPTH_FORMAT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            )?,
+        );
+        let mut readbacks = Guard::new(ctx, Vec::new());
         for _ in 0..slots {
             readbacks.push(ctx.create_buffer(
                 "frame readback",
@@ -63,9 +69,9 @@ impl ColorTarget {
             )?);
         }
         Ok(Self {
-            color,
-            depth,
-            readbacks,
+            color: color.take(),
+            depth: depth.take(),
+            readbacks: readbacks.take(),
         })
     }
 

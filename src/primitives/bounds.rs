@@ -1,7 +1,7 @@
 //! Axis-aligned bounding box of vec4 positions by a two-level min/max reduction;
 //! the result (min, max as two vec4) stays on the GPU for the Morton pass.
 use crate::error::Result;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -36,10 +36,14 @@ pub struct BoundsBuffers {
 
 impl BoundsBuffers {
     pub fn new(ctx: &Context, capacity: u64) -> Result<Self> {
+        let partials = Guard::new(
+            ctx,
+            ctx.storage_buffer("bounds partials", capacity.div_ceil(BLOCK).max(1) * 32)?,
+        );
+        let result = ctx.storage_buffer("bounds", 32)?;
         Ok(Self {
-            partials: ctx
-                .storage_buffer("bounds partials", capacity.div_ceil(BLOCK).max(1) * 32)?,
-            result: ctx.storage_buffer("bounds", 32)?,
+            partials: partials.take(),
+            result,
             capacity,
         })
     }

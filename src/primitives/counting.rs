@@ -3,7 +3,7 @@
 //! start + rank. O(N + cells); order inside a cell is arbitrary.
 use super::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -53,11 +53,16 @@ impl CountingBuffers {
         if cells == 0 {
             return Err(Error::Param("counting sort needs at least one cell".into()));
         }
+        let buf = |name: &str, bytes| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let counts = buf("cell counts", (cells as u64 + 1) * 4)?;
+        let starts = buf("cell starts", cells as u64 * 4)?;
+        let rank = buf("in-cell rank", capacity * 4)?;
+        let scan = scan.scratch(ctx, cells as u64)?;
         Ok(Self {
-            counts: ctx.storage_buffer("cell counts", (cells as u64 + 1) * 4)?,
-            starts: ctx.storage_buffer("cell starts", cells as u64 * 4)?,
-            rank: ctx.storage_buffer("in-cell rank", capacity * 4)?,
-            scan: scan.scratch(ctx, cells as u64)?,
+            counts: counts.take(),
+            starts: starts.take(),
+            rank: rank.take(),
+            scan,
             cells,
             capacity,
         })

@@ -298,27 +298,47 @@ impl NeighborSearch {
                 ctx.max_storage_range()
             )));
         }
-        Ok(NeighborBuffers {
-            keys: ctx.storage_buffer("nb keys", cap * 4)?,
-            vals: ctx.storage_buffer("nb values", cap * 4)?,
-            sorted_keys: ctx.storage_buffer("nb sorted keys", cap * 4)?,
-            perm: ctx.storage_buffer("nb permutation", cap * 4)?,
-            sorted_pos: ctx.storage_buffer("nb sorted positions", cap * 16)?,
-            starts: ctx.storage_buffer("nb cell starts", cells * 4)?,
-            ends: ctx.storage_buffer("nb cell ends", cells * 4)?,
-            counting: match self.sort {
+        // Guarded: a failure halfway (the lists, last, are the large ones) releases the rest.
+        let buf = |name: &str, bytes| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let keys = buf("nb keys", cap * 4)?;
+        let vals = buf("nb values", cap * 4)?;
+        let sorted_keys = buf("nb sorted keys", cap * 4)?;
+        let perm = buf("nb permutation", cap * 4)?;
+        let sorted_pos = buf("nb sorted positions", cap * 16)?;
+        let starts = buf("nb cell starts", cells * 4)?;
+        let ends = buf("nb cell ends", cells * 4)?;
+        let counting = Guard::new(
+            ctx,
+            match self.sort {
                 SortAlgo::Counting => {
                     Some(CountingBuffers::new(ctx, &self.scan, cap, cells as u32)?)
                 }
                 _ => None,
             },
-            bounds: match self.strategy {
+        );
+        let bounds = Guard::new(
+            ctx,
+            match self.strategy {
                 Neighbors::Morton => Some(BoundsBuffers::new(ctx, cap)?),
                 _ => None,
             },
-            counts: ctx.storage_buffer("nb counts", cap * 4)?,
-            list: ctx.storage_buffer("nb lists", list_bytes)?,
-            visited: ctx.storage_buffer("nb visited", cap * 4)?,
+        );
+        let counts = buf("nb counts", cap * 4)?;
+        let list = buf("nb lists", list_bytes)?;
+        let visited = ctx.storage_buffer("nb visited", cap * 4)?;
+        Ok(NeighborBuffers {
+            keys: keys.take(),
+            vals: vals.take(),
+            sorted_keys: sorted_keys.take(),
+            perm: perm.take(),
+            sorted_pos: sorted_pos.take(),
+            starts: starts.take(),
+            ends: ends.take(),
+            counting: counting.take(),
+            bounds: bounds.take(),
+            counts: counts.take(),
+            list: list.take(),
+            visited,
             capacity,
             table,
             max_neighbors,

@@ -8,7 +8,7 @@
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
 use crate::error::{Error, Result};
-use crate::gpu::{BindingDecl, Buffer, ComputeDesc, ComputePipeline, Context, Interface};
+use crate::gpu::{BindingDecl, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Interface};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -154,22 +154,35 @@ impl ScanPass {
         let pipeline = |name, shader| {
             ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, WG))
         };
+        let chunk_reduce = Guard::new(
+            ctx,
+            pipeline("scan chunk sums", "primitives/scan_chunk_reduce.comp")?,
+        );
+        let chunk_down = Guard::new(
+            ctx,
+            pipeline("scan chunks", "primitives/scan_chunk_down.comp")?,
+        );
+        let top = pipeline("scan top", "primitives/scan_block.comp")?;
         Ok(Self {
-            chunk_reduce: pipeline("scan chunk sums", "primitives/scan_chunk_reduce.comp")?,
-            chunk_down: pipeline("scan chunks", "primitives/scan_chunk_down.comp")?,
-            top: pipeline("scan top", "primitives/scan_block.comp")?,
+            chunk_reduce: chunk_reduce.take(),
+            chunk_down: chunk_down.take(),
+            top,
             uses_subgroups: subgroup,
         })
     }
 
     pub fn scratch(&self, ctx: &Context, capacity: u64) -> Result<ScanScratch> {
-        let mut levels = Vec::new();
+        let mut levels = Guard::new(ctx, Vec::new());
         let mut n = capacity;
         while n > BLOCK {
             n = n.div_ceil(CHUNK as u64);
-            levels.push(ctx.storage_buffer(&format!("scan chunk sums {}", levels.len()), n * 4)?);
+            let name = format!("scan chunk sums {}", levels.len());
+            levels.push(ctx.storage_buffer(&name, n * 4)?);
         }
-        Ok(ScanScratch { levels, capacity })
+        Ok(ScanScratch {
+            levels: levels.take(),
+            capacity,
+        })
     }
 
     /// Record a scan of `n` u32 from `input` into `output` (may be the same buffer).

@@ -3,7 +3,7 @@
 use super::scene::Scene;
 use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, MemoryLocation, Profiler};
+use crate::gpu::{sync, Buffer, Context, Guard, MemoryLocation, Profiler};
 use crate::primitives::bounds::{BoundsBuffers, BoundsPass};
 use ash::vk;
 use serde::{Deserialize, Serialize};
@@ -23,7 +23,7 @@ pub struct Stepper {
 
 impl Stepper {
     pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
-        let mut readbacks = Vec::new();
+        let mut readbacks = Guard::new(ctx, Vec::new());
         for _ in 0..slots {
             readbacks.push(ctx.create_buffer(
                 "velocity bounds readback",
@@ -32,10 +32,12 @@ impl Stepper {
                 MemoryLocation::GpuToCpu,
             )?);
         }
+        let bounds = Guard::new(ctx, BoundsPass::new(ctx)?);
+        let boxes = BoundsBuffers::new(ctx, st.n as u64)?;
         Ok(Self {
-            bounds: BoundsPass::new(ctx)?,
-            boxes: BoundsBuffers::new(ctx, st.n as u64)?,
-            readbacks,
+            bounds: bounds.take(),
+            boxes,
+            readbacks: readbacks.take(),
             frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
             steps_taken: 0,
             sim_time: 0.0,
@@ -79,7 +81,7 @@ impl Stepper {
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
         if st.fluid.cfl.is_some() {
-            prof.begin(ctx, cmd, "sph-cfl");
+            prof.begin(ctx, cmd, "sph/cfl");
             self.bounds
                 .record(ctx, cmd, st.vel(), st.n as u64, &self.boxes)?;
             ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // velocity box -> copy
@@ -120,10 +122,15 @@ pub struct PhysicsStats {
     /// Particles with a non-finite position or velocity.
     pub nan: usize,
     pub outside_domain: usize,
+    #[serde(with = "crate::report::non_finite_as_null")]
     pub density_mean: f64,
+    #[serde(with = "crate::report::non_finite_as_null")]
     pub density_mean_over_rest: f64,
+    #[serde(with = "crate::report::non_finite_as_null")]
     pub density_min: f64,
+    #[serde(with = "crate::report::non_finite_as_null")]
     pub density_max: f64,
+    #[serde(with = "crate::report::non_finite_as_null")]
     pub max_speed: f64,
 }
 

@@ -194,16 +194,20 @@ impl MetaballBuffers {
         }
         match list {
             ListKind::None => Ok(()),
+            // The new list is made before the old one goes, so a failed allocation leaves
+            // the buffers as they were.
             ListKind::Sbuffer => {
-                ctx.destroy_buffer(&mut b.list);
-                b.list = ctx.storage_buffer("sbuffer list", needed.max(1) * 4)?;
+                let fresh = ctx.storage_buffer("sbuffer list", needed.max(1) * 4)?;
+                let mut old = std::mem::replace(&mut b.list, fresh);
+                ctx.destroy_buffer(&mut old);
                 b.list_capacity = needed.max(1);
                 Ok(())
             }
             ListKind::Abuffer => {
                 let cap = (needed + needed / 4 + 1).min(fits);
-                ctx.destroy_buffer(&mut b.nodes);
-                b.nodes = ctx.storage_buffer("abuffer nodes", cap * 8)?;
+                let fresh = ctx.storage_buffer("abuffer nodes", cap * 8)?;
+                let mut old = std::mem::replace(&mut b.nodes, fresh);
+                ctx.destroy_buffer(&mut old);
                 b.list_capacity = cap;
                 Ok(())
             }
