@@ -197,31 +197,41 @@ fn internal_forces_conserve_momentum() {
 }
 
 #[test]
-fn poly6_kernel_is_normalised() {
-    // Integrate W_poly6 over its support on a fine lattice: 1 within 0.5%.
-    let h = 0.0457f64;
-    let c = 315.0 / (64.0 * std::f64::consts::PI * h.powi(9));
+fn kernels_the_solver_uploads_are_normalised() {
+    // Integrate the kernels with the constants the solver uploads (SphGpuParams, f32) over
+    // their support on a fine lattice: W_poly6 and W_spiky integrate to 1 within 0.5%.
+    let f = FluidParams::default();
+    let p = fluidform::sph::params::SphGpuParams::new(&f, [0.0; 3], [1.0; 3], f.dt, 0);
+    let h = p.h as f64;
+    let c = p.poly6 as f64;
+    // W_spiky = -spiky_grad / 3 (h - r)^3, whose gradient is the one the forces use.
+    let spiky = -(p.spiky_grad as f64) / 3.0;
     let steps = 80;
     let dx = 2.0 * h / steps as f64;
-    let mut sum = 0.0;
+    let (mut sum, mut sum_spiky) = (0.0, 0.0);
     for i in 0..steps {
         for j in 0..steps {
             for k in 0..steps {
-                let p = [
+                let q = [
                     (i as f64 + 0.5) * dx - h,
                     (j as f64 + 0.5) * dx - h,
                     (k as f64 + 0.5) * dx - h,
                 ];
-                let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+                let r2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
                 if r2 < h * h {
                     sum += c * (h * h - r2).powi(3) * dx * dx * dx;
+                    sum_spiky += spiky * (h - r2.sqrt()).powi(3) * dx * dx * dx;
                 }
             }
         }
     }
-    assert!((sum - 1.0).abs() < 5e-3, "integral {sum}");
+    assert!((sum - 1.0).abs() < 5e-3, "poly6 integral {sum}");
+    assert!((sum_spiky - 1.0).abs() < 5e-3, "spiky integral {sum_spiky}");
+    // grad W_poly6 = -6 poly6 r (h^2 - r^2)^2, and the viscosity Laplacian is 3 x the
+    // spiky gradient's magnitude (45 / (pi h^6)), as uploaded.
+    assert!(((p.poly6_grad / p.poly6) as f64 + 6.0).abs() < 1e-5);
+    assert!(((p.visc_lap / p.spiky_grad) as f64 + 1.0).abs() < 1e-6);
     // The rest lattice of Kelager's water has a density near rho_0 (about 20 neighbours).
-    let f = FluidParams::default();
     let s = f.spacing() as f64;
     let mut rho = 0.0;
     for i in -3i32..=3 {
@@ -245,9 +255,10 @@ fn run_steps(
     scene: &Scene,
     steps: u32,
     strategy: Neighbors,
+    sort: SortAlgo,
 ) -> fluidform::sph::solver::StateDump {
     let parts = scene.particles(1);
-    let mut solver = SphSolver::new(ctx, strategy, None).unwrap();
+    let mut solver = SphSolver::new(ctx, strategy, Some(sort)).unwrap();
     let mut st = solver.state(ctx, scene, &parts).unwrap();
     for _ in 0..steps.div_ceil(50) {
         ctx.one_shot(|cmd| {
@@ -284,7 +295,7 @@ fn assert_sane(d: &fluidform::sph::solver::StateDump, scene: &Scene, what: &str)
 fn short_dam_break_is_stable_and_stays_in_the_domain() {
     let ctx = common::ctx();
     let scene = Scene::built_in("dam-break").unwrap().with_particles(3000);
-    let d = run_steps(&ctx, &scene, 400, Neighbors::Grid);
+    let d = run_steps(&ctx, &scene, 400, Neighbors::Grid, SortAlgo::Counting);
     assert_sane(&d, &scene, "dam break");
     // The column has collapsed: the centre of mass moved down and along x.
     let n = d.pos.len() as f32;
@@ -307,15 +318,15 @@ fn colliders_keep_fluid_out_and_strategies_agree() {
     .unwrap();
     assert_eq!(scene.colliders.len(), 3);
     let mut means = Vec::new();
-    for (strategy, _) in STRATEGIES.iter().step_by(1).take(3) {
-        let d = run_steps(&ctx, &scene, 150, *strategy);
+    for (strategy, sort) in STRATEGIES {
+        let d = run_steps(&ctx, &scene, 150, strategy, sort);
         assert_sane(&d, &scene, "obstacles");
         for (i, p) in d.pos.iter().enumerate() {
             for c in &scene.colliders {
                 let dist = c.distance([p[0], p[1], p[2]]);
                 assert!(
                     dist > -1e-4,
-                    "{strategy:?}: particle {i} inside {c:?} by {dist}"
+                    "{strategy:?}/{sort:?}: particle {i} inside {c:?} by {dist}"
                 );
             }
         }
@@ -324,6 +335,7 @@ fn colliders_keep_fluid_out_and_strategies_agree() {
         let rho = d.rho_p.iter().map(|r| r[0] as f64).sum::<f64>() / n;
         means.push((cy, rho));
     }
+    assert_eq!(means.len(), STRATEGIES.len(), "every strategy ran");
     // Same physics whatever the neighbour search: aggregates agree closely.
     for m in &means[1..] {
         assert!((m.0 - means[0].0).abs() < 2e-3, "centre of mass {means:?}");

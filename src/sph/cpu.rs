@@ -2,7 +2,6 @@
 //! by the same formulas as glsl/sph (self term in density and colour Laplacian; pairs
 //! closer than 1e-6 h skip the spiky and viscosity terms).
 use super::params::{Eos, FluidParams};
-use std::f64::consts::PI;
 
 pub struct Reference {
     pub density: Vec<f64>,
@@ -30,10 +29,12 @@ pub fn evaluate(f: &FluidParams, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Referenc
     let h = f.h as f64;
     let h2 = h * h;
     let m = f.mass as f64;
-    let poly6 = 315.0 / (64.0 * PI * h.powi(9));
-    let poly6_grad = -945.0 / (32.0 * PI * h.powi(9));
-    let spiky_grad = -45.0 / (PI * h.powi(6));
-    let visc_lap = 45.0 / (PI * h.powi(6));
+    let super::params::Kernels {
+        poly6,
+        poly6_grad,
+        spiky_grad,
+        visc_lap,
+    } = super::params::Kernels::new(h);
     let p3 = |p: &[f32; 4]| [p[0] as f64, p[1] as f64, p[2] as f64];
     let x: Vec<[f64; 3]> = pos.iter().map(p3).collect();
     let v: Vec<[f64; 3]> = vel.iter().map(p3).collect();

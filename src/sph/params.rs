@@ -2,7 +2,6 @@
 use crate::error::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
-use std::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -231,6 +230,7 @@ const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 112);
 impl SphGpuParams {
     pub fn new(f: &FluidParams, lo: [f32; 3], hi: [f32; 3], dt: f32, colliders: u32) -> Self {
         let h = f.h;
+        let k = Kernels::new(h as f64);
         Self {
             gravity: [f.gravity[0], f.gravity[1], f.gravity[2], dt],
             domain_min: [lo[0], lo[1], lo[2], f.restitution],
@@ -247,6 +247,29 @@ impl SphGpuParams {
             clamp_negative: f.clamp_negative_pressure as u32,
             colliders,
             pad: 0,
+            poly6: k.poly6 as f32,
+            poly6_grad: k.poly6_grad as f32,
+            spiky_grad: k.spiky_grad as f32,
+            visc_lap: k.visc_lap as f32,
+        }
+    }
+}
+
+/// The smoothing kernels' constants (Müller 2003), for the GPU parameters and the CPU
+/// reference alike: W_poly6 = poly6 (h^2 - r^2)^3, grad W_poly6 = poly6_grad r (h^2 - r^2)^2,
+/// grad W_spiky = spiky_grad (h - r)^2 r/|r|, lap W_visc = visc_lap (h - r).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kernels {
+    pub poly6: f64,
+    pub poly6_grad: f64,
+    pub spiky_grad: f64,
+    pub visc_lap: f64,
+}
+
+impl Kernels {
+    pub fn new(h: f64) -> Self {
+        use std::f64::consts::PI;
+        Self {
             poly6: 315.0 / (64.0 * PI * h.powi(9)),
             poly6_grad: -945.0 / (32.0 * PI * h.powi(9)),
             spiky_grad: -45.0 / (PI * h.powi(6)),
