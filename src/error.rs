@@ -22,6 +22,9 @@ pub enum Error {
     Interface(String),
     #[error("GPU memory: {0}")]
     Memory(String),
+    /// The simulation went unstable (NaN, infinity, or beyond what the step resolves).
+    #[error("the simulation went unstable: {0}")]
+    Unstable(String),
     #[error("invalid parameter: {0}")]
     Param(String),
     #[error("{0}")]

@@ -254,7 +254,7 @@ impl FrameWork for SphWork<'_> {
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
-        self.stepper.retire_slot(slot);
+        self.stepper.retire_slot(slot, frame)?;
         let path = self.frames.path(frame);
         self.view.retire(ctx, slot, self.st.n, path.as_deref())
     }
@@ -287,14 +287,23 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         uses.push(Group::Metaball);
     }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
+    use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
     let mut scene = scene;
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
+    // Refused before any particle or buffer is made (the count is estimated, not built).
+    scene.validate()?;
+    scene.check_size(MAX_PARTICLES, BYTES_PER_PARTICLE, 0)?;
     let scene = match sw.common.particles {
         Some(n) => scene.with_particles(n),
         None => scene,
     };
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
+    scene.check_size(
+        MAX_PARTICLES,
+        BYTES_PER_PARTICLE,
+        ctx.info.device_local_bytes,
+    )?;
     let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
     let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
     let parts = scene.particles(sw.common.seed);

@@ -454,6 +454,10 @@ fn fluid_overrides_from_the_command_line() {
         "eos=tait",
         "--fluid",
         "gravity=[0.0, -1.0, 0.0]",
+        // Tait water needs steps far below the scene's 0.01 s: without the CFL limit the
+        // run goes unstable in its first frame (and is stopped there).
+        "--fluid",
+        "cfl=0.4",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let s = summary(dir.path());
@@ -547,4 +551,101 @@ fn every_scene_kind_and_list_mode_is_free_of_sync_hazards() {
     ]);
     let s = run_ok(dir.path(), &args);
     assert_eq!(s["validation"]["errors"], 0);
+}
+
+/// Bad scene input is refused before any allocation (or stopped within a frame), each with
+/// a one-line error and a non-zero exit, never an abort, a hang or exit 0 with nonsense.
+#[test]
+fn bad_scene_input_is_refused_quickly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let timed = |args: &[&str]| {
+        let t = std::time::Instant::now();
+        let o = fluidform(args);
+        (o, t.elapsed().as_secs_f64())
+    };
+    // About 6e11 particles: refused from the estimate, before any is made.
+    let (o, secs) = timed(&["run", "--out", d, "--frames", "1", "--fluid", "mass=1e-9"]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert!(
+        t.contains("implies about") && t.contains("at most 67108864"),
+        "{t}"
+    );
+    assert!(secs < 20.0, "took {secs} s");
+    // A huge step goes unstable in the first frame and is stopped there.
+    let (o, _) = timed(&[
+        "run",
+        "--out",
+        d,
+        "--frames",
+        "50",
+        "--save-every",
+        "0",
+        "--fluid",
+        "dt=1e9",
+        "--width",
+        "64",
+        "--height",
+        "48",
+    ]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert!(t.contains("went unstable: frame 0:"), "{t}");
+    // Fluid outside the domain is an error, not silently dropped particles.
+    let scene = dir.path().join("outside.toml");
+    std::fs::write(
+        &scene,
+        "name = \"outside\"\n[domain]\nmin = [0, 0, 0]\nmax = [0.2, 0.2, 0.2]\n\
+         [[blocks]]\nmin = [-1, -1, -1]\nmax = [5, 5, 5]\n",
+    )
+    .unwrap();
+    let (o, _) = timed(&[
+        "run",
+        "--out",
+        d,
+        "--frames",
+        "1",
+        "--scene",
+        scene.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("reaches outside the domain"),
+        "{}",
+        text(&o)
+    );
+}
+
+/// BYTES_PER_PARTICLE, used to refuse scenes that cannot fit, bounds what a run allocates
+/// per particle (every buffer but the pixel-sized ones).
+#[test]
+fn bytes_per_particle_bounds_the_allocation() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = run_ok(
+        dir.path(),
+        &[
+            "--scene", "drop", "--frames", "1", "--width", "64", "--height", "48",
+        ],
+    );
+    let n = s["stats"]["particles"].as_u64().unwrap();
+    let pixel_sized = [
+        "render", "sbuffer", "abuffer", "sky", "frame", "color", "depth",
+    ];
+    let per_particle: u64 = s["memory_bytes"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(k, _)| !pixel_sized.iter().any(|p| k.starts_with(p)))
+        .map(|(_, v)| v.as_u64().unwrap())
+        .sum();
+    let bound = fluidform::sph::solver::BYTES_PER_PARTICLE * n;
+    assert!(
+        per_particle <= bound,
+        "{per_particle} bytes for {n} particles > {bound}"
+    );
+    assert!(
+        per_particle * 2 > bound,
+        "the bound is loose: {per_particle} of {bound}"
+    );
 }

@@ -24,6 +24,8 @@ pub struct DeviceInfo {
     pub subgroup_size_control: bool,
     pub max_storage_buffer_range: u64,
     pub max_shared_memory: u32,
+    /// Bytes of the device-local memory heaps (on lavapipe: the host's memory).
+    pub device_local_bytes: u64,
     /// Loop iterations llvmpipe lets one batch of invocations run before it stops their
     /// loops (hang protection, LP_MAX_TGSI_LOOP_ITERATIONS); None on other drivers.
     pub loop_budget: Option<u32>,
@@ -161,6 +163,14 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
             && f13.compute_full_subgroups == vk::TRUE,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
         max_shared_memory: props.limits.max_compute_shared_memory_size,
+        device_local_bytes: {
+            let m = unsafe { instance.get_physical_device_memory_properties(pd) };
+            m.memory_heaps[..m.memory_heap_count as usize]
+                .iter()
+                .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+                .map(|h| h.size)
+                .sum()
+        },
         loop_budget: (driver.driver_id == vk::DriverId::MESA_LLVMPIPE).then_some(65535),
         missing,
         queue_family,

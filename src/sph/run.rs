@@ -1,48 +1,33 @@
 //! Playing an SPH scene: steps per frame (fixed, or CFL-limited from the previous
-//! frame's velocity bounds), the particle view, and end-of-run physics statistics.
+//! frame's largest speed), the state's health every frame, and end-of-run statistics.
+use super::health::Health;
 use super::scene::Scene;
 use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, Guard, MemoryLocation, Profiler};
-use crate::primitives::bounds::{BoundsBuffers, BoundsPass};
+use crate::gpu::{Context, Profiler};
 use ash::vk;
 use serde::{Deserialize, Serialize};
 
-/// Chooses steps per frame. With `cfl`, a step never exceeds cfl * h / max(c, v_max),
-/// v_max bounded by the velocity box read back from the latest finished frame.
+/// Chooses steps per frame and watches the state's health. With `cfl`, a step never
+/// exceeds cfl * h / max(c, v_max), v_max read back from the latest finished frame.
 pub struct Stepper {
-    bounds: BoundsPass,
-    boxes: BoundsBuffers,
-    readbacks: Vec<Buffer>,
+    health: Health,
     pub frame_time: f64,
     pub steps_taken: u64,
     pub sim_time: f64,
     v_max: f32,
-    cfl: bool,
+    rest_density: f32,
 }
 
 impl Stepper {
     pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
-        let mut readbacks = Guard::new(ctx, Vec::new());
-        for _ in 0..slots {
-            readbacks.push(ctx.create_buffer(
-                "velocity bounds readback",
-                32,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )?);
-        }
-        let bounds = Guard::new(ctx, BoundsPass::new(ctx)?);
-        let boxes = BoundsBuffers::new(ctx, st.n as u64)?;
         Ok(Self {
-            bounds: bounds.take(),
-            boxes,
-            readbacks: readbacks.take(),
+            health: Health::new(ctx, slots)?,
             frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
             steps_taken: 0,
             sim_time: 0.0,
             v_max: 0.0,
-            cfl: st.fluid.cfl.is_some(),
+            rest_density: st.fluid.rest_density,
         })
     }
 
@@ -63,7 +48,7 @@ impl Stepper {
         }
     }
 
-    /// Record one frame of steps; with CFL, also the velocity bounds for this slot.
+    /// Record one frame of steps and the state's health for this slot.
     pub fn record_frame(
         &mut self,
         ctx: &Context,
@@ -80,38 +65,21 @@ impl Stepper {
         }
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
-        if st.fluid.cfl.is_some() {
-            prof.begin(ctx, cmd, "sph/cfl");
-            self.bounds
-                .record(ctx, cmd, st.vel(), st.n as u64, &self.boxes)?;
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // velocity box -> copy
-            ctx.copy(cmd, &self.boxes.result, 0, &self.readbacks[slot], 0, 32);
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // copy -> the host
-            prof.end(ctx, cmd);
-        }
+        prof.begin(ctx, cmd, "sph/health");
+        self.health.record(ctx, cmd, st, slot);
+        prof.end(ctx, cmd);
         Ok(())
     }
 
-    /// After a slot's fence: update v_max from its velocity bounds.
-    pub fn retire_slot(&mut self, slot: usize) {
-        if !self.cfl {
-            return;
-        }
-        let b: &[[f32; 4]] = bytemuck::cast_slice(self.readbacks[slot].mapped().expect("mapped"));
-        let v2: f32 = (0..3)
-            .map(|k| b[0][k].abs().max(b[1][k].abs()).powi(2))
-            .sum();
-        if v2.is_finite() {
-            self.v_max = v2.sqrt();
-        }
+    /// After a slot's fence: stop on an unstable frame; update v_max for CFL.
+    pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
+        let h = self.health.check(slot, frame, self.rest_density)?;
+        self.v_max = h.max_speed();
+        Ok(())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        self.bounds.destroy(ctx);
-        self.boxes.destroy(ctx);
-        for b in &mut self.readbacks {
-            ctx.destroy_buffer(b);
-        }
+        self.health.destroy(ctx);
     }
 }
 

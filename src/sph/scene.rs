@@ -270,6 +270,33 @@ impl Scene {
                 )));
             }
         }
+        // Fluid outside the domain would be dropped silently: refuse it instead.
+        let (dlo, dhi) = (self.domain.min, self.domain.max);
+        let outside = |lo: [f32; 3], hi: [f32; 3]| {
+            let tol = 1e-4 * (0..3).map(|k| dhi[k] - dlo[k]).fold(0.0f32, f32::max);
+            (0..3).any(|k| lo[k] < dlo[k] - tol || hi[k] > dhi[k] + tol)
+        };
+        for b in &self.blocks {
+            if outside(b.min, b.max) {
+                return Err(Error::Param(format!(
+                    "scene {}: block {:?}..{:?} reaches outside the domain {dlo:?}..{dhi:?}",
+                    self.name, b.min, b.max
+                )));
+            }
+        }
+        for b in &self.balls {
+            let (c, r) = (b.center, b.radius);
+            if outside(
+                [c[0] - r, c[1] - r, c[2] - r],
+                [c[0] + r, c[1] + r, c[2] + r],
+            ) {
+                return Err(Error::Param(format!(
+                    "scene {}: ball at {c:?} of radius {r} reaches outside the domain \
+                     {dlo:?}..{dhi:?}",
+                    self.name
+                )));
+            }
+        }
         if self.blocks.is_empty() && self.balls.is_empty() {
             return Err(Error::Param(format!(
                 "scene {}: no fluid (blocks or balls)",
@@ -312,6 +339,56 @@ impl Scene {
 
     /// Fill blocks and balls on a cubic lattice at the rest spacing, jittered by 1% of it
     /// (seeded), keeping points inside the domain and outside colliders.
+    /// An upper bound of the particles `particles` makes (lattice points in the blocks'
+    /// and balls' boxes), computed without making them.
+    pub fn estimated_particles(&self) -> f64 {
+        let s = self.fluid.spacing() as f64;
+        let count = |lo: [f32; 3], hi: [f32; 3]| {
+            (0..3)
+                .map(|k| ((hi[k] - lo[k]) as f64 / s).floor().max(0.0))
+                .product::<f64>()
+        };
+        let blocks: f64 = self.blocks.iter().map(|b| count(b.min, b.max)).sum();
+        let balls: f64 = self
+            .balls
+            .iter()
+            .map(|b| {
+                let (c, r) = (b.center, b.radius);
+                count(
+                    [c[0] - r, c[1] - r, c[2] - r],
+                    [c[0] + r, c[1] + r, c[2] + r],
+                )
+            })
+            .sum();
+        blocks + balls
+    }
+
+    /// Refuse a scene whose particles would not fit, before any is made: more than
+    /// `limit`, or more than `bytes_per_particle` each in `memory` bytes.
+    pub fn check_size(&self, limit: u64, bytes_per_particle: u64, memory: u64) -> Result<()> {
+        let n = self.estimated_particles();
+        let why = format!(
+            "scene {} implies about {n:.3e} particles at a spacing of {:.3e} m (mass {} kg)",
+            self.name,
+            self.fluid.spacing(),
+            self.fluid.mass
+        );
+        if !n.is_finite() || n > limit as f64 {
+            return Err(Error::Param(format!(
+                "{why}: at most {limit}; raise the mass or shrink the fluid"
+            )));
+        }
+        let need = n * bytes_per_particle as f64;
+        if memory > 0 && need > memory as f64 {
+            return Err(Error::Memory(format!(
+                "{why}, about {:.1} GiB, more than the device's {:.1} GiB",
+                need / (1u64 << 30) as f64,
+                memory as f64 / (1u64 << 30) as f64
+            )));
+        }
+        Ok(())
+    }
+
     pub fn particles(&self, seed: u64) -> Particles {
         let s = self.fluid.spacing();
         let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);

@@ -65,6 +65,14 @@ const ATTRIBUTES: [AttributeDecl; 6] = [
     },
 ];
 
+/// Most particles a scene may have.
+pub const MAX_PARTICLES: u64 = 1 << 26;
+
+/// Device bytes per particle, an upper bound for the solver's state and neighbour buffers
+/// and a view's per-particle buffers (measured in tests/sph.rs), for refusing scenes that
+/// cannot fit before anything is made.
+pub const BYTES_PER_PARTICLE: u64 = 320;
+
 /// Local size of the per-particle passes.
 pub const LOCAL_SIZE: u32 = 128;
 
@@ -231,7 +239,7 @@ impl SphSolver {
                 scene.name
             )));
         }
-        if n > 1 << 26 {
+        if n as u64 > MAX_PARTICLES {
             return Err(Error::Param(format!("{n} particles: at most 2^26")));
         }
         let f = &scene.fluid;
