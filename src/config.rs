@@ -65,6 +65,9 @@ pub struct CommonArgs {
     /// Khronos validation layer on; the run fails on any validation error
     #[arg(long)]
     pub validation: bool,
+    /// No progress bar or progress lines
+    #[arg(long)]
+    pub quiet: bool,
     /// Seed of every random choice (initial particles, test data)
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -74,14 +77,24 @@ pub struct CommonArgs {
 }
 
 /// Size of rendered frames.
-#[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct FrameArgs {
-    /// Frame width in pixels
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub width: u32,
-    /// Frame height in pixels
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub height: u32,
+    /// Frame width in pixels (default 512, or the scene's)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: Option<u32>,
+    /// Frame height in pixels (default 512, or the scene's)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: Option<u32>,
+}
+
+impl FrameArgs {
+    pub const DEFAULT: u32 = 512;
+    pub fn width(&self) -> u32 {
+        self.width.unwrap_or(Self::DEFAULT)
+    }
+    pub fn height(&self) -> u32 {
+        self.height.unwrap_or(Self::DEFAULT)
+    }
 }
 
 /// The sort of the neighbour search and the sort benchmark.
@@ -220,18 +233,9 @@ impl Default for CommonArgs {
         Self {
             device: None,
             validation: false,
+            quiet: false,
             seed: 1,
             particles: None,
-        }
-    }
-}
-
-impl Default for FrameArgs {
-    /// The parser's defaults.
-    fn default() -> Self {
-        Self {
-            width: 512,
-            height: 512,
         }
     }
 }

@@ -1,11 +1,13 @@
 //! fluidform: a Rust + Vulkan research testbed for liquid characters.
 //! See README.md for the command line and outputs.
+pub mod animation;
 pub mod bench;
 pub mod config;
 pub mod error;
 pub mod gpu;
 pub mod particles;
 pub mod primitives;
+pub mod progress;
 pub mod render;
 pub mod report;
 pub mod run;

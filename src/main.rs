@@ -242,7 +242,18 @@ fn main() -> Result<()> {
                 save_every,
                 switches,
             })?;
-            print_summary(&r.summary, &out);
+            print_summary(&r.summary);
+            // One closing line: where the files went.
+            let anim = r
+                .animation
+                .as_ref()
+                .map(|p| format!(", {}", p.display()))
+                .unwrap_or_default();
+            println!(
+                "wrote {} frame PNGs{anim}, timings.csv and summary.json to {}",
+                r.pngs.len(),
+                out.display()
+            );
             Ok(())
         }
         Command::Bench {
@@ -300,7 +311,7 @@ fn devices(json: bool) -> Result<()> {
     Ok(())
 }
 
-fn print_summary(s: &fluidform::run::RunSummary, out: &std::path::Path) {
+fn print_summary(s: &fluidform::run::RunSummary) {
     println!(
         "device: {}  frames: {}  GPU frame median {:.3} ms",
         s.device.name,
@@ -316,7 +327,6 @@ fn print_summary(s: &fluidform::run::RunSummary, out: &std::path::Path) {
     if let Some(v) = &s.validation {
         println!("validation: {} errors, {} warnings", v.errors, v.warnings);
     }
-    println!("wrote {}", out.display());
 }
 
 trait ParseDefault {

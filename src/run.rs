@@ -1,8 +1,10 @@
 //! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
 //! Every scene kind is a `FrameWork` played by `session::play`.
+use crate::animation::Animation;
 use crate::config::Switches;
 use crate::config::{Neighbors, RenderKind, SortAlgo};
 use crate::error::{Error, Result};
+use crate::gpu::target::save_rgba;
 use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
 use crate::render::{points::PointsPush, Camera, PointsView};
 use crate::report::{Report, Summary};
@@ -11,6 +13,7 @@ pub use crate::session::{camera_with_switches, check_validation, SLOTS};
 use crate::session::{open, play};
 use crate::sph::run::SphRunStats;
 use crate::sph::FluidParams;
+use crate::viewer::Picture;
 use ash::vk;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -25,7 +28,7 @@ pub struct RunOptions {
     pub switches: Switches,
 }
 
-pub const DEFAULT_SCENE: &str = "dam-break";
+pub const DEFAULT_SCENE: &str = "demo";
 
 /// `config` of a run's summary.json.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -67,25 +70,63 @@ pub type RunSummary = Summary<RunConfig, RunStats>;
 pub struct RunResult {
     pub summary: RunSummary,
     pub pngs: Vec<PathBuf>,
+    /// animation.png (APNG) of the saved frames, when any were saved.
+    pub animation: Option<PathBuf>,
 }
 
-/// Where saved frames go.
+/// Frames per second the animation plays at.
+pub const ANIMATION_FPS: u16 = 30;
+
+/// Where saved frames go: frame_NNNN.png each, and animation.png (APNG) of them all.
 struct Frames<'a> {
     out: &'a Path,
     every: u64,
+    /// Frames the run plays.
+    total: u64,
     pngs: Vec<PathBuf>,
+    animation: Option<Animation>,
 }
 
-impl Frames<'_> {
+impl<'a> Frames<'a> {
+    fn new(out: &'a Path, every: u64, total: u64) -> Self {
+        Self {
+            out,
+            every,
+            total,
+            pngs: Vec::new(),
+            animation: None,
+        }
+    }
+
     fn save(&self, f: u64) -> bool {
         self.every > 0 && f.is_multiple_of(self.every)
     }
-    fn path(&mut self, f: u64) -> Option<PathBuf> {
-        let p = self
-            .save(f)
-            .then(|| self.out.join(format!("frame_{f:04}.png")));
-        self.pngs.extend(p.clone());
-        p
+
+    /// Write frame `f`'s picture as a PNG and as the animation's next frame.
+    fn store(&mut self, f: u64, pic: Option<Picture>) -> Result<()> {
+        let Some(pic) = pic else { return Ok(()) };
+        let path = self.out.join(format!("frame_{f:04}.png"));
+        save_rgba(&path, pic.width, pic.height, pic.rgba)?;
+        self.pngs.push(path);
+        if self.animation.is_none() {
+            let saved = (self.total - 1) / self.every + 1;
+            self.animation = Some(Animation::create(
+                &self.out.join("animation.png"),
+                pic.width,
+                pic.height,
+                saved as u32,
+                ANIMATION_FPS,
+            )?);
+        }
+        if let Some(a) = &mut self.animation {
+            a.add(pic.rgba, pic.width, pic.height)?;
+        }
+        Ok(())
+    }
+
+    /// Close the animation; its path, when frames were saved.
+    fn finish(&mut self) -> Result<Option<PathBuf>> {
+        self.animation.take().map(Animation::finish).transpose()
     }
 }
 
@@ -144,10 +185,13 @@ impl FrameWork for OrbitsWork<'_> {
     }
 
     fn retire(&mut self, _: &Context, frame: u64, slot: usize) -> Result<()> {
-        if let Some(p) = self.frames.path(frame) {
-            self.target.save_png(slot, &p)?;
-        }
-        Ok(())
+        let t = &self.target;
+        let pic = self.frames.save(frame).then(|| Picture {
+            rgba: t.pixels(slot),
+            width: t.width(),
+            height: t.height(),
+        });
+        self.frames.store(frame, pic)
     }
 }
 
@@ -171,28 +215,25 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
         glam::Vec3::new(0.0, 0.8, 3.2),
         glam::Vec3::ZERO,
         45.0,
-        sw.frame.width as f32 / sw.frame.height as f32,
+        sw.frame.width() as f32 / sw.frame.height() as f32,
     );
     let pass = Guard::new(&ctx, OrbitsPass::new(&ctx)?);
     let view = Guard::new(&ctx, PointsView::new(&ctx)?);
     let scene = Guard::new(&ctx, Orbits::new(&ctx, &state)?);
-    let target = ColorTarget::new(&ctx, sw.frame.width, sw.frame.height, SLOTS)?;
+    let target = ColorTarget::new(&ctx, sw.frame.width(), sw.frame.height(), SLOTS)?;
     let mut work = OrbitsWork {
         pass: pass.take(),
         view: view.take(),
         scene: scene.take(),
         target,
         push: PointsPush::from_camera(&cam, 1.0),
-        frames: Frames {
-            out: &opts.out,
-            every: opts.save_every,
-            pngs: Vec::new(),
-        },
+        frames: Frames::new(&opts.out, opts.save_every, frame_count),
     };
     let memory = ctx.memory_bytes();
-    let timings = play(&ctx, frame_count, &mut work);
+    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     work.destroy(&ctx);
     let timings = timings?;
+    let animation = work.frames.finish()?;
     let config = RunConfig {
         command: "run".into(),
         scene: opts.scene.clone(),
@@ -218,6 +259,7 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     Ok(RunResult {
         summary,
         pngs: work.frames.pngs,
+        animation,
     })
 }
 
@@ -255,8 +297,9 @@ impl FrameWork for SphWork<'_> {
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         self.stepper.retire_slot(slot, frame)?;
-        let path = self.frames.path(frame);
-        self.view.retire(ctx, slot, self.st.n, path.as_deref())
+        let save = self.frames.save(frame);
+        let pic = self.view.retire(ctx, slot, self.st.n, save)?;
+        self.frames.store(frame, pic)
     }
 }
 
@@ -289,6 +332,8 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
     let mut scene = scene;
+    // The scene's look where the switches leave it open; summary.json records the result.
+    let sw = &scene.look.apply(sw);
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
     // Refused before any particle or buffer is made (the count is estimated, not built).
     scene.validate()?;
@@ -308,7 +353,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
     let parts = scene.particles(sw.common.seed);
     let st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
-    let aspect = sw.frame.width as f32 / sw.frame.height as f32;
+    let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
         None => {
@@ -327,7 +372,14 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let cam = camera_with_switches(cam, sw);
     let view: Box<dyn View> = match render {
-        RenderKind::Metaballs => Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS)?),
+        RenderKind::Metaballs => {
+            let tank = scene
+                .look
+                .tank
+                .unwrap_or(true)
+                .then_some([scene.domain.min, scene.domain.max]);
+            Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS, tank)?)
+        }
         // Spheres of half the rest spacing.
         RenderKind::Points => Box::new(PointsViewer::new(
             &ctx,
@@ -350,13 +402,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         st: st.take(),
         stepper,
         view,
-        frames: Frames {
-            out: &opts.out,
-            every: opts.save_every,
-            pngs: Vec::new(),
-        },
+        frames: Frames::new(&opts.out, opts.save_every, frame_count),
     };
-    let timings = play(&ctx, frame_count, &mut work);
+    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
     let dump = match &timings {
         Ok(_) => Some(work.st.read(&ctx)),
@@ -367,6 +415,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let sort = work.solver.search.sort;
     work.destroy(&ctx);
     let timings = timings?;
+    let animation = work.frames.finish()?;
     let stats = SphRunStats {
         physics: physics_stats(&dump.expect("state read")?, &scene),
         steps,
@@ -400,5 +449,6 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     Ok(RunResult {
         summary,
         pngs: work.frames.pngs,
+        animation,
     })
 }

@@ -44,10 +44,22 @@ pub fn camera_with_switches(mut cam: Camera, sw: &Switches) -> Camera {
     cam
 }
 
-/// Play `frames` frames of `work` with `SLOTS` in flight; the GPU timings of every frame.
-pub fn play(ctx: &Context, frames: u64, work: &mut dyn FrameWork) -> Result<Vec<FrameTiming>> {
+/// Play `frames` frames of `work` with `SLOTS` in flight, reporting progress as `what`
+/// unless `quiet`; the GPU timings of every frame.
+pub fn play(
+    ctx: &Context,
+    frames: u64,
+    work: &mut dyn FrameWork,
+    what: &str,
+    quiet: bool,
+) -> Result<Vec<FrameTiming>> {
     let mut fl = FrameLoop::new(ctx, SLOTS)?;
-    let r = fl.run(ctx, frames, work);
+    let mut reporting = crate::progress::Reporting {
+        work,
+        progress: crate::progress::Progress::new(what, frames, quiet),
+    };
+    let r = fl.run(ctx, frames, &mut reporting);
+    reporting.progress.finish();
     let timings = std::mem::take(&mut fl.profiler.results);
     fl.destroy(ctx);
     r.map(|_| timings)

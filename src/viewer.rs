@@ -3,13 +3,11 @@
 //! frame.
 use crate::config::Switches;
 use crate::error::Result;
-use crate::gpu::target::save_rgba;
 use crate::gpu::{sync, Buffer, ColorTarget, Context, Guard, Profiler};
 use crate::render::metaball::{FrameStats, MetaballBuffers, MetaballRenderer, MetaballSettings};
 use crate::render::{points::PointsPush, Camera, PointsView};
 use ash::vk;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// A picture of `n` particles per frame.
 pub trait View {
@@ -27,10 +25,24 @@ pub trait View {
         slot: usize,
         save: bool,
     ) -> Result<()>;
-    /// After the slot's fence: check the frame and save its PNG when asked.
-    fn retire(&mut self, ctx: &Context, slot: usize, n: u32, png: Option<&Path>) -> Result<()>;
+    /// After the slot's fence: check the frame; its picture when `save` (it was recorded
+    /// with `save`).
+    fn retire(
+        &mut self,
+        ctx: &Context,
+        slot: usize,
+        n: u32,
+        save: bool,
+    ) -> Result<Option<Picture<'_>>>;
     fn stats(&self) -> RenderSummary;
     fn destroy(&mut self, ctx: &Context);
+}
+
+/// A frame's RGBA8 pixels.
+pub struct Picture<'a> {
+    pub rgba: &'a [u8],
+    pub width: u32,
+    pub height: u32,
 }
 
 /// The `stats.render` block of summary.json.
@@ -64,7 +76,7 @@ impl PointsViewer {
         slots: usize,
     ) -> Result<Self> {
         let view = Guard::new(ctx, PointsView::new(ctx)?);
-        let target = ColorTarget::new(ctx, sw.frame.width, sw.frame.height, slots)?;
+        let target = ColorTarget::new(ctx, sw.frame.width(), sw.frame.height(), slots)?;
         Ok(Self {
             view: view.take(),
             target,
@@ -99,11 +111,18 @@ impl View for PointsViewer {
         Ok(())
     }
 
-    fn retire(&mut self, _: &Context, slot: usize, _: u32, png: Option<&Path>) -> Result<()> {
-        if let Some(p) = png {
-            self.target.save_png(slot, p)?;
-        }
-        Ok(())
+    fn retire(
+        &mut self,
+        _: &Context,
+        slot: usize,
+        _: u32,
+        save: bool,
+    ) -> Result<Option<Picture<'_>>> {
+        Ok(save.then(|| Picture {
+            rgba: self.target.pixels(slot),
+            width: self.target.width(),
+            height: self.target.height(),
+        }))
     }
 
     fn stats(&self) -> RenderSummary {
@@ -129,8 +148,17 @@ pub struct MetaballViewer {
 }
 
 impl MetaballViewer {
-    pub fn new(ctx: &Context, sw: &Switches, cam: Camera, n: u32, slots: usize) -> Result<Self> {
-        let settings = MetaballSettings::from_switches(sw)?;
+    /// `tank`: the container to draw around the fluid (min, max), if any.
+    pub fn new(
+        ctx: &Context,
+        sw: &Switches,
+        cam: Camera,
+        n: u32,
+        slots: usize,
+        tank: Option<[[f32; 3]; 2]>,
+    ) -> Result<Self> {
+        let mut settings = MetaballSettings::from_switches(sw)?;
+        settings.tank = tank;
         let renderer = Guard::new(ctx, MetaballRenderer::new(ctx, settings)?);
         let buffers = Guard::new(ctx, renderer.buffers(ctx, n as u64, slots, false)?);
         let mut centers = Guard::new(ctx, Vec::new());
@@ -186,7 +214,13 @@ impl View for MetaballViewer {
         r
     }
 
-    fn retire(&mut self, ctx: &Context, slot: usize, n: u32, png: Option<&Path>) -> Result<()> {
+    fn retire(
+        &mut self,
+        ctx: &Context,
+        slot: usize,
+        n: u32,
+        save: bool,
+    ) -> Result<Option<Picture<'_>>> {
         let mut st = self.renderer.frame_stats(&self.buffers, slot);
         if st.overflow > 0 {
             // Buffers of frames still in flight are about to be replaced.
@@ -217,11 +251,12 @@ impl View for MetaballViewer {
             );
         }
         t.last_frame = Some(st);
-        if let Some(p) = png {
-            let s = &self.renderer.settings;
-            save_rgba(p, s.width, s.height, self.buffers.pixels(slot))?;
-        }
-        Ok(())
+        let s = &self.renderer.settings;
+        Ok(save.then(|| Picture {
+            rgba: self.buffers.pixels(slot),
+            width: s.width,
+            height: s.height,
+        }))
     }
 
     fn stats(&self) -> RenderSummary {

@@ -317,7 +317,8 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "render/metaball/march.comp",
             "RenderParams",
             fields!(RenderParams;
-            view_proj, inv_view_proj, view, proj, eye, sun, absorb, f0, base, width, height,
+            view_proj, inv_view_proj, view, proj, eye, sun, absorb, f0, base, tank_min, tank_max,
+            width, height,
             n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, pad),
         ),
         (

@@ -40,6 +40,7 @@ fn block_scene(fluid: FluidParams) -> Scene {
         colliders: vec![],
         camera: None,
         frames: 1,
+        look: Default::default(),
     }
 }
 

@@ -17,6 +17,8 @@ struct RenderParams {
     vec4 absorb;    // rgb absorption per unit length (tinted), w = index of refraction
     vec4 f0;        // rgb Fresnel reflectance at normal incidence (metals)
     vec4 base;      // rgb Phong colour, w = threshold T
+    vec4 tank_min;  // xyz container min, w = 1: draw it
+    vec4 tank_max;  // xyz container max
     uint width;
     uint height;
     uint n;

@@ -232,6 +232,31 @@ vec3 phong(vec3 n, vec3 v) {
     return P.base.rgb * (0.15 + 0.85 * diff) + vec3(0.6) * spec;
 }
 
+// The container as thin glass walls with dark edges, over what the primary ray saw up to
+// t_max (the fluid's first hit, or infinity): each wall face in front tints, its edges draw.
+vec3 with_tank(vec3 color, vec3 o, vec3 d, float t_max) {
+    if (P.tank_min.w == 0.0) return color;
+    vec3 lo = P.tank_min.xyz, hi = P.tank_max.xyz;
+    vec3 inv = 1.0 / d;
+    vec3 t0 = (lo - o) * inv, t1 = (hi - o) * inv;
+    vec3 tn = min(t0, t1), tf = max(t0, t1);
+    float enter = max(max(tn.x, tn.y), tn.z), leave = min(min(tf.x, tf.y), tf.z);
+    if (enter > leave || leave <= 0.0) return color;
+    float faces[2] = float[2](enter, leave);
+    for (int k = 0; k < 2; ++k) {
+        float t = faces[k];
+        if (t <= 0.0 || t > t_max) continue;
+        vec3 p = o + d * t;
+        // Near an edge: two coordinates at their bounds (width grows with distance).
+        float w = 0.0025 * t;
+        vec3 near_lo = step(abs(p - lo), vec3(w)), near_hi = step(abs(p - hi), vec3(w));
+        float on = dot(max(near_lo, near_hi), vec3(1.0));
+        color = on >= 2.0 ? mix(color, vec3(0.02, 0.03, 0.05), 0.85)
+                          : mix(color, vec3(0.75, 0.85, 0.95), 0.08);
+    }
+    return color;
+}
+
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
 const int STACK = 8;
 
@@ -301,6 +326,7 @@ void main() {
 #endif
     }
     CUT_UNLESS(!(sp > 0))
+    color = with_tank(color, o, d, dbg.x >= 0.0 ? dbg.x : 1e30);
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
     if (P.debug != 0u) debug_out[id] = dbg;

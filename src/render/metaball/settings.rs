@@ -36,6 +36,9 @@ pub struct MetaballSettings {
     pub absorb: [f32; 3],
     /// Phong colour ("tar monster").
     pub base: [f32; 3],
+    /// The container to draw around the fluid (min, max), as glass walls with dark edges.
+    #[serde(default)]
+    pub tank: Option<[[f32; 3]; 2]>,
     /// Equirectangular sky image (else the procedural sky).
     pub sky: Option<String>,
 }
@@ -96,11 +99,12 @@ impl MetaballSettings {
                     Some(Material::Glass) | Some(Material::Tinted)
                 ),
             },
-            width: sw.frame.width,
-            height: sw.frame.height,
+            width: sw.frame.width(),
+            height: sw.frame.height(),
             ior: 1.33,
             absorb: [6.0, 2.0, 0.8],
             base: [0.08, 0.06, 0.05],
+            tank: None,
             sky: sw.metaball.sky.clone(),
         };
         if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
@@ -249,6 +253,9 @@ pub struct RenderParams {
     pub absorb: [f32; 4],
     pub f0: [f32; 4],
     pub base: [f32; 4],
+    /// The container drawn as glass walls with dark edges: min xyz (w = 1: draw), max xyz.
+    pub tank_min: [f32; 4],
+    pub tank_max: [f32; 4],
     pub width: u32,
     pub height: u32,
     pub n: u32,
@@ -262,7 +269,7 @@ pub struct RenderParams {
     pub debug: u32,
     pub pad: u32,
 }
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 336);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 368);
 
 impl RenderParams {
     pub fn new(
@@ -287,6 +294,14 @@ impl RenderParams {
             absorb: [s.absorb[0], s.absorb[1], s.absorb[2], s.ior],
             f0: [f0[0], f0[1], f0[2], 0.0],
             base: [s.base[0], s.base[1], s.base[2], s.threshold],
+            tank_min: match s.tank {
+                Some([lo, _]) => [lo[0], lo[1], lo[2], 1.0],
+                None => [0.0; 4],
+            },
+            tank_max: match s.tank {
+                Some([_, hi]) => [hi[0], hi[1], hi[2], 0.0],
+                None => [0.0; 4],
+            },
             width: s.width,
             height: s.height,
             n,
