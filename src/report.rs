@@ -189,7 +189,7 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
             // timestamps inside its rasterizer scene, so compute scopes of frames after a
             // draw can read near zero while frame_ms stays right.
             timing_caveat: (self.device.name.contains("llvmpipe") && drew).then(|| {
-                "llvmpipe: per-pass compute times after a draw are unreliable (frame_ms is right); use `fluidform bench` for per-pass times".to_string()
+                "llvmpipe: once a frame has drawn, its rasterizer threads resolve timestamps late and some compute passes read too short (frame_ms and top-level scopes are right); use `fluidform bench` for per-pass times".to_string()
             }),
             validation: self
                 .validation

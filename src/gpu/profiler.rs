@@ -29,6 +29,10 @@ struct Slot {
 
 pub struct Profiler {
     slots: Vec<Slot>,
+    /// llvmpipe resolves a timestamp at the *next* flush once its rasterizer has been used
+    /// (lavapipe flushes before each timestamp, and llvmpipe bins the query into a new
+    /// scene), so every timestamp there is followed by a throwaway one that settles it.
+    settle: bool,
     period_ns: f64,
     mask: u64,
     /// Open scopes: (index into the slot's scopes, key).
@@ -82,6 +86,7 @@ impl Profiler {
         let bits = ctx.info.timestamp_valid_bits;
         let mut p = Self {
             slots: v,
+            settle: ctx.info.loop_budget.is_some(),
             period_ns: ctx.info.timestamp_period_ns as f64,
             mask: if bits >= 64 {
                 u64::MAX
@@ -172,6 +177,7 @@ impl Profiler {
                         q % POOL_QUERIES,
                     )
                 };
+                self.settle_timestamp(ctx, cmd);
                 (q, q + 1)
             }
             // No query pool could be made: keep the label, report at collect.
@@ -197,8 +203,27 @@ impl Profiler {
                     q % POOL_QUERIES,
                 )
             };
+            self.settle_timestamp(ctx, cmd);
         }
         ctx.end_label(cmd);
+    }
+
+    /// On llvmpipe: a throwaway timestamp right after a real one, so the real one is
+    /// resolved now rather than at the next flush (see `settle`).
+    fn settle_timestamp(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        if !self.settle {
+            return;
+        }
+        if let Some((pool, q)) = self.next_query(ctx) {
+            unsafe {
+                ctx.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    pool,
+                    q % POOL_QUERIES,
+                )
+            };
+        }
     }
 
     /// Read `slot`'s results; call only after that slot's fence has signalled.
