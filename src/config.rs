@@ -175,6 +175,19 @@ pub struct CameraArgs {
     pub fov: Option<f32>,
 }
 
+switch_enum!(ExportFormat { Ply, Vtk });
+
+/// Particle files for ParaView, Blender and splashsurf (SPH runs).
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct ExportArgs {
+    /// Write the particles as binary PLY or legacy VTK files, with particles.csv
+    #[arg(long, value_enum)]
+    pub export: Option<ExportFormat>,
+    /// Export every K-th frame (default 1)
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub export_every: Option<u64>,
+}
+
 /// Characters and control particles: not built yet, each fails naming what brings it.
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ControlArgs {
@@ -224,6 +237,9 @@ pub struct Switches {
     pub camera: CameraArgs,
     #[command(flatten)]
     #[serde(flatten)]
+    pub export: ExportArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
     pub control: ControlArgs,
 }
 
@@ -271,6 +287,7 @@ pub enum Group {
     View,
     Metaball,
     Camera,
+    Export,
 }
 
 /// The switches of `g` that differ from the group's defaults, as written on the command
@@ -294,7 +311,7 @@ impl Switches {
     /// applies, and for every control switch (not built yet), naming what brings it: a
     /// switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
-        let groups: [(Group, Vec<String>, &str); 6] = [
+        let groups: [(Group, Vec<String>, &str); 7] = [
             (
                 Group::Sort,
                 set_in(&self.sorting),
@@ -321,6 +338,7 @@ impl Switches {
                 set_in(&self.camera),
                 "rendered SPH scenes and bench render",
             ),
+            (Group::Export, set_in(&self.export), "run with an SPH scene"),
         ];
         for (g, set, owner) in groups {
             if let Some(name) = set.first().filter(|_| !uses.contains(&g)) {

@@ -4,6 +4,7 @@ pub mod animation;
 pub mod bench;
 pub mod config;
 pub mod error;
+pub mod export;
 pub mod gpu;
 pub mod particles;
 pub mod primitives;

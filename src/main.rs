@@ -249,8 +249,12 @@ fn main() -> Result<()> {
                 .as_ref()
                 .map(|p| format!(", {}", p.display()))
                 .unwrap_or_default();
+            let exports = match r.exports.len() {
+                0 => String::new(),
+                k => format!(", {k} particle files and particles.csv"),
+            };
             println!(
-                "wrote {} frame PNGs{anim}, timings.csv and summary.json to {}",
+                "wrote {} frame PNGs{anim}{exports}, timings.csv and summary.json to {}",
                 r.pngs.len(),
                 out.display()
             );

@@ -72,6 +72,8 @@ pub struct RunResult {
     pub pngs: Vec<PathBuf>,
     /// animation.png (APNG) of the saved frames, when any were saved.
     pub animation: Option<PathBuf>,
+    /// Particle files written by --export.
+    pub exports: Vec<PathBuf>,
 }
 
 /// Frames per second the animation plays at.
@@ -260,6 +262,7 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
         summary,
         pngs: work.frames.pngs,
         animation,
+        exports: Vec::new(),
     })
 }
 
@@ -270,6 +273,7 @@ struct SphWork<'a> {
     stepper: crate::sph::run::Stepper,
     view: Box<dyn crate::viewer::View>,
     frames: Frames<'a>,
+    export: Option<crate::export::ParticleExport>,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -289,6 +293,9 @@ impl FrameWork for SphWork<'_> {
             sync::COMPUTE_WRITE,
             sync::TRANSFER_READ | sync::GRAPHICS_READ,
         );
+        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+            e.record(ctx, cmd, &self.st, slot, self.stepper.sim_time);
+        }
         let save = self.frames.save(frame);
         let st = &self.st;
         self.view
@@ -297,6 +304,9 @@ impl FrameWork for SphWork<'_> {
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         self.stepper.retire_slot(slot, frame)?;
+        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+            e.retire(frame, slot)?;
+        }
         let save = self.frames.save(frame);
         let pic = self.view.retire(ctx, slot, self.st.n, save)?;
         self.frames.store(frame, pic)
@@ -306,6 +316,9 @@ impl FrameWork for SphWork<'_> {
 impl SphWork<'_> {
     fn destroy(&mut self, ctx: &Context) {
         self.stepper.destroy(ctx);
+        if let Some(e) = &mut self.export {
+            e.destroy(ctx);
+        }
         self.view.destroy(ctx);
         self.st.destroy(ctx);
         self.solver.destroy(ctx);
@@ -324,6 +337,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         Group::Neighbors,
         Group::Fluid,
         Group::View,
+        Group::Export,
         Group::Camera,
     ];
     if render == RenderKind::Metaballs {
@@ -397,12 +411,28 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             return Err(e);
         }
     };
+    let export = match sw.export.export {
+        None => None,
+        Some(format) => {
+            let every = sw.export.export_every.unwrap_or(1);
+            match crate::export::ParticleExport::new(&ctx, format, every, &opts.out, &st, SLOTS) {
+                Ok(e) => Some(e),
+                Err(e) => {
+                    let mut stepper = stepper;
+                    stepper.destroy(&ctx);
+                    view.destroy(&ctx);
+                    return Err(e);
+                }
+            }
+        }
+    };
     let mut work = SphWork {
         solver: solver.take(),
         st: st.take(),
         stepper,
         view,
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
+        export,
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -413,6 +443,11 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
     let render_stats = work.view.stats();
     let sort = work.solver.search.sort;
+    let exports = work
+        .export
+        .as_ref()
+        .map(|e| e.files.clone())
+        .unwrap_or_default();
     work.destroy(&ctx);
     let timings = timings?;
     let animation = work.frames.finish()?;
@@ -450,5 +485,6 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         summary,
         pngs: work.frames.pngs,
         animation,
+        exports,
     })
 }

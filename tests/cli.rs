@@ -649,3 +649,87 @@ fn bytes_per_particle_bounds_the_allocation() {
         "the bound is loose: {per_particle} of {bound}"
     );
 }
+
+/// `--export ply|vtk` writes files ParaView, Blender and splashsurf read: read back here.
+#[test]
+fn particle_export_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = [
+        "--scene", "drop", "--frames", "3", "--width", "64", "--height", "48",
+    ];
+    // Binary little-endian PLY.
+    let ply_dir = dir.path().join("ply");
+    let s = run_ok(&ply_dir, &[&base[..], &["--export", "ply"]].concat());
+    let n = s["stats"]["particles"].as_u64().unwrap() as usize;
+    let bytes = std::fs::read(ply_dir.join("particles_0002.ply")).unwrap();
+    let end = b"end_header\n";
+    let at = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+    let header = std::str::from_utf8(&bytes[..at]).unwrap();
+    assert!(
+        header.starts_with("ply\nformat binary_little_endian 1.0\n"),
+        "{header}"
+    );
+    assert!(
+        header.contains(&format!("element vertex {n}\n")),
+        "{header}"
+    );
+    assert_eq!(
+        bytes.len() - at,
+        n * 36,
+        "9 four-byte properties per particle"
+    );
+    let rec = |i: usize, k: usize| {
+        let o = at + i * 36 + k * 4;
+        <[u8; 4]>::try_from(&bytes[o..o + 4]).unwrap()
+    };
+    let mut groups = std::collections::BTreeSet::new();
+    for i in 0..n {
+        let p: Vec<f32> = (0..3).map(|k| f32::from_le_bytes(rec(i, k))).collect();
+        assert!(
+            p.iter().all(|x| (0.0..=1.0).contains(x)),
+            "particle {i} at {p:?}"
+        );
+        assert!(f32::from_le_bytes(rec(i, 6)) > 0.0, "density of {i}");
+        groups.insert(u32::from_le_bytes(rec(i, 8)));
+    }
+    assert_eq!(
+        groups.into_iter().collect::<Vec<_>>(),
+        [0, 1],
+        "pool and ball groups"
+    );
+    // particles.csv: one row per exported frame.
+    let csv = std::fs::read_to_string(ply_dir.join("particles.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r.split(',').nth(2).unwrap(), n.to_string());
+    }
+    // Legacy VTK, big-endian: the points, then the point data in order.
+    let vtk_dir = dir.path().join("vtk");
+    run_ok(
+        &vtk_dir,
+        &[&base[..], &["--export", "vtk", "--export-every", "2"]].concat(),
+    );
+    assert!(
+        !vtk_dir.join("particles_0001.vtk").exists(),
+        "every second frame only"
+    );
+    let bytes = std::fs::read(vtk_dir.join("particles_0002.vtk")).unwrap();
+    let find = |s: &str| {
+        bytes
+            .windows(s.len())
+            .position(|w| w == s.as_bytes())
+            .unwrap()
+            + s.len()
+    };
+    let pts = find(&format!("POINTS {n} float\n"));
+    let first: Vec<f32> = (0..3)
+        .map(|k| f32::from_be_bytes(bytes[pts + 4 * k..pts + 4 * k + 4].try_into().unwrap()))
+        .collect();
+    assert!(first.iter().all(|x| (0.0..=1.0).contains(x)), "{first:?}");
+    let dens = find("SCALARS density float 1\nLOOKUP_TABLE default\n");
+    let rho = f32::from_be_bytes(bytes[dens..dens + 4].try_into().unwrap());
+    assert!(rho > 100.0 && rho < 5000.0, "density {rho}");
+    let grp = find("SCALARS group int 1\nLOOKUP_TABLE default\n");
+    assert_eq!(bytes.len() - grp, n * 4 + 1);
+}
