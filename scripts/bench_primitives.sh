@@ -19,9 +19,10 @@ for what in scan sort neighbors; do
   echo "    fluidform ${cmd[*]:1}" >> "$md.tmp"
   "${cmd[@]}" > /dev/null
   cp "out/bench/$what/sweep.csv" "$dir/$what.csv"
+  cp "out/bench/$what/sweep.png" "$dir/$what.png"
 done
 for what in scan sort neighbors; do
-  { echo; echo "## $what"; echo; cat "out/bench/$what/sweep.md"; } >> "$md.tmp"
+  { echo; echo "## $what"; echo; cat "out/bench/$what/sweep.md"; echo; echo "![$what cost per element against N]($what.png)"; } >> "$md.tmp"
 done
 mv "$md.tmp" "$md"
 echo "wrote $md"

@@ -14,6 +14,8 @@ glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material
 "${glass[@]}" > /dev/null
 cp out/bench/render-phong/sweep.csv "$dir/render-phong.csv"
 cp out/bench/render-glass/sweep.csv "$dir/render-glass.csv"
+cp out/bench/render-phong/sweep.png "$dir/render-phong.png"
+cp out/bench/render-glass/sweep.png "$dir/render-glass.png"
 md=$dir/render.md
 {
   echo "# Metaball rendering on $slug"
@@ -33,8 +35,12 @@ md=$dir/render.md
   echo
   cat out/bench/render-phong/sweep.md
   echo
+  echo "![Phong frame time per list](render-phong.png)"
+  echo
   echo "## Glass, recursion depth 3"
   echo
   cat out/bench/render-glass/sweep.md
+  echo
+  echo "![Glass frame time per list](render-glass.png)"
 } > "$md"
 echo "wrote $md"

@@ -12,6 +12,7 @@ stab=("$bin" bench stability --out out/bench/stability "${dev[@]}")
 "${sweep[@]}" > /dev/null
 "${stab[@]}" > /dev/null
 cp out/bench/sph/sweep.csv "$dir/sph.csv"
+cp out/bench/sph/sweep.png "$dir/sph.png"
 cp out/bench/stability/stability.json "$dir/stability.json"
 {
   echo "# SPH on $slug"
@@ -26,6 +27,8 @@ cp out/bench/stability/stability.json "$dir/stability.json"
   echo "## Steps: the dam break scaled to N, one step per repetition"
   echo
   cat out/bench/sph/sweep.md
+  echo
+  echo "![SPH step cost per particle against N](sph.png)"
   echo
   echo "## Stability: the 32K dam break for 10 000 steps"
   echo

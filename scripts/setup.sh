@@ -10,6 +10,8 @@ PACKAGES=(
   libshaderc-dev glslang-dev spirv-tools
   # C/C++ toolchain for the static link (libstdc++) and pkg-config
   build-essential pkg-config
+  # DejaVu Sans for the benchmark plots
+  fonts-dejavu-core
 )
 
 missing=()

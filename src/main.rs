@@ -65,6 +65,26 @@ enum Command {
         #[arg(long, global = true, default_value_t = 300.0)]
         budget_s: f64,
     },
+    /// Plot a sweep.csv (e.g. a committed results/<device>/sph.csv) as a PNG
+    Plot {
+        /// The sweep CSV (variant,n,reps,median_ms,min_ms,max_ms,...)
+        csv: PathBuf,
+        /// The PNG to write
+        #[arg(long)]
+        out: PathBuf,
+        /// Title, e.g. "bench sph"
+        #[arg(long)]
+        title: String,
+        /// What the median times (axis label), e.g. "sph step"
+        #[arg(long)]
+        scope: String,
+        /// The device the CSV was measured on
+        #[arg(long)]
+        device: String,
+        /// The date it was measured (YYYY-MM-DD)
+        #[arg(long)]
+        date: String,
+    },
     /// Reproduce a table of the papers
     Experiment {
         name: String,
@@ -278,6 +298,19 @@ fn main() -> Result<()> {
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{} configurations; wrote {}", rows.len(), out.display());
+            Ok(())
+        }
+        Command::Plot {
+            csv,
+            out,
+            title,
+            scope,
+            device,
+            date,
+        } => {
+            let rows = fluidform::bench::plot::read_sweep(&csv)?;
+            fluidform::bench::plot::sweep_dated(&out, &title, &scope, &device, &date, &rows)?;
+            println!("wrote {}", out.display());
             Ok(())
         }
         Command::Experiment { name, .. } => {

@@ -417,6 +417,34 @@ fn bench_smoke_writes_sweep_tables() {
         }
         let md = std::fs::read_to_string(out.join("sweep.md")).unwrap();
         assert!(md.contains("| variant | N | reps |"), "{what}");
+        // The plot beside the table: a real image, not blank.
+        let img = image::open(out.join("sweep.png"))
+            .unwrap_or_else(|e| panic!("{what}: sweep.png: {e}"))
+            .to_rgb8();
+        assert_eq!(img.dimensions(), (900, 560), "{what}");
+        let coloured = img
+            .pixels()
+            .filter(|p| p[0] != p[1] || p[1] != p[2])
+            .count();
+        assert!(coloured > 500, "{what}: only {coloured} coloured pixels");
+        // `fluidform plot` draws the same table from its CSV.
+        let png = out.join("again.png");
+        let o = fluidform(&[
+            "plot",
+            out.join("sweep.csv").to_str().unwrap(),
+            "--out",
+            png.to_str().unwrap(),
+            "--title",
+            what,
+            "--scope",
+            what,
+            "--device",
+            "lavapipe",
+            "--date",
+            "2026-01-01",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert_eq!(image::open(&png).unwrap().width(), 900);
         let runs: Vec<_> = std::fs::read_dir(out.join("runs")).unwrap().collect();
         assert_eq!(runs.len(), rows.len() - 1, "{what}: one summary per row");
     }

@@ -1,6 +1,7 @@
 //! `fluidform bench <what>`: warm-up, timed repetitions, per-pass GPU ms in the output
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
+pub mod plot;
 pub mod primitives;
 pub mod render;
 pub mod sph;
@@ -303,5 +304,12 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String
     std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
     let p = opts.out.join("sweep.md");
     std::fs::write(&p, md).map_err(|e| io(&p, e))?;
-    Ok(())
+    let title = format!("bench {}", opts.what);
+    plot::sweep(
+        &opts.out.join("sweep.png"),
+        &title,
+        &opts.what,
+        &ctx.info.name,
+        rows,
+    )
 }

@@ -1,0 +1,224 @@
+//! A PNG beside every sweep table (plotters): cost per element against N per variant on
+//! log-log axes where a variant has several N, else the median per variant as bars (list
+//! modes, materials). Axes carry units; the title names the device and the date.
+use super::Row;
+use crate::error::{Error, Result};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// DejaVu Sans from Debian's fonts-dejavu-core (installed by scripts/setup.sh).
+const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+fn err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Image {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Register the font once; plotters draws text with it.
+fn font() -> Result<()> {
+    static DONE: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        let bytes = std::fs::read(FONT)
+            .map_err(|e| format!("{FONT}: {e} (install fonts-dejavu-core: scripts/setup.sh)"))?;
+        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+        plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
+            .map_err(|_| format!("{FONT}: not a usable TrueType font"))
+    })
+    .clone()
+    .map_err(|m| Error::Image {
+        path: FONT.into(),
+        message: m,
+    })
+}
+
+/// Today's date (UTC) as YYYY-MM-DD.
+pub fn today() -> String {
+    let days = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() / 86_400)
+        .unwrap_or(0) as i64;
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + (m <= 2) as i64;
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// The rows of a sweep.csv (`variant,n,reps,median_ms,min_ms,max_ms,...`).
+pub fn read_sweep(path: &Path) -> Result<Vec<Row>> {
+    let bad = |m: String| Error::Param(format!("{}: {m}", path.display()));
+    let mut r = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let mut rows = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| bad(e.to_string()))?;
+        let num = |i: usize| -> Result<f64> {
+            rec.get(i)
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| bad(format!("column {i} of {rec:?} is not a number")))
+        };
+        rows.push(Row {
+            variant: rec.get(0).unwrap_or("").to_string(),
+            n: num(1)? as u64,
+            reps: num(2)? as u64,
+            main: crate::report::Stat {
+                median: num(3)?,
+                min: num(4)?,
+                max: num(5)?,
+            },
+            passes: Vec::new(),
+            extra: Vec::new(),
+        });
+    }
+    if rows.is_empty() {
+        return Err(bad("no rows".into()));
+    }
+    Ok(rows)
+}
+
+/// Write the sweep's plot to `path`; `title` names the benchmark, `scope` its timed scope.
+pub fn sweep(path: &Path, title: &str, scope: &str, device: &str, rows: &[Row]) -> Result<()> {
+    sweep_dated(path, title, scope, device, &today(), rows)
+}
+
+/// As `sweep`, with the date of the measurement.
+pub fn sweep_dated(
+    path: &Path,
+    title: &str,
+    scope: &str,
+    device: &str,
+    date: &str,
+    rows: &[Row],
+) -> Result<()> {
+    font()?;
+    let mut variants: Vec<&str> = Vec::new();
+    for r in rows {
+        if !variants.contains(&r.variant.as_str()) {
+            variants.push(&r.variant);
+        }
+    }
+    let several_n = variants
+        .iter()
+        .any(|v| rows.iter().filter(|r| r.variant == *v).count() > 1);
+    let caption = format!("{title}: {device}, {date}");
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    if several_n {
+        let per = |r: &Row| r.main.median * 1e6 / r.n.max(1) as f64;
+        let (nmin, nmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
+            (a.min(r.n as f64), b.max(r.n as f64))
+        });
+        let (cmin, cmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
+            (a.min(per(r)), b.max(per(r)))
+        });
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&caption, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(
+                (nmin / 1.3..nmax * 1.3).log_scale(),
+                (cmin / 1.5..cmax * 1.5).log_scale(),
+            )
+            .map_err(|e| err(path, e))?;
+        chart
+            .configure_mesh()
+            .x_desc("N (elements)")
+            .y_desc(format!("{scope} ns per element"))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| {
+                if *y >= 10.0 {
+                    format!("{y:.0}")
+                } else {
+                    format!("{y:.2}")
+                }
+            })
+            .draw()
+            .map_err(|e| err(path, e))?;
+        for (i, v) in variants.iter().enumerate() {
+            let c = PALETTE[i % PALETTE.len()];
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.variant == *v)
+                .map(|r| (r.n as f64, per(r)))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+                .map_err(|e| err(path, e))?
+                .label(*v)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
+            chart
+                .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))
+                .map_err(|e| err(path, e))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(path, e))?;
+    } else {
+        let ymax = rows.iter().map(|r| r.main.max).fold(0.0f64, f64::max);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&caption, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(0.0..rows.len() as f64, 0.0..ymax * 1.15)
+            .map_err(|e| err(path, e))?;
+        let labels: Vec<String> = rows
+            .iter()
+            .map(|r| format!("{} (N {})", r.variant, r.n))
+            .collect();
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(rows.len() * 2 + 1)
+            .x_label_formatter(&|x| {
+                let i = (*x - 0.5).round();
+                if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+                    labels[i as usize].clone()
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc(format!("{scope} ms (median, bar: min..max)"))
+            .draw()
+            .map_err(|e| err(path, e))?;
+        for (i, r) in rows.iter().enumerate() {
+            let c = PALETTE[i % PALETTE.len()];
+            let x = i as f64;
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x + 0.15, 0.0), (x + 0.85, r.main.median)],
+                    c.filled(),
+                )))
+                .map_err(|e| err(path, e))?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(x + 0.5, r.main.min), (x + 0.5, r.main.max)],
+                    BLACK.stroke_width(2),
+                )))
+                .map_err(|e| err(path, e))?;
+        }
+    }
+    root.present().map_err(|e| err(path, e))
+}
