@@ -140,7 +140,9 @@ pub fn measure(
     mut record: impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
 ) -> Result<Row> {
     // One warm-up frame tells how long a repetition takes.
-    let first = run_frames(ctx, 1, &mut record)?;
+    let label = format!("{variant} n={n}");
+    let quiet = opts.switches.common.quiet;
+    let first = run_frames(ctx, 1, &mut record, &label, true)?;
     let per_frame_s = first.iter().map(|t| t.frame_ms).sum::<f64>() / 1000.0;
     let reps = if per_frame_s * opts.frames as f64 <= opts.budget_s {
         opts.frames
@@ -152,7 +154,7 @@ pub fn measure(
     } else {
         0
     };
-    let mut timings = run_frames(ctx, warmup + reps, &mut record)?;
+    let mut timings = run_frames(ctx, warmup + reps, &mut record, &label, quiet)?;
     timings.retain(|t| t.frame >= warmup);
     for t in &mut timings {
         t.frame -= warmup;
@@ -201,17 +203,22 @@ pub fn measure(
     })
 }
 
+/// `count` frames of `record`, with a progress bar (or plain lines) named `label`.
 fn run_frames(
     ctx: &Context,
     count: u64,
     record: &mut impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
+    label: &str,
+    quiet: bool,
 ) -> Result<Vec<FrameTiming>> {
     let mut frames = FrameLoop::new(ctx, 2)?;
-    let r = frames.run(
-        ctx,
-        count,
-        &mut RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd)),
-    );
+    let mut work = RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd));
+    let mut reporting = crate::progress::Reporting {
+        work: &mut work,
+        progress: crate::progress::Progress::new(label, count, quiet),
+    };
+    let r = frames.run(ctx, count, &mut reporting);
+    reporting.progress.finish();
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);
     r.map(|_| timings)
