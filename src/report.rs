@@ -139,6 +139,7 @@ pub struct Summary<C, S> {
     pub fps: Option<f64>,
     pub memory_bytes: BTreeMap<String, u64>,
     pub stats: S,
+    /// A device's note on its timings, where some cannot be trusted (none known now).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub timing_caveat: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -151,9 +152,6 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
         source: e,
     }
 }
-
-/// Scopes that rasterise (after which llvmpipe's compute timestamps are unreliable).
-pub const DRAW_SCOPES: &[&str] = &["points", "render/count", "render/fill"];
 
 /// What one `run` or `bench` measured.
 pub struct Report<'a, C, S> {
@@ -169,11 +167,6 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
     pub fn summary(&self) -> Summary<C, S> {
         let frame: Vec<f64> = self.timings.iter().map(|t| t.frame_ms).collect();
         let frame_ms = stat(&frame);
-        let drew = self.timings.iter().any(|t| {
-            t.passes
-                .iter()
-                .any(|(n, _)| DRAW_SCOPES.contains(&n.as_str()))
-        });
         Summary {
             device: DeviceSummary::of(self.device),
             config: self.config.clone(),
@@ -185,12 +178,7 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
                 .map(|s| 1000.0 / s.median),
             memory_bytes: self.memory.clone(),
             stats: self.stats.clone(),
-            // Measured here: once a framebuffer is bound, llvmpipe resolves some later
-            // timestamps inside its rasterizer scene, so compute scopes of frames after a
-            // draw can read near zero while frame_ms stays right.
-            timing_caveat: (self.device.name.contains("llvmpipe") && drew).then(|| {
-                "llvmpipe: once a frame has drawn, its rasterizer threads resolve timestamps late and some compute passes read too short (frame_ms and top-level scopes are right); use `fluidform bench` for per-pass times".to_string()
-            }),
+            timing_caveat: None,
             validation: self
                 .validation
                 .map(|(errors, warnings)| ValidationCounts { errors, warnings }),

@@ -767,3 +767,65 @@ fn particle_export_reads_back() {
     let grp = find("SCALARS group int 1\nLOOKUP_TABLE default\n");
     assert_eq!(bytes.len() - grp, n * 4 + 1);
 }
+
+/// `run`'s per-pass times are right on lavapipe too, drawing and all: per step they agree
+/// with `bench sph` for the same scene, N and neighbour search (medians within 1.5x).
+#[test]
+fn run_pass_times_agree_with_bench() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = "6000";
+    let run = run_ok(
+        &dir.path().join("run"),
+        &[
+            "--scene",
+            "dam-break",
+            "--particles",
+            n,
+            "--frames",
+            "10",
+            "--render",
+            "points",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--neighbors",
+            "grid",
+        ],
+    );
+    let steps_per_frame = run["config"]["fluid"]["substeps"].as_f64().unwrap();
+    let bench_dir = dir.path().join("bench");
+    let o = fluidform(&[
+        "bench",
+        "sph",
+        "--particles",
+        n,
+        "--neighbors",
+        "grid",
+        "--frames",
+        "10",
+        "--warmup",
+        "2",
+        "--quiet",
+        "--out",
+        bench_dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(bench_dir.join("sweep.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for pass in ["sph/density", "sph/forces", "sph"] {
+        let col = head
+            .iter()
+            .position(|h| *h == format!("{pass}_ms"))
+            .unwrap();
+        let bench: f64 = row[col].parse().unwrap();
+        let ran = run["pass_ms"][pass]["median"].as_f64().unwrap() / steps_per_frame;
+        let ratio = ran / bench;
+        assert!(
+            (1.0 / 1.5..=1.5).contains(&ratio),
+            "{pass}: run {ran:.3} ms per step, bench {bench:.3} ms (ratio {ratio:.2})"
+        );
+    }
+}

@@ -29,9 +29,11 @@ struct Slot {
 
 pub struct Profiler {
     slots: Vec<Slot>,
-    /// llvmpipe resolves a timestamp at the *next* flush once its rasterizer has been used
-    /// (lavapipe flushes before each timestamp, and llvmpipe bins the query into a new
-    /// scene), so every timestamp there is followed by a throwaway one that settles it.
+    /// llvmpipe resolves a timestamp on its rasterizer threads at the next flush once a
+    /// framebuffer has been bound (lavapipe flushes before each timestamp, and llvmpipe
+    /// bins the query into a new scene), so later compute scopes read too short. There,
+    /// every timestamp is followed by a barrier, which lavapipe executes as a stall (flush
+    /// and wait): the timestamp resolves before any later work starts.
     settle: bool,
     period_ns: f64,
     mask: u64,
@@ -208,22 +210,14 @@ impl Profiler {
         ctx.end_label(cmd);
     }
 
-    /// On llvmpipe: a throwaway timestamp right after a real one, so the real one is
-    /// resolved now rather than at the next flush (see `settle`).
-    fn settle_timestamp(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    /// On llvmpipe: a stall right after a timestamp, so it resolves now (see `settle`).
+    fn settle_timestamp(&self, ctx: &Context, cmd: vk::CommandBuffer) {
         if !self.settle {
             return;
         }
-        if let Some((pool, q)) = self.next_query(ctx) {
-            unsafe {
-                ctx.device.cmd_write_timestamp2(
-                    cmd,
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    pool,
-                    q % POOL_QUERIES,
-                )
-            };
-        }
+        // lavapipe executes a pipeline barrier as a stall (flush and wait), which resolves
+        // the timestamp just binned before any later work starts.
+        ctx.barrier(cmd, super::sync::ALL, super::sync::ALL);
     }
 
     /// Read `slot`'s results; call only after that slot's fence has signalled.

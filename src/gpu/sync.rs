@@ -90,6 +90,14 @@ pub const ATTACHMENT_WRITE: Access = acc(
             | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
     ),
 );
+/// Every stage and access: only for an execution stall that protects no data (the
+/// profiler's timestamp settle on llvmpipe).
+pub const ALL: Access = acc(
+    vk::PipelineStageFlags2::ALL_COMMANDS,
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::MEMORY_READ.as_raw() | vk::AccessFlags2::MEMORY_WRITE.as_raw(),
+    ),
+);
 /// The host reading a mapped buffer after the fence.
 pub const HOST_READ: Access = acc(vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ);
 
