@@ -153,6 +153,35 @@ fn stiff_water() -> FluidParams {
     }
 }
 
+/// A water column of size `column` at the origin released in a tank of size `tank`, seen
+/// from the front at height and distance `view`, 600 frames of stiff water.
+fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Scene {
+    Scene {
+        name: name.into(),
+        domain: Domain {
+            min: [0.0; 3],
+            max: tank,
+        },
+        fluid: stiff_water(),
+        blocks: vec![Block {
+            min: [0.0; 3],
+            max: column,
+            group: 0,
+            color: [0.2, 0.45, 1.0],
+            velocity: [0.0; 3],
+        }],
+        balls: vec![],
+        colliders: vec![],
+        camera: Some(CameraDesc {
+            eye: [0.5 * tank[0], view[0], view[1]],
+            target: [0.5 * tank[0], 0.25 * tank[1], 0.5 * tank[2]],
+            fov: 45.0,
+        }),
+        frames: 600,
+        look: Look::default(),
+    }
+}
+
 impl Scene {
     pub fn built_in(name: &str) -> Option<Self> {
         let blue = [0.2, 0.45, 1.0];
@@ -161,63 +190,22 @@ impl Scene {
             // The default: a small dam break made to watch in a minute or two on a 2-core
             // CPU (7.5K particles, 96 frames of 10.8 ms, tinted water at 300 x 200).
             "demo" => Scene {
-                name: name.into(),
-                domain: Domain {
-                    min: [0.0, 0.0, 0.0],
-                    max: [1.5, 0.9, 0.5],
-                },
                 fluid: FluidParams {
                     sound_speed: 20.0,
                     dt: 9e-4,
                     substeps: 12,
                     ..stiff_water()
                 },
-                blocks: vec![Block {
-                    min: [0.0, 0.0, 0.0],
-                    max: [0.5, 0.63, 0.5],
-                    group: 0,
-                    color: blue,
-                    velocity: [0.0; 3],
-                }],
-                balls: vec![],
-                colliders: vec![],
-                camera: Some(CameraDesc {
-                    eye: [0.75, 0.95, 2.3],
-                    target: [0.75, 0.22, 0.25],
-                    fov: 45.0,
-                }),
                 frames: 96,
                 look: Look {
                     material: Some(crate::config::Material::Tinted),
                     size: Some([300, 200]),
                     tank: None,
                 },
+                ..dam_break(name, [1.5, 0.9, 0.5], [0.5, 0.63, 0.5], [0.95, 2.3])
             },
             // 32K particles: a 0.8 x 1.0 x 0.8 m column released in a 2.4 m long tank.
-            "dam-break" => Scene {
-                name: name.into(),
-                domain: Domain {
-                    min: [0.0, 0.0, 0.0],
-                    max: [2.4, 1.4, 0.8],
-                },
-                fluid: stiff_water(),
-                blocks: vec![Block {
-                    min: [0.0, 0.0, 0.0],
-                    max: [0.8, 1.0, 0.8],
-                    group: 0,
-                    color: blue,
-                    velocity: [0.0; 3],
-                }],
-                balls: vec![],
-                colliders: vec![],
-                camera: Some(CameraDesc {
-                    eye: [1.2, 1.6, 3.4],
-                    target: [1.2, 0.35, 0.4],
-                    fov: 45.0,
-                }),
-                frames: 600,
-                look: Look::default(),
-            },
+            "dam-break" => dam_break(name, [2.4, 1.4, 0.8], [0.8, 1.0, 0.8], [1.6, 3.4]),
             // A ball (group 1) falling into a shallow pool (group 0).
             "drop" => Scene {
                 name: name.into(),
