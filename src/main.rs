@@ -118,27 +118,9 @@ enum BenchWhat {
         search: NeighborArgs,
     },
     /// One SPH step of the dam break scaled to N, per neighbour strategy
-    Sph {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-        #[command(flatten)]
-        search: NeighborArgs,
-        #[command(flatten)]
-        fluid_args: FluidArgs,
-    },
+    Sph(SphBench),
     /// The 32K dam break for 10 000 steps, with physics checkpoints
-    Stability {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-        #[command(flatten)]
-        search: NeighborArgs,
-        #[command(flatten)]
-        fluid_args: FluidArgs,
-    },
+    Stability(SphBench),
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
         #[command(flatten)]
@@ -150,6 +132,31 @@ enum BenchWhat {
         #[command(flatten)]
         camera: CameraArgs,
     },
+}
+
+/// The switches of the SPH benchmarks.
+#[derive(clap::Args)]
+struct SphBench {
+    #[command(flatten)]
+    common: CommonArgs,
+    #[command(flatten)]
+    sorting: SortArgs,
+    #[command(flatten)]
+    search: NeighborArgs,
+    #[command(flatten)]
+    fluid_args: FluidArgs,
+}
+
+impl SphBench {
+    fn switches(self) -> Switches {
+        Switches {
+            common: self.common,
+            sorting: self.sorting,
+            search: self.search,
+            fluid_args: self.fluid_args,
+            ..Switches::default()
+        }
+    }
 }
 
 impl BenchWhat {
@@ -179,36 +186,8 @@ impl BenchWhat {
                     ..d()
                 },
             ),
-            BenchWhat::Sph {
-                common,
-                sorting,
-                search,
-                fluid_args,
-            } => (
-                "sph",
-                Switches {
-                    common,
-                    sorting,
-                    search,
-                    fluid_args,
-                    ..d()
-                },
-            ),
-            BenchWhat::Stability {
-                common,
-                sorting,
-                search,
-                fluid_args,
-            } => (
-                "stability",
-                Switches {
-                    common,
-                    sorting,
-                    search,
-                    fluid_args,
-                    ..d()
-                },
-            ),
+            BenchWhat::Sph(a) => ("sph", a.switches()),
+            BenchWhat::Stability(a) => ("stability", a.switches()),
             BenchWhat::Render {
                 common,
                 frame,

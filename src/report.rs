@@ -139,9 +139,6 @@ pub struct Summary<C, S> {
     pub fps: Option<f64>,
     pub memory_bytes: BTreeMap<String, u64>,
     pub stats: S,
-    /// A device's note on its timings, where some cannot be trusted (none known now).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub timing_caveat: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation: Option<ValidationCounts>,
 }
@@ -178,7 +175,6 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
                 .map(|s| 1000.0 / s.median),
             memory_bytes: self.memory.clone(),
             stats: self.stats.clone(),
-            timing_caveat: None,
             validation: self
                 .validation
                 .map(|(errors, warnings)| ValidationCounts { errors, warnings }),

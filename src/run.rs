@@ -5,15 +5,15 @@ use crate::config::Switches;
 use crate::config::{Neighbors, RenderKind, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::target::save_rgba;
-use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
-use crate::render::{points::PointsPush, Camera, PointsView};
+use crate::gpu::{sync, Context, FrameWork, Guard, Profiler};
+use crate::render::Camera;
 use crate::report::{Report, Summary};
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
 pub use crate::session::{camera_with_switches, check_validation, SLOTS};
 use crate::session::{open, play};
 use crate::sph::run::SphRunStats;
 use crate::sph::FluidParams;
-use crate::viewer::Picture;
+use crate::viewer::{Picture, PointsViewer, View};
 use ash::vk;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -150,10 +150,8 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
 /// The orbits scene: a gravity step and the point view per frame.
 struct OrbitsWork<'a> {
     pass: OrbitsPass,
-    view: PointsView,
+    view: PointsViewer,
     scene: Orbits,
-    target: ColorTarget,
-    push: PointsPush,
     frames: Frames<'a>,
 }
 
@@ -171,35 +169,20 @@ impl FrameWork for OrbitsWork<'_> {
         prof.end(ctx, cmd);
         // New positions -> the point view's vertex shader.
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
-        prof.begin(ctx, cmd, PointsView::NAME);
-        self.target
-            .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-        let s = &self.scene;
-        self.view.draw(ctx, cmd, &s.pos, &s.color, s.n, &self.push);
-        self.target.end_rendering(ctx, cmd);
-        prof.end(ctx, cmd);
-        if self.frames.save(frame) {
-            prof.begin(ctx, cmd, "readback");
-            self.target.copy_out(ctx, cmd, slot);
-            prof.end(ctx, cmd);
-        }
-        Ok(())
+        let (s, save) = (&self.scene, self.frames.save(frame));
+        self.view
+            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, slot, save)
     }
 
-    fn retire(&mut self, _: &Context, frame: u64, slot: usize) -> Result<()> {
-        let t = &self.target;
-        let pic = self.frames.save(frame).then(|| Picture {
-            rgba: t.pixels(slot),
-            width: t.width(),
-            height: t.height(),
-        });
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        let save = self.frames.save(frame);
+        let pic = self.view.retire(ctx, slot, self.scene.n, save)?;
         self.frames.store(frame, pic)
     }
 }
 
 impl OrbitsWork<'_> {
     fn destroy(&mut self, ctx: &Context) {
-        self.target.destroy(ctx);
         self.scene.destroy(ctx);
         self.view.destroy(ctx);
         self.pass.destroy(ctx);
@@ -220,15 +203,12 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
         sw.frame.width() as f32 / sw.frame.height() as f32,
     );
     let pass = Guard::new(&ctx, OrbitsPass::new(&ctx)?);
-    let view = Guard::new(&ctx, PointsView::new(&ctx)?);
     let scene = Guard::new(&ctx, Orbits::new(&ctx, &state)?);
-    let target = ColorTarget::new(&ctx, sw.frame.width(), sw.frame.height(), SLOTS)?;
+    let view = PointsViewer::new(&ctx, sw, &cam, 1.0, SLOTS)?;
     let mut work = OrbitsWork {
         pass: pass.take(),
-        view: view.take(),
+        view,
         scene: scene.take(),
-        target,
-        push: PointsPush::from_camera(&cam, 1.0),
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
     };
     let memory = ctx.memory_bytes();
@@ -403,34 +383,19 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             SLOTS,
         )?),
     };
-    let mut view = view;
-    let stepper = match Stepper::new(&ctx, &st, SLOTS) {
-        Ok(s) => s,
-        Err(e) => {
-            view.destroy(&ctx);
-            return Err(e);
-        }
-    };
-    let export = match sw.export.export {
-        None => None,
-        Some(format) => {
-            let every = sw.export.export_every.unwrap_or(1);
-            match crate::export::ParticleExport::new(&ctx, format, every, &opts.out, &st, SLOTS) {
-                Ok(e) => Some(e),
-                Err(e) => {
-                    let mut stepper = stepper;
-                    stepper.destroy(&ctx);
-                    view.destroy(&ctx);
-                    return Err(e);
-                }
-            }
-        }
-    };
+    let view = Guard::new(&ctx, view);
+    let stepper = Guard::new(&ctx, Stepper::new(&ctx, &st, SLOTS)?);
+    let every = sw.export.export_every.unwrap_or(1);
+    let export = sw
+        .export
+        .export
+        .map(|f| crate::export::ParticleExport::new(&ctx, f, every, &opts.out, &st, SLOTS))
+        .transpose()?;
     let mut work = SphWork {
         solver: solver.take(),
         st: st.take(),
-        stepper,
-        view,
+        stepper: stepper.take(),
+        view: view.take(),
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
     };

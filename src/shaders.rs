@@ -36,14 +36,16 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::render::points::PointsIo>("render/points.vert", &[]),
         with::<crate::render::points::PointsIo>("render/points.frag", &[]),
     ];
-    for sub in [0, 1] {
-        let d = [kv("SUBGROUP", sub), kv("IPT", "16u"), kv("CHUNK", "64u")];
-        for f in ["scan_chunk_reduce", "scan_chunk_down", "scan_block"] {
-            let file: &'static str = match f {
-                "scan_chunk_reduce" => "primitives/scan_chunk_reduce.comp",
-                "scan_chunk_down" => "primitives/scan_chunk_down.comp",
-                _ => "primitives/scan_block.comp",
-            };
+    for sub in [false, true] {
+        let d: Vec<(String, String)> = scan::ScanPass::defines(sub)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        for file in [
+            "primitives/scan_chunk_reduce.comp",
+            "primitives/scan_chunk_down.comp",
+            "primitives/scan_block.comp",
+        ] {
             v.push(with::<scan::ScanIo>(file, &d));
         }
     }

@@ -38,6 +38,12 @@ pub trait View {
     fn destroy(&mut self, ctx: &Context);
 }
 
+impl crate::gpu::Destroy for Box<dyn View> {
+    fn destroy(&mut self, ctx: &Context) {
+        View::destroy(self.as_mut(), ctx)
+    }
+}
+
 /// A frame's RGBA8 pixels.
 pub struct Picture<'a> {
     pub rgba: &'a [u8],

@@ -8,7 +8,7 @@ pub mod sph;
 
 use crate::config::{Group, Switches};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, Profiler, RecordOnly};
+use crate::gpu::{Context, ContextOptions, FrameTiming, Profiler, RecordOnly};
 use crate::report::{stat, Report, Stat};
 use ash::vk;
 use serde_json::Value;
@@ -211,17 +211,8 @@ fn run_frames(
     label: &str,
     quiet: bool,
 ) -> Result<Vec<FrameTiming>> {
-    let mut frames = FrameLoop::new(ctx, 2)?;
     let mut work = RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd));
-    let mut reporting = crate::progress::Reporting {
-        work: &mut work,
-        progress: crate::progress::Progress::new(label, count, quiet),
-    };
-    let r = frames.run(ctx, count, &mut reporting);
-    reporting.progress.finish();
-    let timings = std::mem::take(&mut frames.profiler.results);
-    frames.destroy(ctx);
-    r.map(|_| timings)
+    crate::session::play(ctx, count, &mut work, label, quiet)
 }
 
 fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {

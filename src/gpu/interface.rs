@@ -141,16 +141,32 @@ pub fn reflect(file: &str, spv: &[u32]) -> Result<Reflected> {
 fn without_source_text(spv: &[u32]) -> Vec<u32> {
     const DROP: [u32; 4] = [2, 3, 7, 8];
     let mut out = spv[..spv.len().min(5)].to_vec();
-    let mut i = 5;
-    while i < spv.len() {
-        let count = (spv[i] >> 16).max(1) as usize;
-        let end = (i + count).min(spv.len());
-        if !DROP.contains(&(spv[i] & 0xffff)) {
-            out.extend_from_slice(&spv[i..end]);
+    for ins in instructions(spv) {
+        if !DROP.contains(&(ins[0] & 0xffff)) {
+            out.extend_from_slice(ins);
         }
-        i = end;
     }
     out
+}
+
+/// The module's instructions after its 5-word header, each with its operands (the word
+/// count is in the upper half of the first word).
+fn instructions(spv: &[u32]) -> impl Iterator<Item = &[u32]> {
+    let mut i = 5;
+    std::iter::from_fn(move || {
+        let first = *spv.get(i)?;
+        let end = (i + (first >> 16).max(1) as usize).min(spv.len());
+        let ins = &spv[i..end];
+        i = end;
+        Some(ins)
+    })
+}
+
+/// A SPIR-V literal string (nul-terminated UTF-8 packed into words).
+fn literal_string(words: &[u32]) -> String {
+    let bytes: &[u8] = bytemuck::cast_slice(words);
+    let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+    String::from_utf8_lossy(&bytes[..end]).into_owned()
 }
 
 /// Binding number -> type name of the block bound there (`buffer Pos { ... }` gives "Pos"):
@@ -167,15 +183,10 @@ fn block_names(words: &[u32]) -> BTreeMap<u32, String> {
         BTreeMap::new(),
         BTreeMap::new(),
     );
-    let mut i = 5;
-    while i < words.len() {
-        let count = (words[i] >> 16).max(1) as usize;
-        let ins = &words[i..(i + count).min(words.len())];
+    for ins in instructions(words) {
         match (ins[0] & 0xffff, ins.len()) {
             (NAME, n) if n >= 3 => {
-                let bytes: Vec<u8> = bytemuck::cast_slice(&ins[2..]).to_vec();
-                let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
-                names.insert(ins[1], String::from_utf8_lossy(&bytes[..end]).into_owned());
+                names.insert(ins[1], literal_string(&ins[2..]));
             }
             (TYPE_POINTER, 4) => {
                 pointee.insert(ins[1], ins[3]);
@@ -188,7 +199,6 @@ fn block_names(words: &[u32]) -> BTreeMap<u32, String> {
             }
             _ => {}
         }
-        i += count;
     }
     binding
         .into_iter()
@@ -281,32 +291,17 @@ pub fn enum_defines(prefix: &str, values: &[(&str, u32)]) -> Vec<(String, String
 /// compiler laid it out: the field-offset check of Rust mirrors of GPU structs.
 pub fn member_offsets(spv: &[u32], name: &str) -> Vec<(String, u32)> {
     const NAME: u32 = 5;
-    let text = |w: &[u32]| {
-        let bytes: Vec<u8> = bytemuck::cast_slice(w).to_vec();
-        let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
-        String::from_utf8_lossy(&bytes[..end]).into_owned()
-    };
-    let mut ins = Vec::new();
-    let mut i = 5;
-    while i < spv.len() {
-        let count = (spv[i] >> 16).max(1) as usize;
-        ins.push(&spv[i..(i + count).min(spv.len())]);
-        i += count;
-    }
-    let ids: Vec<u32> = ins
-        .iter()
-        .filter(|w| w[0] & 0xffff == NAME && w.len() >= 3 && text(&w[2..]) == name)
-        .map(|w| w[1])
-        .collect();
+    let ins: Vec<&[u32]> = instructions(spv).collect();
     // The optimizer may copy a struct into a function-local type of the same name with no
     // layout: take the one that carries offsets.
-    ids.iter()
-        .map(|&id| layout_of(&ins, id, &text))
+    ins.iter()
+        .filter(|w| w[0] & 0xffff == NAME && w.len() >= 3 && literal_string(&w[2..]) == name)
+        .map(|w| layout_of(&ins, w[1]))
         .find(|l| !l.is_empty())
         .unwrap_or_default()
 }
 
-fn layout_of(ins: &[&[u32]], id: u32, text: &dyn Fn(&[u32]) -> String) -> Vec<(String, u32)> {
+fn layout_of(ins: &[&[u32]], id: u32) -> Vec<(String, u32)> {
     const MEMBER_NAME: u32 = 6;
     const MEMBER_DECORATE: u32 = 72;
     const OFFSET: u32 = 35;
@@ -315,7 +310,7 @@ fn layout_of(ins: &[&[u32]], id: u32, text: &dyn Fn(&[u32]) -> String) -> Vec<(S
     for w in ins {
         match w[0] & 0xffff {
             MEMBER_NAME if w.len() >= 4 && w[1] == id => {
-                names.insert(w[2], text(&w[3..]));
+                names.insert(w[2], literal_string(&w[3..]));
             }
             MEMBER_DECORATE if w.len() >= 5 && w[1] == id && w[3] == OFFSET => {
                 offsets.insert(w[2], w[4]);

@@ -146,11 +146,7 @@ impl ScanPass {
                 true
             }
         };
-        let defines = [
-            ("SUBGROUP", (subgroup as u32).to_string()),
-            ("IPT", format!("{IPT}u")),
-            ("CHUNK", format!("{CHUNK}u")),
-        ];
+        let defines = Self::defines(subgroup);
         let pipeline = |name, shader| {
             ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, WG))
         };
@@ -169,6 +165,15 @@ impl ScanPass {
             top,
             uses_subgroups: subgroup,
         })
+    }
+
+    /// The scan shaders' defines (also the shader registry's variants).
+    pub fn defines(subgroup: bool) -> [(&'static str, String); 3] {
+        [
+            ("SUBGROUP", (subgroup as u32).to_string()),
+            ("IPT", format!("{IPT}u")),
+            ("CHUNK", format!("{CHUNK}u")),
+        ]
     }
 
     pub fn scratch(&self, ctx: &Context, capacity: u64) -> Result<ScanScratch> {

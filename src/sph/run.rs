@@ -163,3 +163,5 @@ pub fn check(stats: &PhysicsStats) -> Result<()> {
     }
     Ok(())
 }
+
+crate::impl_destroy!(Stepper);

@@ -85,18 +85,8 @@ impl MetaballBuffers {
         self.pixels_readback[slot].mapped().expect("mapped")
     }
 
-    pub fn new(
-        ctx: &Context,
-        s: &MetaballSettings,
-        scan: &ScanPass,
-        n_capacity: u64,
-        slots: usize,
-        debug: bool,
-    ) -> Result<MetaballBuffers> {
-        Self::with_capacity(ctx, s, scan, n_capacity, slots, debug, s.pixels() * 4)
-    }
-
-    /// As `buffers`, with the list's first capacity in entries (it grows on overflow).
+    /// Buffers for `s` and up to `n_capacity` metaballs, the list starting at `capacity`
+    /// entries (it grows on overflow).
     #[allow(clippy::too_many_arguments)]
     pub fn with_capacity(
         ctx: &Context,

@@ -105,7 +105,7 @@ impl MetaballRenderer {
         slots: usize,
         debug: bool,
     ) -> Result<MetaballBuffers> {
-        MetaballBuffers::new(ctx, &self.settings, &self.scan, n_capacity, slots, debug)
+        self.buffers_with_capacity(ctx, n_capacity, slots, debug, self.settings.pixels() * 4)
     }
 
     /// As `buffers`, with the list's first capacity in entries (it grows on overflow).

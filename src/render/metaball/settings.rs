@@ -57,6 +57,15 @@ fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
 }
 
 /// Reflectance at normal incidence from a complex index: ((n-1)^2 + k^2) / ((n+1)^2 + k^2).
+/// LIST in the shaders.
+pub fn list_index(l: ListKind) -> u32 {
+    match l {
+        ListKind::None => 0,
+        ListKind::Abuffer => 1,
+        ListKind::Sbuffer => 2,
+    }
+}
+
 /// MATERIAL in the shaders: the metals share one path.
 pub fn material_index(m: Material) -> u32 {
     match m {
@@ -169,16 +178,6 @@ impl MetaballSettings {
         }
     }
 
-    /// Shader define MATERIAL: 0 phong, 1 glass, 2 tinted, 3 metal.
-    pub fn material_index(&self) -> u32 {
-        match self.material {
-            Material::Phong => 0,
-            Material::Glass => 1,
-            Material::Tinted => 2,
-            Material::Gold | Material::Copper | Material::Aluminium => 3,
-        }
-    }
-
     /// LIST, DENSITY, MATERIAL and SORTED with the named values the shaders compare
     /// against (`LIST_SBUFFER`, ...), all from here.
     pub fn shader_defines(&self) -> Vec<(String, String)> {
@@ -193,13 +192,9 @@ impl MetaballSettings {
         sorted: bool,
     ) -> Vec<(String, String)> {
         use crate::gpu::interface::enum_defines;
-        let probe = |l| match l {
-            ListKind::None => 0,
-            ListKind::Abuffer => 1,
-            ListKind::Sbuffer => 2,
-        };
+        use clap::ValueEnum;
         let mut d = vec![
-            ("LIST".to_string(), probe(list).to_string()),
+            ("LIST".to_string(), list_index(list).to_string()),
             ("DENSITY".to_string(), density.index().to_string()),
             ("MATERIAL".to_string(), material_index(material).to_string()),
             (
@@ -207,32 +202,34 @@ impl MetaballSettings {
                 ((sorted && list == ListKind::Sbuffer) as u32).to_string(),
             ),
         ];
-        d.extend(enum_defines(
-            "LIST",
-            &[("none", 0), ("abuffer", 1), ("sbuffer", 2)],
-        ));
-        d.extend(enum_defines(
-            "DENSITY",
-            &[
-                ("blinn", 0),
-                ("wyvill", 1),
-                ("nishimura", 2),
-                ("murakami", 3),
-            ],
-        ));
-        d.extend(enum_defines(
-            "MATERIAL",
-            &[("phong", 0), ("glass", 1), ("tinted", 2), ("metal", 3)],
-        ));
-        d
-    }
-
-    pub fn list_index(&self) -> u32 {
-        match self.list {
-            ListKind::None => 0,
-            ListKind::Abuffer => 1,
-            ListKind::Sbuffer => 2,
+        // The named values the shaders compare against, from the same index functions.
+        let lists: Vec<(String, u32)> = ListKind::value_variants()
+            .iter()
+            .map(|l| (l.as_str(), list_index(*l)))
+            .collect();
+        let densities: Vec<(String, u32)> = DensityFn::value_variants()
+            .iter()
+            .map(|f| (f.as_str(), f.index()))
+            .collect();
+        // The metals share one shader path, MATERIAL_METAL.
+        let materials: Vec<(String, u32)> = [
+            ("phong", Material::Phong),
+            ("glass", Material::Glass),
+            ("tinted", Material::Tinted),
+            ("metal", Material::Gold),
+        ]
+        .iter()
+        .map(|(n, m)| (n.to_string(), material_index(*m)))
+        .collect();
+        for (prefix, values) in [
+            ("LIST", lists),
+            ("DENSITY", densities),
+            ("MATERIAL", materials),
+        ] {
+            let refs: Vec<(&str, u32)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+            d.extend(enum_defines(prefix, &refs));
         }
+        d
     }
 
     pub fn pixels(&self) -> u64 {
