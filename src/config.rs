@@ -55,6 +55,7 @@ switch_enum!(OnOff { On, Off });
 switch_enum!(BoneWeights { Eq8, Eq9 });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
+switch_enum!(ShowMesh { Off, Shaded, Wire });
 
 /// The device, validation, seed and size: every command takes these.
 #[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
@@ -188,13 +189,23 @@ pub struct ExportArgs {
     pub export_every: Option<u64>,
 }
 
-/// Characters and control particles: not built yet, each fails naming what brings it.
+/// Characters: how they are skinned and drawn.
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct CharacterArgs {
+    /// Skinning: linear blend (lbs, default) or dual quaternions (dqs, Kavan et al. 2008)
+    #[arg(long, value_enum)]
+    pub skinning: Option<Skinning>,
+    /// Draw the character's mesh: shaded, as a wireframe, or not at all (default shaded
+    /// with no fluid, off with fluid)
+    #[arg(long, value_enum)]
+    pub show_mesh: Option<ShowMesh>,
+}
+
+/// Control particles: not built yet, each fails naming what brings it.
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ControlArgs {
     #[arg(long, value_enum)]
     pub placement: Option<Placement>,
-    #[arg(long, value_enum)]
-    pub skinning: Option<Skinning>,
     /// Control pressure c_cp
     #[arg(long)]
     pub control_pressure: Option<f32>,
@@ -238,6 +249,9 @@ pub struct Switches {
     #[command(flatten)]
     #[serde(flatten)]
     pub export: ExportArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub character: CharacterArgs,
     #[command(flatten)]
     #[serde(flatten)]
     pub control: ControlArgs,
@@ -288,6 +302,7 @@ pub enum Group {
     Metaball,
     Camera,
     Export,
+    Character,
 }
 
 /// The switches of `g` that differ from the group's defaults, as written on the command
@@ -311,7 +326,7 @@ impl Switches {
     /// applies, and for every control switch (not built yet), naming what brings it: a
     /// switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
-        let groups: [(Group, Vec<String>, &str); 7] = [
+        let groups: [(Group, Vec<String>, &str); 8] = [
             (
                 Group::Sort,
                 set_in(&self.sorting),
@@ -339,6 +354,11 @@ impl Switches {
                 "rendered SPH scenes and bench render",
             ),
             (Group::Export, set_in(&self.export), "run with an SPH scene"),
+            (
+                Group::Character,
+                set_in(&self.character),
+                "scenes with a character (run) and bench skin",
+            ),
         ];
         for (g, set, owner) in groups {
             if let Some(name) = set.first().filter(|_| !uses.contains(&g)) {
@@ -349,8 +369,7 @@ impl Switches {
         }
         if let Some(name) = set_in(&self.control).first() {
             return Err(Error::Unsupported(format!(
-                "{name} is not implemented yet: it arrives with characters and control \
-                 particles (issues 12 and 13)"
+                "{name} is not implemented yet: it arrives with control particles (issue 13)"
             )));
         }
         Ok(())

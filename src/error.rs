@@ -34,6 +34,9 @@ pub enum Error {
         path: String,
         source: std::io::Error,
     },
+    /// A character or mesh file that cannot be used as asked.
+    #[error("{path}: {message}")]
+    Model { path: String, message: String },
     #[error("image {path}: {message}")]
     Image { path: String, message: String },
 }

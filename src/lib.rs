@@ -2,6 +2,7 @@
 //! See README.md for the command line and outputs.
 pub mod animation;
 pub mod bench;
+pub mod character;
 pub mod config;
 pub mod error;
 pub mod export;

@@ -1,4 +1,4 @@
-//! The command line: devices | run | bench | experiment.
+//! The command line: devices | run | bench | plot | inspect | experiment.
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
 use fluidform::config::{
@@ -84,6 +84,14 @@ enum Command {
         /// The date it was measured (YYYY-MM-DD)
         #[arg(long)]
         date: String,
+    },
+    /// What a character or mesh file (.glb, .gltf, .obj, builtin:walker, builtin:giraffe)
+    /// holds: triangles, vertices, joints, animations, bounds, closedness, volume, warnings
+    Inspect {
+        file: String,
+        /// Print JSON instead of text
+        #[arg(long)]
+        json: bool,
     },
     /// Reproduce a table of the papers
     Experiment {
@@ -290,6 +298,15 @@ fn main() -> Result<()> {
             let rows = fluidform::bench::plot::read_sweep(&csv)?;
             fluidform::bench::plot::sweep_dated(&out, &title, &scope, &device, &date, &rows)?;
             println!("wrote {}", out.display());
+            Ok(())
+        }
+        Command::Inspect { file, json } => {
+            let ch = fluidform::character::load(&file)?;
+            let report = fluidform::character::inspect::inspect(&ch)?;
+            match json {
+                true => println!("{}", serde_json::to_string_pretty(&report)?),
+                false => print!("{}", report.text()),
+            }
             Ok(())
         }
         Command::Experiment { name, .. } => {

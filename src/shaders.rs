@@ -36,6 +36,16 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::render::points::PointsIo>("render/points.vert", &[]),
         with::<crate::render::points::PointsIo>("render/points.frag", &[]),
     ];
+    use crate::character::skin::{SkinIo, SkinPass};
+    for method in [crate::config::Skinning::Lbs, crate::config::Skinning::Dqs] {
+        for sets in [1, 2] {
+            let d: Vec<(String, String)> = SkinPass::defines(method, sets)
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect();
+            v.push(with::<SkinIo>("character/skin.comp", &d));
+        }
+    }
     for sub in [false, true] {
         let d: Vec<(String, String)> = scan::ScanPass::defines(sub)
             .into_iter()

@@ -1,0 +1,440 @@
+//! glTF 2.0 (.glb, .gltf with embedded, data-URI or external buffers) -> `Character`.
+//! Every triangle primitive of every mesh node in the scene; skinned meshes keep their
+//! vertices in bind space (joint matrices ignore the mesh node's transform, as the spec
+//! requires); rigid meshes become skinned to their own node with weight 1.
+use super::model::*;
+use crate::error::{Error, Result};
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
+use gltf::mesh::Mode;
+use std::collections::HashMap;
+use std::path::Path;
+
+fn err(path: &Path, message: impl Into<String>) -> Error {
+    Error::Model {
+        path: path.display().to_string(),
+        message: message.into(),
+    }
+}
+
+/// One primitive's vertices before merging.
+struct Part {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    indices: Vec<u32>,
+    influences: Vec<Vec<(u16, f32)>>,
+}
+
+pub fn load(path: &Path) -> Result<Character> {
+    std::fs::metadata(path).map_err(|e| Error::Io {
+        path: path.display().to_string(),
+        source: e,
+    })?;
+    let gltf =
+        gltf::Gltf::open(path).map_err(|e| err(path, format!("not a valid glTF 2.0 file: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let doc = &gltf.document;
+    for b in doc.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = b.source() {
+            if !uri.starts_with("data:") {
+                let file = base.join(urlencoding_decode(uri));
+                if !file.exists() {
+                    return Err(err(
+                        path,
+                        format!(
+                            "buffer {} names '{uri}', which is missing ({})",
+                            b.index(),
+                            file.display()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let buffers = gltf::import_buffers(doc, Some(base), gltf.blob.clone())
+        .map_err(|e| err(path, format!("cannot read its buffers: {e}")))?;
+    let mut warnings = Vec::new();
+
+    // Node hierarchy.
+    let mut nodes: Vec<Node> = doc
+        .nodes()
+        .map(|n| {
+            let (t, r, s) = n.transform().decomposed();
+            Node {
+                name: n
+                    .name()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("node{}", n.index())),
+                parent: None,
+                rest: Trs {
+                    t: Vec3::from(t),
+                    r: Quat::from_array(r).normalize(),
+                    s: Vec3::from(s),
+                },
+            }
+        })
+        .collect();
+    for n in doc.nodes() {
+        for c in n.children() {
+            nodes[c.index()].parent = Some(n.index());
+        }
+    }
+    let order =
+        Skeleton::sort(&nodes).ok_or_else(|| err(path, "its node hierarchy has a cycle"))?;
+
+    // Mesh nodes of the scene shown (the default scene, else the first, else every root).
+    let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().map(|n| n.index()).collect(),
+        None => (0..nodes.len())
+            .filter(|&i| nodes[i].parent.is_none())
+            .collect(),
+    };
+    let mut stack = roots;
+    let mut in_scene = Vec::new();
+    while let Some(i) = stack.pop() {
+        in_scene.push(i);
+        stack.extend(doc.nodes().nth(i).unwrap().children().map(|c| c.index()));
+    }
+    in_scene.sort_unstable();
+
+    let mut joints: Vec<Joint> = Vec::new();
+    let mut skin_offset: HashMap<usize, usize> = HashMap::new();
+    let mut rigid_joint: HashMap<usize, usize> = HashMap::new();
+    let mut parts = Vec::new();
+    let mut skinned = false;
+    let mut morph_warned = false;
+    for &ni in &in_scene {
+        let node = doc.nodes().nth(ni).unwrap();
+        let Some(mesh) = node.mesh() else { continue };
+        // Joint indices of this node's vertices map to joints[offset + j].
+        let (offset, skin_joints) = match node.skin() {
+            Some(skin) => {
+                skinned = true;
+                let n = skin.joints().count();
+                let off = match skin_offset.get(&skin.index()) {
+                    Some(&o) => o,
+                    None => {
+                        let o = joints.len();
+                        let ibm: Vec<Mat4> = match skin
+                            .reader(|b| Some(&buffers[b.index()]))
+                            .read_inverse_bind_matrices()
+                        {
+                            Some(it) => it.map(|m| Mat4::from_cols_array_2d(&m)).collect(),
+                            None => vec![Mat4::IDENTITY; n],
+                        };
+                        if ibm.len() < n {
+                            return Err(err(
+                                path,
+                                format!(
+                                    "skin {} has {} inverse bind matrices for {n} joints",
+                                    skin.index(),
+                                    ibm.len()
+                                ),
+                            ));
+                        }
+                        for (j, jn) in skin.joints().enumerate() {
+                            joints.push(Joint {
+                                node: jn.index(),
+                                inverse_bind: ibm[j],
+                            });
+                        }
+                        if joints.len() > MAX_JOINTS {
+                            return Err(err(
+                                path,
+                                format!(
+                                    "has {} joints; at most {MAX_JOINTS} are supported",
+                                    joints.len()
+                                ),
+                            ));
+                        }
+                        skin_offset.insert(skin.index(), o);
+                        o
+                    }
+                };
+                (off, Some(n))
+            }
+            None => {
+                let o = *rigid_joint.entry(ni).or_insert_with(|| {
+                    joints.push(Joint {
+                        node: ni,
+                        inverse_bind: Mat4::IDENTITY,
+                    });
+                    joints.len() - 1
+                });
+                (o, None)
+            }
+        };
+        for prim in mesh.primitives() {
+            let what = format!(
+                "mesh {} ('{}') primitive {}",
+                mesh.index(),
+                mesh.name().unwrap_or(""),
+                prim.index()
+            );
+            let reader = prim.reader(|b| Some(&buffers[b.index()]));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| err(path, format!("{what} has no POSITION")))?
+                .map(Vec3::from)
+                .collect();
+            let n = positions.len();
+            let list: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..n as u32).collect(),
+            };
+            if let Some(&bad) = list.iter().find(|&&i| i as usize >= n) {
+                return Err(err(
+                    path,
+                    format!("{what}: index {bad} is past its {n} vertices"),
+                ));
+            }
+            let indices = triangles(prim.mode(), &list).ok_or_else(|| {
+                err(path, format!("{what} draws {:?}; only triangle primitives (triangles, strips, fans) can be loaded", prim.mode()))
+            })?;
+            let normals = reader
+                .read_normals()
+                .map(|it| it.map(Vec3::from).collect::<Vec<_>>());
+            let uvs = reader
+                .read_tex_coords(0)
+                .map(|it| it.into_f32().map(Vec2::from).collect());
+            if prim.morph_targets().next().is_some() && !morph_warned {
+                warnings.push("morph targets are ignored (the rest shape is used)".to_string());
+                morph_warned = true;
+            }
+            let mut influences = vec![Vec::new(); n];
+            match skin_joints {
+                Some(count) => {
+                    let mut sets = 0;
+                    for set in 0..3u32 {
+                        let (Some(js), Some(ws)) =
+                            (reader.read_joints(set), reader.read_weights(set))
+                        else {
+                            break;
+                        };
+                        if set == 2 {
+                            warnings.push(format!("{what}: JOINTS_2 and later sets are ignored (at most {MAX_INFLUENCES} influences per vertex)"));
+                            break;
+                        }
+                        sets += 1;
+                        for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate().take(n) {
+                            for k in 0..4 {
+                                if w[k] > 0.0 {
+                                    if j[k] as usize >= count {
+                                        return Err(err(path, format!("{what}: vertex {v} names joint {} of a skin with {count}", j[k])));
+                                    }
+                                    influences[v].push(((offset + j[k] as usize) as u16, w[k]));
+                                }
+                            }
+                        }
+                    }
+                    if sets == 0 {
+                        return Err(err(
+                            path,
+                            format!(
+                                "{what} belongs to a skinned node but has no JOINTS_0/WEIGHTS_0"
+                            ),
+                        ));
+                    }
+                }
+                None => influences
+                    .iter_mut()
+                    .for_each(|i| i.push((offset as u16, 1.0))),
+            }
+            parts.push(Part {
+                positions,
+                normals,
+                uvs,
+                indices,
+                influences,
+            });
+        }
+    }
+    if parts.is_empty() {
+        return Err(err(path, "has no mesh in its scene"));
+    }
+    if joints.len() > MAX_JOINTS {
+        return Err(err(
+            path,
+            format!(
+                "has {} joints; at most {MAX_JOINTS} are supported",
+                joints.len()
+            ),
+        ));
+    }
+    let clips = read_clips(path, doc, &buffers, &mut warnings)?;
+    let skeleton = Skeleton {
+        nodes,
+        joints,
+        order,
+    };
+    super::assemble(
+        path.display().to_string(),
+        merge(parts, &mut warnings),
+        skeleton,
+        clips,
+        skinned,
+        warnings,
+    )
+}
+
+/// Triangle list of a primitive's index list, or None for points and lines.
+fn triangles(mode: Mode, list: &[u32]) -> Option<Vec<u32>> {
+    Some(match mode {
+        Mode::Triangles => list[..list.len() / 3 * 3].to_vec(),
+        Mode::TriangleStrip => (2..list.len())
+            .flat_map(|i| match i % 2 {
+                0 => [list[i - 2], list[i - 1], list[i]],
+                _ => [list[i - 1], list[i - 2], list[i]],
+            })
+            .collect(),
+        Mode::TriangleFan => (2..list.len())
+            .flat_map(|i| [list[0], list[i - 1], list[i]])
+            .collect(),
+        _ => return None,
+    })
+}
+
+/// One mesh of all parts: influences renormalised and sorted, normals where parts have them.
+fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
+    let mut m = Mesh {
+        influence_sets: 1,
+        ..Default::default()
+    };
+    let mut has_normal = Vec::new();
+    let any_uv = parts.iter().any(|p| p.uvs.is_some());
+    let mut zero = 0;
+    let mut over = 0;
+    for p in parts {
+        let base = m.positions.len() as u32;
+        let n = p.positions.len();
+        m.indices.extend(p.indices.iter().map(|i| i + base));
+        m.positions.extend(&p.positions);
+        has_normal.extend(std::iter::repeat_n(p.normals.is_some(), n));
+        m.normals
+            .extend(p.normals.unwrap_or_else(|| vec![Vec3::ZERO; n]));
+        if any_uv {
+            m.uvs.extend(p.uvs.unwrap_or_else(|| vec![Vec2::ZERO; n]));
+        }
+        for mut inf in p.influences {
+            inf.sort_by(|a, b| b.1.total_cmp(&a.1));
+            if inf.len() > MAX_INFLUENCES {
+                over += 1;
+                inf.truncate(MAX_INFLUENCES);
+            }
+            let sum: f32 = inf.iter().map(|x| x.1).sum();
+            if sum <= 0.0 {
+                zero += 1;
+                inf = vec![(0, 1.0)];
+            }
+            let sum: f32 = inf.iter().map(|x| x.1).sum();
+            if inf.len() > 4 {
+                m.influence_sets = 2;
+            }
+            let (mut j, mut w) = ([0u16; MAX_INFLUENCES], [0f32; MAX_INFLUENCES]);
+            for (k, (id, wt)) in inf.into_iter().enumerate() {
+                j[k] = id;
+                w[k] = wt / sum;
+            }
+            m.joints.push(j);
+            m.weights.push(w);
+        }
+    }
+    if zero > 0 {
+        warnings.push(format!(
+            "{zero} vertices have all-zero weights; bound to joint 0"
+        ));
+    }
+    if over > 0 {
+        warnings.push(format!(
+            "{over} vertices had more than {MAX_INFLUENCES} influences; the lightest were dropped"
+        ));
+    }
+    (m, has_normal)
+}
+
+fn read_clips(
+    path: &Path,
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Clip>> {
+    use gltf::animation::util::ReadOutputs;
+    let mut clips = Vec::new();
+    for a in doc.animations() {
+        let name = a
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("animation{}", a.index()));
+        let mut channels = Vec::new();
+        let mut duration = 0f32;
+        for c in a.channels() {
+            let reader = c.reader(|b| Some(&buffers[b.index()]));
+            let times: Vec<f32> = reader
+                .read_inputs()
+                .map(|i| i.collect())
+                .unwrap_or_default();
+            let (property, values): (Property, Vec<Vec4>) = match reader.read_outputs() {
+                Some(ReadOutputs::Translations(it)) => (
+                    Property::Translation,
+                    it.map(|v| Vec3::from(v).extend(0.0)).collect(),
+                ),
+                Some(ReadOutputs::Scales(it)) => (
+                    Property::Scale,
+                    it.map(|v| Vec3::from(v).extend(0.0)).collect(),
+                ),
+                Some(ReadOutputs::Rotations(it)) => {
+                    (Property::Rotation, it.into_f32().map(Vec4::from).collect())
+                }
+                Some(ReadOutputs::MorphTargetWeights(_)) => {
+                    warnings.push(format!(
+                        "animation '{name}': a morph-weight channel is ignored"
+                    ));
+                    continue;
+                }
+                None => {
+                    return Err(err(
+                        path,
+                        format!("animation '{name}': a channel's output cannot be read"),
+                    ))
+                }
+            };
+            let interp = match c.sampler().interpolation() {
+                gltf::animation::Interpolation::Step => Interp::Step,
+                gltf::animation::Interpolation::Linear => Interp::Linear,
+                gltf::animation::Interpolation::CubicSpline => Interp::CubicSpline,
+            };
+            let per_key = if interp == Interp::CubicSpline { 3 } else { 1 };
+            if times.is_empty() || values.len() != per_key * times.len() {
+                return Err(err(path, format!(
+                    "animation '{name}': a channel has {} keys and {} values ({per_key} per key expected)",
+                    times.len(),
+                    values.len()
+                )));
+            }
+            if times.windows(2).any(|w| w[1] < w[0]) {
+                return Err(err(path, format!("animation '{name}': key times decrease")));
+            }
+            duration = duration.max(*times.last().unwrap());
+            channels.push(Channel {
+                node: c.target().node().index(),
+                property,
+                interp,
+                times,
+                values,
+            });
+        }
+        clips.push(Clip {
+            name,
+            duration,
+            channels,
+        });
+    }
+    Ok(clips)
+}
+
+/// Percent-decoding of a relative URI (spaces and the like in file names).
+fn urlencoding_decode(uri: &str) -> String {
+    urlencoding::decode(uri)
+        .map(|c| c.into_owned())
+        .unwrap_or_else(|_| uri.to_string())
+}

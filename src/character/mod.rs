@@ -1,0 +1,172 @@
+//! Characters: glTF 2.0 and OBJ loading, mesh checks, clip sampling, and skinning (a GPU
+//! pass with linear blend or dual quaternions, and its CPU reference).
+pub mod anim;
+pub mod check;
+pub mod cpu;
+pub mod gltf_load;
+pub mod inspect;
+pub mod model;
+pub mod obj_load;
+pub mod pose;
+pub mod procedural;
+pub mod skin;
+
+pub use anim::Animator;
+pub use check::MeshCheck;
+pub use model::*;
+
+use crate::config::Skinning;
+use crate::error::{Error, Result};
+use glam::{Mat4, Vec3};
+use std::path::Path;
+
+/// A character or mesh file by its extension, or a built-in shape (`builtin:NAME`).
+pub fn load(name: &str) -> Result<Character> {
+    if let Some(b) = name.strip_prefix("builtin:") {
+        return procedural::built_in(b);
+    }
+    let path = Path::new(name);
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "glb" | "gltf" => gltf_load::load(path),
+        "obj" => obj_load::load(path),
+        _ => Err(Error::Model {
+            path: name.to_string(),
+            message: format!(
+                "unknown mesh format (.glb, .gltf or .obj, or builtin:{})",
+                procedural::BUILT_IN.join("|builtin:")
+            ),
+        }),
+    }
+}
+
+/// Finish a loaded mesh: normals computed where the file has none, inward-facing closed
+/// meshes flipped, the checks at the rest pose.
+pub(crate) fn assemble(
+    source: String,
+    (mut mesh, has_normal): (Mesh, Vec<bool>),
+    skeleton: Skeleton,
+    clips: Vec<Clip>,
+    skinned: bool,
+    mut warnings: Vec<String>,
+) -> Result<Character> {
+    let raw_vertices = mesh.vertices();
+    let mut ch = Character {
+        source,
+        mesh: Mesh::default(),
+        skeleton,
+        clips,
+        skinned,
+        raw_vertices,
+        normals_computed: false,
+        check: MeshCheck::default(),
+        flipped: false,
+        warnings: Vec::new(),
+    };
+    // Normals first (the rest pose skins them too); given ones kept, zero ones replaced.
+    let computed = check::area_normals(&mesh.positions, &mesh.indices);
+    for (v, n) in mesh.normals.iter_mut().enumerate() {
+        let given = has_normal[v] && n.length_squared() > 0.0;
+        *n = if given { n.normalize() } else { computed[v] };
+    }
+    ch.normals_computed = has_normal.iter().any(|h| !h);
+    ch.mesh = mesh;
+    let rest = ch.rest_positions()?;
+    ch.check = check::check(&rest, &ch.mesh.indices);
+    if ch.check.closed() && ch.check.signed_volume < 0.0 {
+        check::flip(&mut ch.mesh.indices);
+        for n in &mut ch.mesh.normals {
+            *n = -*n;
+        }
+        warnings.push(format!(
+            "the closed mesh faced inward (signed volume {:.6}); its triangles and normals were flipped",
+            ch.check.signed_volume
+        ));
+        ch.check.signed_volume = -ch.check.signed_volume;
+        ch.flipped = true;
+    }
+    ch.warnings = warnings;
+    Ok(ch)
+}
+
+impl Character {
+    pub fn joint_name(&self, j: usize) -> String {
+        self.skeleton.nodes[self.skeleton.joints[j].node]
+            .name
+            .clone()
+    }
+
+    /// Vertex positions skinned with the rest pose (the nodes' own transforms).
+    pub fn rest_positions(&self) -> Result<Vec<Vec3>> {
+        Ok(self.skinned_at(&self.rest_matrices(), Skinning::Lbs)?.0)
+    }
+
+    pub fn rest_matrices(&self) -> Vec<Mat4> {
+        let g = self.skeleton.globals(&self.skeleton.rest_locals());
+        self.skeleton.joint_matrices(&g)
+    }
+
+    /// CPU-skinned positions and normals for joint matrices `mats`.
+    pub fn skinned_at(&self, mats: &[Mat4], method: Skinning) -> Result<(Vec<Vec3>, Vec<Vec3>)> {
+        let joints = pose::gpu_joints(mats, method, &|j| self.joint_name(j))?;
+        Ok(cpu::skin(method, &joints, &self.mesh))
+    }
+
+    /// The rest pose's bounding box.
+    pub fn rest_bounds(&self) -> Result<(Vec3, Vec3)> {
+        Ok(check::bounds(&self.rest_positions()?))
+    }
+
+    /// A clip by name or index; the error lists the valid ones.
+    pub fn clip_index(&self, sel: &str) -> Result<usize> {
+        if let Some(i) = self.clips.iter().position(|c| c.name == sel) {
+            return Ok(i);
+        }
+        if let Ok(i) = sel.parse::<usize>() {
+            if i < self.clips.len() {
+                return Ok(i);
+            }
+        }
+        let names: Vec<String> = self
+            .clips
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!("{i} '{}'", c.name))
+            .collect();
+        Err(Error::Model {
+            path: self.source.clone(),
+            message: match names.is_empty() {
+                true => format!("has no animation (asked for '{sel}')"),
+                false => format!("has no animation '{sel}'; it has: {}", names.join(", ")),
+            },
+        })
+    }
+
+    /// Refuse a static mesh where a skin is needed.
+    pub fn require_skin(&self, why: &str) -> Result<()> {
+        match self.skinned {
+            true => Ok(()),
+            false => Err(Error::Model {
+                path: self.source.clone(),
+                message: format!("has no skin, which {why} needs"),
+            }),
+        }
+    }
+
+    /// Refuse an open mesh where an inside test is needed, with the counts.
+    pub fn require_closed(&self, why: &str) -> Result<()> {
+        match self.check.closed() {
+            true => Ok(()),
+            false => Err(Error::Model {
+                path: self.source.clone(),
+                message: format!(
+                    "is not closed ({}), and {why} needs an inside test",
+                    self.check.describe()
+                ),
+            }),
+        }
+    }
+}

@@ -1,0 +1,202 @@
+//! A character as loaded: one triangle mesh whose every vertex is skinned to a joint list
+//! (a rigid mesh is skinned to its own node with weight 1), the node hierarchy, and clips.
+use super::check::MeshCheck;
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
+
+/// Joints one character may have (the joint buffer holds them all).
+pub const MAX_JOINTS: usize = 1024;
+
+/// Influences per vertex: JOINTS_0/WEIGHTS_0 and, when present, JOINTS_1/WEIGHTS_1.
+pub const MAX_INFLUENCES: usize = 8;
+
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    /// Empty when the file has no texture coordinates.
+    pub uvs: Vec<Vec2>,
+    /// Triangles, three indices each.
+    pub indices: Vec<u32>,
+    /// Per vertex, sorted by weight (largest first); unused slots have weight 0.
+    pub joints: Vec<[u16; MAX_INFLUENCES]>,
+    pub weights: Vec<[f32; MAX_INFLUENCES]>,
+    /// 1: at most 4 influences per vertex; 2: up to 8.
+    pub influence_sets: usize,
+}
+
+impl Mesh {
+    pub fn triangles(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    pub fn vertices(&self) -> usize {
+        self.positions.len()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trs {
+    pub t: Vec3,
+    pub r: Quat,
+    pub s: Vec3,
+}
+
+impl Default for Trs {
+    fn default() -> Self {
+        Self {
+            t: Vec3::ZERO,
+            r: Quat::IDENTITY,
+            s: Vec3::ONE,
+        }
+    }
+}
+
+impl Trs {
+    pub fn matrix(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(self.s, self.r, self.t)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Node {
+    pub name: String,
+    pub parent: Option<usize>,
+    pub rest: Trs,
+}
+
+#[derive(Clone, Debug)]
+pub struct Joint {
+    pub node: usize,
+    pub inverse_bind: Mat4,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Skeleton {
+    pub nodes: Vec<Node>,
+    pub joints: Vec<Joint>,
+    /// Node indices, every parent before its children.
+    pub order: Vec<usize>,
+}
+
+impl Skeleton {
+    /// One node, one joint: a static mesh.
+    pub fn single(name: &str) -> Self {
+        Self {
+            nodes: vec![Node {
+                name: name.into(),
+                parent: None,
+                rest: Trs::default(),
+            }],
+            joints: vec![Joint {
+                node: 0,
+                inverse_bind: Mat4::IDENTITY,
+            }],
+            order: vec![0],
+        }
+    }
+
+    /// Global transforms of every node from their local transforms.
+    pub fn globals(&self, locals: &[Trs]) -> Vec<Mat4> {
+        let mut g = vec![Mat4::IDENTITY; self.nodes.len()];
+        for &i in &self.order {
+            let m = locals[i].matrix();
+            g[i] = match self.nodes[i].parent {
+                Some(p) => g[p] * m,
+                None => m,
+            };
+        }
+        g
+    }
+
+    pub fn rest_locals(&self) -> Vec<Trs> {
+        self.nodes.iter().map(|n| n.rest).collect()
+    }
+
+    /// Joint matrices (joint global x inverse bind) for node globals.
+    pub fn joint_matrices(&self, globals: &[Mat4]) -> Vec<Mat4> {
+        self.joints
+            .iter()
+            .map(|j| globals[j.node] * j.inverse_bind)
+            .collect()
+    }
+
+    /// Parents-first order of the nodes (fails on a cycle).
+    pub fn sort(nodes: &[Node]) -> Option<Vec<usize>> {
+        let mut order = Vec::with_capacity(nodes.len());
+        let mut state = vec![0u8; nodes.len()]; // 0 new, 1 visiting, 2 done
+        fn visit(i: usize, nodes: &[Node], st: &mut [u8], out: &mut Vec<usize>) -> bool {
+            match st[i] {
+                2 => return true,
+                1 => return false,
+                _ => {}
+            }
+            st[i] = 1;
+            if let Some(p) = nodes[i].parent {
+                if !visit(p, nodes, st, out) {
+                    return false;
+                }
+            }
+            st[i] = 2;
+            out.push(i);
+            true
+        }
+        for i in 0..nodes.len() {
+            if !visit(i, nodes, &mut state, &mut order) {
+                return None;
+            }
+        }
+        Some(order)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interp {
+    Step,
+    Linear,
+    CubicSpline,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Property {
+    Translation,
+    Rotation,
+    Scale,
+}
+
+/// One animated property of one node. Values are xyz(w); CUBICSPLINE stores three per key
+/// (in-tangent, value, out-tangent).
+#[derive(Clone, Debug)]
+pub struct Channel {
+    pub node: usize,
+    pub property: Property,
+    pub interp: Interp,
+    pub times: Vec<f32>,
+    pub values: Vec<Vec4>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Clip {
+    pub name: String,
+    /// Last key time of any channel (seconds).
+    pub duration: f32,
+    pub channels: Vec<Channel>,
+}
+
+/// Everything `inspect` reports and the scene needs.
+#[derive(Clone, Debug)]
+pub struct Character {
+    /// The file (or built-in name) it came from.
+    pub source: String,
+    pub mesh: Mesh,
+    pub skeleton: Skeleton,
+    pub clips: Vec<Clip>,
+    /// The file had a skin (false: a static mesh, rigidly attached to its nodes).
+    pub skinned: bool,
+    /// Vertices as stored, before welding.
+    pub raw_vertices: usize,
+    pub normals_computed: bool,
+    pub check: MeshCheck,
+    /// The mesh faced inward and was flipped.
+    pub flipped: bool,
+    pub warnings: Vec<String>,
+}
