@@ -2,7 +2,8 @@
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
 use fluidform::config::{
-    CameraArgs, CommonArgs, FluidArgs, FrameArgs, MetaballArgs, NeighborArgs, SortArgs, Switches,
+    CameraArgs, CharacterArgs, CommonArgs, FluidArgs, FrameArgs, MetaballArgs, NeighborArgs,
+    SortArgs, Switches,
 };
 use fluidform::gpu::list_devices;
 use fluidform::run::{run, RunOptions, DEFAULT_SCENE};
@@ -129,6 +130,19 @@ enum BenchWhat {
     Sph(SphBench),
     /// The 32K dam break for 10 000 steps, with physics checkpoints
     Stability(SphBench),
+    /// GPU skinning per method (or --skinning) on a character and on a generated mesh
+    Skin {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        character: CharacterArgs,
+        /// Character file (.glb, .gltf, .obj) or builtin:walker (the default)
+        #[arg(long = "character", value_name = "FILE")]
+        file: Option<String>,
+        /// Vertices of the generated mesh (copies of the walker; default 1048576)
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
+        vertices: Option<u32>,
+    },
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
         #[command(flatten)]
@@ -169,9 +183,26 @@ impl SphBench {
 
 impl BenchWhat {
     /// The benchmark's name and its switches (groups it does not take at their defaults).
-    fn into_parts(self) -> (&'static str, Switches) {
+    fn into_parts(self) -> (&'static str, Switches, Option<String>, Option<u32>) {
         let d = Switches::default;
-        match self {
+        let (what, sw) = match self {
+            BenchWhat::Skin {
+                common,
+                character,
+                file,
+                vertices,
+            } => {
+                return (
+                    "skin",
+                    Switches {
+                        common,
+                        character,
+                        ..d()
+                    },
+                    file,
+                    vertices,
+                )
+            }
             BenchWhat::Scan { common } => ("scan", Switches { common, ..d() }),
             BenchWhat::Sort { common, sorting } => (
                 "sort",
@@ -211,7 +242,8 @@ impl BenchWhat {
                     ..d()
                 },
             ),
-        }
+        };
+        (what, sw, None, None)
     }
 }
 
@@ -274,7 +306,7 @@ fn main() -> Result<()> {
             warmup,
             budget_s,
         } => {
-            let (what, switches) = what.into_parts();
+            let (what, switches, character, vertices) = what.into_parts();
             let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
                 what: what.to_string(),
                 out: out.clone(),
@@ -282,6 +314,8 @@ fn main() -> Result<()> {
                 warmup,
                 budget_s,
                 switches,
+                character,
+                vertices,
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{} configurations; wrote {}", rows.len(), out.display());

@@ -4,6 +4,7 @@
 pub mod plot;
 pub mod primitives;
 pub mod render;
+pub mod skin;
 pub mod sph;
 
 use crate::config::{Group, Switches};
@@ -24,6 +25,10 @@ pub struct BenchOptions {
     /// (at least 3), and the table reports how many each had.
     pub budget_s: f64,
     pub switches: Switches,
+    /// bench skin: the character file (default builtin:walker).
+    pub character: Option<String>,
+    /// bench skin: vertices of the generated mesh (default 1M).
+    pub vertices: Option<u32>,
 }
 
 /// `config` of one benchmark configuration's summary.json.
@@ -44,7 +49,15 @@ pub struct BenchConfig {
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct NoStats {}
 
-pub const WHATS: &[&str] = &["scan", "sort", "neighbors", "sph", "stability", "render"];
+pub const WHATS: &[&str] = &[
+    "scan",
+    "sort",
+    "neighbors",
+    "sph",
+    "stability",
+    "render",
+    "skin",
+];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
 pub const SWEEP: &[u32] = &[
@@ -105,6 +118,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         "render" => {
             sw.reject_unused("bench render", &[Group::Metaball, Group::Camera])?;
             render::render(&ctx, opts)?
+        }
+        "skin" => {
+            sw.reject_unused("bench skin", &[Group::Character])?;
+            skin::skin(&ctx, opts)?
         }
         other => {
             return Err(Error::Param(format!(

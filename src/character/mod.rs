@@ -109,9 +109,14 @@ impl Character {
         self.skeleton.joint_matrices(&g)
     }
 
+    /// What the skinning shader reads for joint matrices `mats`.
+    pub fn gpu_joints(&self, mats: &[Mat4], method: Skinning) -> Result<Vec<pose::GpuJoint>> {
+        pose::gpu_joints(mats, method, &|j| self.joint_name(j))
+    }
+
     /// CPU-skinned positions and normals for joint matrices `mats`.
     pub fn skinned_at(&self, mats: &[Mat4], method: Skinning) -> Result<(Vec<Vec3>, Vec<Vec3>)> {
-        let joints = pose::gpu_joints(mats, method, &|j| self.joint_name(j))?;
+        let joints = self.gpu_joints(mats, method)?;
         Ok(cpu::skin(method, &joints, &self.mesh))
     }
 

@@ -207,3 +207,38 @@ impl SkinnedMesh {
     }
 }
 crate::impl_destroy!(SkinnedMesh);
+
+/// A character's mesh on the GPU with its skinning pass.
+pub struct Skinner {
+    pub pass: SkinPass,
+    pub mesh: SkinnedMesh,
+}
+
+impl Skinner {
+    pub fn new(ctx: &Context, ch: &super::Character, method: Skinning) -> Result<Self> {
+        let pass = Guard::new(ctx, SkinPass::new(ctx, method, ch.mesh.influence_sets)?);
+        let mesh = SkinnedMesh::new(ctx, &ch.mesh, ch.skeleton.joints.len())?;
+        Ok(Self {
+            pass: pass.take(),
+            mesh,
+        })
+    }
+
+    /// Record the joints' upload and the skinning; the caller makes `mesh.pos`/`mesh.nrm`
+    /// visible to what reads them.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, joints: &[GpuJoint]) -> Result<()> {
+        self.mesh.set_pose(ctx, cmd, joints)?;
+        ctx.barrier(
+            cmd,
+            crate::gpu::sync::TRANSFER_WRITE,
+            crate::gpu::sync::COMPUTE_READ,
+        );
+        self.pass.record(ctx, cmd, &self.mesh)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.mesh.destroy(ctx);
+        self.pass.destroy(ctx);
+    }
+}
+crate::impl_destroy!(Skinner);

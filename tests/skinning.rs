@@ -1,0 +1,141 @@
+//! GPU skinning (LBS and DQS) against the CPU reference, on CesiumMan at three times and
+//! on a mesh with eight influences per vertex.
+mod common;
+use fluidform::character::skin::Skinner;
+use fluidform::character::{self, Animator, Character};
+use fluidform::config::Skinning;
+use fluidform::gpu::{sync, Context};
+use glam::{Mat4, Vec3};
+use rand::{Rng, SeedableRng};
+use std::path::PathBuf;
+
+fn asset(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets")
+        .join(name);
+    assert!(
+        p.exists(),
+        "test asset {} is missing (CI has ../shared/assets)",
+        p.display()
+    );
+    p.display().to_string()
+}
+
+/// Skin on the GPU; the largest position error relative to the mesh size, and the largest
+/// normal error, against the CPU reference.
+fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
+    let anim = Animator {
+        clip: (!ch.clips.is_empty()).then_some(0),
+        looping: true,
+        placement: Mat4::IDENTITY,
+    };
+    let mats = anim.joint_matrices(ch, t);
+    let joints = ch.gpu_joints(&mats, method).unwrap();
+    let mut sk = Skinner::new(ctx, ch, method).unwrap();
+    ctx.one_shot(|cmd| {
+        sk.record(ctx, cmd, &joints).unwrap();
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::HOST_READ | sync::TRANSFER_READ,
+        );
+    })
+    .unwrap();
+    let pos: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.pos).unwrap();
+    let nrm: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.nrm).unwrap();
+    sk.destroy(ctx);
+    let (cp, cn) = ch.skinned_at(&mats, method).unwrap();
+    let (lo, hi) = character::check::bounds(&cp);
+    let size = (hi - lo).length();
+    let mut e = (0f32, 0f32);
+    for v in 0..cp.len() {
+        let g = Vec3::from_slice(&pos[v][..3]);
+        e.0 = e.0.max((g - cp[v]).length() / size);
+        e.1 = e.1.max((Vec3::from_slice(&nrm[v][..3]) - cn[v]).length());
+    }
+    e
+}
+
+#[test]
+fn gpu_skinning_matches_the_cpu_reference() {
+    let ctx = common::ctx();
+    let ch = character::load(&asset("CesiumMan.glb")).unwrap();
+    for method in [Skinning::Lbs, Skinning::Dqs] {
+        for t in [0.0, 0.5, 1.3] {
+            let (p, n) = compare(&ctx, &ch, method, t);
+            assert!(
+                p <= 1e-5,
+                "{method:?} t = {t}: position error {p} of the size"
+            );
+            assert!(n <= 1e-4, "{method:?} t = {t}: normal error {n}");
+        }
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn eight_influences_and_dqs_against_lbs() {
+    let ctx = common::ctx();
+    // The walker with eight random influences per vertex (JOINTS_1/WEIGHTS_1's path).
+    let mut ch = character::load("builtin:walker").unwrap();
+    let joints = ch.skeleton.joints.len() as u16;
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(7);
+    for (j, w) in ch.mesh.joints.iter_mut().zip(&mut ch.mesh.weights) {
+        let mut pairs: Vec<(u16, f32)> = (0..8)
+            .map(|_| (rng.random_range(0..joints), rng.random_range(0.01..1.0)))
+            .collect();
+        pairs.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let sum: f32 = pairs.iter().map(|p| p.1).sum();
+        for (k, (id, wt)) in pairs.into_iter().enumerate() {
+            j[k] = id;
+            w[k] = wt / sum;
+        }
+    }
+    ch.mesh.influence_sets = 2;
+    for method in [Skinning::Lbs, Skinning::Dqs] {
+        let (p, n) = compare(&ctx, &ch, method, 0.37);
+        assert!(p <= 1e-5 && n <= 1e-4, "{method:?}: {p} {n}");
+    }
+    // Rigid motion (one influence each): both methods give the same mesh.
+    let rigid = character::load("builtin:walker").unwrap();
+    let anim = Animator {
+        clip: Some(0),
+        looping: true,
+        placement: glam::Mat4::from_scale(Vec3::splat(2.0)),
+    };
+    let mats = anim.joint_matrices(&rigid, 0.25);
+    let mut one = rigid.clone();
+    for (j, w) in one.mesh.joints.iter_mut().zip(&mut one.mesh.weights) {
+        *w = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        j[1] = 0;
+    }
+    let (l, _) = one.skinned_at(&mats, Skinning::Lbs).unwrap();
+    let (d, _) = one.skinned_at(&mats, Skinning::Dqs).unwrap();
+    let worst = l
+        .iter()
+        .zip(&d)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f32::max);
+    assert!(
+        worst < 1e-5,
+        "uniformly scaled rigid joints: LBS and DQS differ by {worst}"
+    );
+    common::finish(&ctx);
+}
+
+#[test]
+fn dqs_refuses_a_mirroring_joint() {
+    let ch = character::load("builtin:walker").unwrap();
+    let anim = Animator {
+        clip: None,
+        looping: true,
+        placement: Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
+    };
+    let mats = anim.joint_matrices(&ch, 0.0);
+    let e = ch.gpu_joints(&mats, Skinning::Dqs).unwrap_err().to_string();
+    assert!(
+        e.contains("determinant") && e.contains("--skinning lbs") && e.lines().count() == 1,
+        "{e}"
+    );
+    assert!(ch.gpu_joints(&mats, Skinning::Lbs).is_ok());
+}
