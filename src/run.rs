@@ -2,12 +2,13 @@
 //! Every scene kind is a `FrameWork` played by `session::play`.
 use crate::animation::Animation;
 use crate::config::Switches;
-use crate::config::{Neighbors, RenderKind, SortAlgo};
+use crate::config::{Neighbors, RenderKind, ShowMesh, Skinning, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::target::save_rgba;
 use crate::gpu::{sync, Context, FrameWork, Guard, Profiler};
 use crate::render::Camera;
 use crate::report::{Report, Summary};
+use crate::scene::character::{CharacterStats, SceneCharacter};
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
 pub use crate::session::{camera_with_switches, check_validation, SLOTS};
 use crate::session::{open, play};
@@ -56,11 +57,20 @@ pub struct OrbitsStats {
     pub particles: u32,
 }
 
+/// `stats` of a scene with a character and no fluid.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterRunStats {
+    pub character: CharacterStats,
+    pub render: crate::viewer::RenderSummary,
+}
+
 /// `stats` of a run, by scene kind.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(untagged)]
 pub enum RunStats {
     Sph(Box<SphRunStats>),
+    Character(CharacterRunStats),
     Orbits(OrbitsStats),
 }
 
@@ -144,7 +154,10 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
         return run_orbits(opts);
     }
     let scene = crate::sph::Scene::load(&opts.scene)?;
-    run_sph(opts, scene)
+    match scene.has_fluid() {
+        true => run_sph(opts, scene),
+        false => run_character(opts, scene),
+    }
 }
 
 /// The orbits scene: a gravity step and the point view per frame.
@@ -171,7 +184,7 @@ impl FrameWork for OrbitsWork<'_> {
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
         let (s, save) = (&self.scene, self.frames.save(frame));
         self.view
-            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, slot, save)
+            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, None, slot, save)
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
@@ -204,7 +217,7 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     );
     let pass = Guard::new(&ctx, OrbitsPass::new(&ctx)?);
     let scene = Guard::new(&ctx, Orbits::new(&ctx, &state)?);
-    let view = PointsViewer::new(&ctx, sw, &cam, 1.0, SLOTS)?;
+    let view = PointsViewer::new(&ctx, sw, &cam, 1.0, SLOTS, ShowMesh::Off)?;
     let mut work = OrbitsWork {
         pass: pass.take(),
         view,
@@ -254,6 +267,7 @@ struct SphWork<'a> {
     view: Box<dyn crate::viewer::View>,
     frames: Frames<'a>,
     export: Option<crate::export::ParticleExport>,
+    character: Option<SceneCharacter>,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -267,6 +281,9 @@ impl FrameWork for SphWork<'_> {
     ) -> Result<()> {
         self.stepper
             .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
+        if let Some(c) = &self.character {
+            c.record(ctx, cmd, prof, self.stepper.sim_time)?;
+        }
         // The step's positions -> the view's copies and shaders.
         ctx.barrier(
             cmd,
@@ -278,8 +295,18 @@ impl FrameWork for SphWork<'_> {
         }
         let save = self.frames.save(frame);
         let st = &self.st;
-        self.view
-            .record(ctx, cmd, prof, st.pos(), st.attr(), st.n, slot, save)
+        let mesh = self.character.as_ref().and_then(|c| c.draw());
+        self.view.record(
+            ctx,
+            cmd,
+            prof,
+            st.pos(),
+            st.attr(),
+            st.n,
+            mesh.as_ref(),
+            slot,
+            save,
+        )
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
@@ -300,6 +327,9 @@ impl SphWork<'_> {
             e.destroy(ctx);
         }
         self.view.destroy(ctx);
+        if let Some(c) = &mut self.character {
+            c.destroy(ctx);
+        }
         self.st.destroy(ctx);
         self.solver.destroy(ctx);
     }
@@ -322,6 +352,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     ];
     if render == RenderKind::Metaballs {
         uses.push(Group::Metaball);
+    }
+    if scene.character.is_some() {
+        uses.push(Group::Character);
     }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
@@ -365,6 +398,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         }
     };
     let cam = camera_with_switches(cam, sw);
+    let character = scene_character(&ctx, &scene, sw)?;
+    let character = Guard::new(&ctx, character);
+    let show = character.as_ref().map(|c| c.show).unwrap_or(ShowMesh::Off);
     let view: Box<dyn View> = match render {
         RenderKind::Metaballs => {
             let tank = scene
@@ -372,7 +408,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
                 .tank
                 .unwrap_or(true)
                 .then_some([scene.domain.min, scene.domain.max]);
-            Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS, tank)?)
+            Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS, tank, show)?)
         }
         // Spheres of half the rest spacing.
         RenderKind::Points => Box::new(PointsViewer::new(
@@ -381,6 +417,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             &cam,
             0.5 * scene.fluid.spacing(),
             SLOTS,
+            show,
         )?),
     };
     let view = Guard::new(&ctx, view);
@@ -398,6 +435,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         view: view.take(),
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
+        character: character.take(),
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -407,6 +445,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
     let render_stats = work.view.stats();
+    let character_stats = work.character.as_ref().map(|c| c.stats()).transpose();
     let sort = work.solver.search.sort;
     let exports = work
         .export
@@ -421,6 +460,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         steps,
         simulated_seconds,
         render: render_stats,
+        character: character_stats?,
     };
     let config = RunConfig {
         command: "run".into(),
@@ -451,5 +491,139 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         pngs: work.frames.pngs,
         animation,
         exports,
+    })
+}
+
+/// The scene's character, skinned by --skinning and shown by --show-mesh (default shaded).
+fn scene_character(
+    ctx: &Context,
+    scene: &crate::sph::Scene,
+    sw: &Switches,
+) -> Result<Option<SceneCharacter>> {
+    let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
+    let show = sw.character.show_mesh.unwrap_or(ShowMesh::Shaded);
+    scene
+        .character
+        .as_ref()
+        .map(|d| SceneCharacter::new(ctx, d, method, show))
+        .transpose()
+}
+
+/// A character alone: skinned each frame at 30 frames per second of scene time.
+struct CharacterWork<'a> {
+    character: SceneCharacter,
+    view: PointsViewer,
+    frames: Frames<'a>,
+}
+
+impl FrameWork for CharacterWork<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        let t = frame as f64 / ANIMATION_FPS as f64;
+        self.character.record(ctx, cmd, prof, t)?;
+        let save = self.frames.save(frame);
+        let m = self.character.draw();
+        // Without fluid the mesh is always shown (run_character refuses --show-mesh off).
+        let Some(pos) = m.as_ref().map(|m| m.pos) else {
+            return Err(Error::Param(
+                "a character scene with its mesh hidden".into(),
+            ));
+        };
+        self.view
+            .record(ctx, cmd, prof, pos, pos, 0, m.as_ref(), slot, save)
+    }
+
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        let save = self.frames.save(frame);
+        let pic = self.view.retire(ctx, slot, 0, save)?;
+        self.frames.store(frame, pic)
+    }
+}
+
+fn run_character(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
+    use crate::config::Group;
+    let sw = &scene.look.apply(&opts.switches);
+    sw.reject_unused(
+        &format!("scene {} (a character with no fluid)", scene.name),
+        &[Group::Character, Group::Camera],
+    )?;
+    if sw.character.show_mesh == Some(ShowMesh::Off) {
+        return Err(Error::Param(format!(
+            "scene {} has no fluid: --show-mesh off leaves nothing to draw",
+            scene.name
+        )));
+    }
+    let frame_count = opts.frames.unwrap_or(scene.frames);
+    let ctx = open(sw)?;
+    let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
+    let character = scene_character(&ctx, &scene, sw)?
+        .ok_or_else(|| Error::Param(format!("scene {}: no fluid and no character", scene.name)))?;
+    let character = Guard::new(&ctx, character);
+    let cam = match &scene.camera {
+        Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
+        None => {
+            let st = character.stats()?;
+            let h = st.height.max(1e-3);
+            let base = character.anim.placement.w_axis.truncate();
+            let c = base + glam::Vec3::Y * 0.5 * h;
+            Camera::look_at(
+                c + glam::Vec3::new(0.6, 0.3, 1.6) * h * 1.3,
+                c,
+                40.0,
+                aspect,
+            )
+        }
+    };
+    let cam = camera_with_switches(cam, sw);
+    let view = PointsViewer::new(&ctx, sw, &cam, 1.0, SLOTS, character.show)?;
+    let mut work = CharacterWork {
+        character: character.take(),
+        view,
+        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+    };
+    let memory = ctx.memory_bytes();
+    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
+    let stats = work.character.stats();
+    let render = work.view.stats();
+    work.character.destroy(&ctx);
+    work.view.destroy(&ctx);
+    let timings = timings?;
+    let animation = work.frames.finish()?;
+    let config = RunConfig {
+        command: "run".into(),
+        scene: scene.name.clone(),
+        frames: frame_count,
+        save_every: opts.save_every,
+        particles: 0,
+        neighbors: None,
+        sort: None,
+        render: None,
+        fluid: None,
+        switches: sw.clone(),
+    };
+    let report = Report {
+        device: &ctx.info,
+        config,
+        timings: &timings,
+        memory,
+        stats: RunStats::Character(CharacterRunStats {
+            character: stats?,
+            render,
+        }),
+        validation: sw.common.validation.then(|| ctx.validation_counts()),
+    };
+    let summary = report.write(&opts.out)?;
+    check_validation(&ctx)?;
+    Ok(RunResult {
+        summary,
+        pngs: work.frames.pngs,
+        animation,
+        exports: Vec::new(),
     })
 }

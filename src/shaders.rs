@@ -35,6 +35,8 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::scene::orbits::OrbitsIo>("scene/orbits.comp", &[]),
         with::<crate::render::points::PointsIo>("render/points.vert", &[]),
         with::<crate::render::points::PointsIo>("render/points.frag", &[]),
+        with::<crate::render::mesh::MeshIo>("render/mesh.vert", &[]),
+        with::<crate::render::mesh::MeshIo>("render/mesh.frag", &[]),
     ];
     use crate::character::skin::{SkinIo, SkinPass};
     for method in [crate::config::Skinning::Lbs, crate::config::Skinning::Dqs] {

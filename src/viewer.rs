@@ -1,9 +1,10 @@
 //! How `run` shows particles: ray-marched metaballs with per-pixel lists, or the
-//! sphere-impostor particle view, behind one `View` trait. Both write one PNG per saved
-//! frame.
-use crate::config::Switches;
+//! sphere-impostor particle view, behind one `View` trait; either draws a character's
+//! skinned mesh with them, depth-tested. Both write one PNG per saved frame.
+use crate::config::{ShowMesh, Switches};
 use crate::error::Result;
 use crate::gpu::{sync, Buffer, ColorTarget, Context, Guard, Profiler};
+use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FrameStats, MetaballBuffers, MetaballRenderer, MetaballSettings};
 use crate::render::{points::PointsPush, Camera, PointsView};
 use ash::vk;
@@ -11,8 +12,9 @@ use serde::{Deserialize, Serialize};
 
 /// A picture of `n` particles per frame.
 pub trait View {
-    /// Record the frame's picture of the particles at `pos` (colours in `attr`), whose
-    /// writes the caller made visible to compute, vertex shaders and copies.
+    /// Record the frame's picture of the particles at `pos` (colours in `attr`) and the
+    /// mesh, if any (a view made with a mesh view needs one each frame), whose writes the
+    /// caller made visible to compute, vertex shaders and copies.
     #[allow(clippy::too_many_arguments)]
     fn record(
         &mut self,
@@ -22,6 +24,7 @@ pub trait View {
         pos: &Buffer,
         attr: &Buffer,
         n: u32,
+        mesh: Option<&MeshDraw>,
         slot: usize,
         save: bool,
     ) -> Result<()>;
@@ -69,8 +72,17 @@ pub struct RenderSummary {
 
 pub struct PointsViewer {
     view: PointsView,
+    mesh: Option<MeshView>,
     target: ColorTarget,
     push: PointsPush,
+}
+
+/// The mesh view for `show`, if the mesh is drawn.
+fn mesh_view(ctx: &Context, cam: &Camera, show: ShowMesh) -> Result<Option<MeshView>> {
+    match show {
+        ShowMesh::Off => Ok(None),
+        s => MeshView::new(ctx, cam, s).map(Some),
+    }
 }
 
 impl PointsViewer {
@@ -80,11 +92,14 @@ impl PointsViewer {
         cam: &Camera,
         radius: f32,
         slots: usize,
+        show: ShowMesh,
     ) -> Result<Self> {
         let view = Guard::new(ctx, PointsView::new(ctx)?);
+        let mesh = Guard::new(ctx, mesh_view(ctx, cam, show)?);
         let target = ColorTarget::new(ctx, sw.frame.width(), sw.frame.height(), slots)?;
         Ok(Self {
             view: view.take(),
+            mesh: mesh.take(),
             target,
             push: PointsPush::from_camera(cam, radius),
         })
@@ -100,13 +115,19 @@ impl View for PointsViewer {
         pos: &Buffer,
         attr: &Buffer,
         n: u32,
+        mesh: Option<&MeshDraw>,
         slot: usize,
         save: bool,
     ) -> Result<()> {
         prof.begin(ctx, cmd, PointsView::NAME);
         self.target
             .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-        self.view.draw(ctx, cmd, pos, attr, n, &self.push);
+        if let (Some(v), Some(m)) = (&self.mesh, mesh) {
+            v.draw(ctx, cmd, m);
+        }
+        if n > 0 {
+            self.view.draw(ctx, cmd, pos, attr, n, &self.push);
+        }
         self.target.end_rendering(ctx, cmd);
         prof.end(ctx, cmd);
         if save {
@@ -140,6 +161,9 @@ impl View for PointsViewer {
 
     fn destroy(&mut self, ctx: &Context) {
         self.view.destroy(ctx);
+        if let Some(m) = &mut self.mesh {
+            m.destroy(ctx);
+        }
         self.target.destroy(ctx);
     }
 }
@@ -147,6 +171,9 @@ impl View for PointsViewer {
 pub struct MetaballViewer {
     renderer: MetaballRenderer,
     buffers: MetaballBuffers,
+    /// The mesh view and its colour + depth target, copied into the renderer's opaque
+    /// layer each frame.
+    mesh: Option<(MeshView, ColorTarget)>,
     /// Per-slot copies of the particle positions, so a frame can be redone.
     centers: Vec<Buffer>,
     cam: Camera,
@@ -162,9 +189,17 @@ impl MetaballViewer {
         n: u32,
         slots: usize,
         tank: Option<[[f32; 3]; 2]>,
+        show: ShowMesh,
     ) -> Result<Self> {
         let mut settings = MetaballSettings::from_switches(sw)?;
         settings.tank = tank;
+        settings.opaque = show != ShowMesh::Off;
+        let mesh = Guard::new(ctx, mesh_view(ctx, &cam, show)?);
+        let target = match settings.opaque {
+            true => Some(ColorTarget::new(ctx, settings.width, settings.height, 0)?),
+            false => None,
+        };
+        let target = Guard::new(ctx, target);
         let renderer = Guard::new(ctx, MetaballRenderer::new(ctx, settings)?);
         let buffers = Guard::new(ctx, renderer.buffers(ctx, n as u64, slots, false)?);
         let mut centers = Guard::new(ctx, Vec::new());
@@ -179,6 +214,7 @@ impl MetaballViewer {
         Ok(Self {
             renderer: renderer.take(),
             buffers: buffers.take(),
+            mesh: mesh.take().zip(target.take()),
             centers: centers.take(),
             cam,
             totals,
@@ -195,11 +231,24 @@ impl View for MetaballViewer {
         pos: &Buffer,
         _: &Buffer,
         n: u32,
+        mesh: Option<&MeshDraw>,
         slot: usize,
         _: bool,
     ) -> Result<()> {
+        if let Some((view, target)) = &self.mesh {
+            let m = mesh.ok_or_else(|| {
+                crate::Error::Param("a metaball view made to draw a mesh was given none".into())
+            })?;
+            prof.begin(ctx, cmd, MeshView::NAME);
+            target.begin_rendering(ctx, cmd, [0.0; 4]);
+            view.draw(ctx, cmd, m);
+            target.end_rendering(ctx, cmd);
+            let px = self.renderer.settings.pixels();
+            target.copy_layers(ctx, cmd, &self.buffers.opaque, 0, px * 4);
+            prof.end(ctx, cmd);
+        }
         ctx.copy(cmd, pos, 0, &self.centers[slot], 0, n as u64 * 16);
-        // This slot's centers -> the renderer's bounds pass and billboards.
+        // This slot's centers (and the opaque layer) -> the renderer's passes.
         ctx.barrier(
             cmd,
             sync::TRANSFER_WRITE,
@@ -270,6 +319,10 @@ impl View for MetaballViewer {
     }
 
     fn destroy(&mut self, ctx: &Context) {
+        if let Some((v, t)) = &mut self.mesh {
+            v.destroy(ctx);
+            t.destroy(ctx);
+        }
         self.buffers.destroy(ctx);
         for c in &mut self.centers {
             ctx.destroy_buffer(c);

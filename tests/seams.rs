@@ -333,7 +333,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             fields!(RenderParams;
             view_proj, inv_view_proj, view, proj, eye, sun, absorb, f0, base, tank_min, tank_max,
             width, height,
-            n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, pad),
+            n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, opaque),
         ),
         (
             "render/metaball/march.comp",

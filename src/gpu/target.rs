@@ -56,7 +56,7 @@ impl ColorTarget {
                 width,
                 height,
                 DEPTH_FORMAT,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             )?,
         );
         let mut readbacks = Guard::new(ctx, Vec::new());
@@ -131,7 +131,7 @@ impl ColorTarget {
             .image_view(self.depth.view)
             .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
                     depth: 1.0,
@@ -197,6 +197,76 @@ impl ColorTarget {
             .dst_access_mask(A::HOST_READ)];
         let dep = vk::DependencyInfo::default().memory_barriers(&b);
         unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    /// Copy the colour (RGBA8) to `dst` at byte `color_at` and the depth (f32) at
+    /// `depth_at`, tightly packed rows, after rendering; the caller makes the copy visible.
+    pub fn copy_layers(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        dst: &super::Buffer,
+        color_at: u64,
+        depth_at: u64,
+    ) {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        image_barrier(
+            ctx,
+            cmd,
+            self.color.raw,
+            vk::ImageAspectFlags::COLOR,
+            (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            ),
+            (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
+        );
+        image_barrier(
+            ctx,
+            cmd,
+            self.depth.raw,
+            vk::ImageAspectFlags::DEPTH,
+            (
+                S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+                A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                L::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+            (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
+        );
+        let region = |aspect, offset| vk::BufferImageCopy {
+            buffer_offset: offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: aspect,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: self.width(),
+                height: self.height(),
+                depth: 1,
+            },
+        };
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.color.raw,
+                L::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                &[region(vk::ImageAspectFlags::COLOR, color_at)],
+            );
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.depth.raw,
+                L::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                &[region(vk::ImageAspectFlags::DEPTH, depth_at)],
+            );
+        }
     }
 
     /// RGBA8 pixels of the frame last copied out of `slot` (valid after its fence).

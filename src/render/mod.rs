@@ -1,5 +1,7 @@
-//! Rendering passes. For now: the camera and the particle (billboard sphere) view.
+//! Rendering passes: the camera, the particle (billboard sphere) view, the metaball
+//! renderer and the character mesh.
 pub mod camera;
+pub mod mesh;
 pub mod metaball;
 pub mod points;
 

@@ -1,2 +1,3 @@
-//! Built-in scenes. Until the fluid lands, `orbits` is the default test scene.
+//! Scene parts beside the SPH scenes: the `orbits` test scene and characters.
+pub mod character;
 pub mod orbits;

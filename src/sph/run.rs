@@ -110,6 +110,8 @@ pub struct SphRunStats {
     pub steps: u64,
     pub simulated_seconds: f64,
     pub render: crate::viewer::RenderSummary,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub character: Option<crate::scene::character::CharacterStats>,
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

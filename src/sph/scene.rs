@@ -81,6 +81,9 @@ pub struct Scene {
     /// How the scene is shown unless switches say otherwise.
     #[serde(default)]
     pub look: Look,
+    /// An animated character (a scene may have it alone, with no fluid).
+    #[serde(default)]
+    pub character: Option<crate::scene::character::CharacterDesc>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -136,7 +139,7 @@ impl Particles {
     }
 }
 
-pub const BUILT_IN: &[&str] = &["demo", "dam-break", "drop", "resting-block"];
+pub const BUILT_IN: &[&str] = &["demo", "dam-break", "drop", "resting-block", "walker"];
 
 /// Kelager's water with a Tait equation of state stiff enough for < 1% compression in
 /// a metre of water (c = 40 m/s), dt = 4e-4 s (CFL 0.35), 10 steps per frame.
@@ -179,6 +182,7 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         }),
         frames: 600,
         look: Look::default(),
+        character: None,
     }
 }
 
@@ -236,6 +240,7 @@ impl Scene {
                 }),
                 frames: 240,
                 look: Look::default(),
+                character: None,
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -261,6 +266,39 @@ impl Scene {
                 }),
                 frames: 240,
                 look: Look::default(),
+                character: None,
+            },
+            // The built-in character alone, walking in place: two cycles at 30 fps.
+            "walker" => Scene {
+                name: name.into(),
+                domain: Domain {
+                    min: [-1.0, 0.0, -1.0],
+                    max: [1.0, 1.5, 1.0],
+                },
+                fluid: FluidParams::default(),
+                blocks: vec![],
+                balls: vec![],
+                colliders: vec![],
+                camera: Some(CameraDesc {
+                    eye: [1.4, 0.95, 2.2],
+                    target: [0.0, 0.5, 0.0],
+                    fov: 40.0,
+                }),
+                frames: 60,
+                look: Look {
+                    size: Some([320, 320]),
+                    ..Look::default()
+                },
+                character: Some(crate::scene::character::CharacterDesc {
+                    file: "builtin:walker".into(),
+                    animation: None,
+                    looping: true,
+                    height: None,
+                    scale: None,
+                    position: [0.0; 3],
+                    rotation: [0.0; 3],
+                    speed: 1.0,
+                }),
             },
             _ => return None,
         })
@@ -282,8 +320,16 @@ impl Scene {
             path: name_or_path.into(),
             source: e,
         })?;
-        let s: Scene = toml::from_str(&text)
+        let mut s: Scene = toml::from_str(&text)
             .map_err(|e| Error::Param(format!("scene file {name_or_path}: {e}")))?;
+        // A character file is named relative to the scene file.
+        if let Some(c) = &mut s.character {
+            let f = Path::new(&c.file);
+            if !c.file.starts_with("builtin:") && f.is_relative() {
+                let dir = path.parent().unwrap_or(Path::new("."));
+                c.file = dir.join(f).display().to_string();
+            }
+        }
         s.validate()?;
         Ok(s)
     }
@@ -352,13 +398,21 @@ impl Scene {
                 )));
             }
         }
-        if self.blocks.is_empty() && self.balls.is_empty() {
+        if let Some(c) = &self.character {
+            c.validate(&self.name)?;
+        }
+        if !self.has_fluid() && self.character.is_none() {
             return Err(Error::Param(format!(
-                "scene {}: no fluid (blocks or balls)",
+                "scene {}: no fluid (blocks or balls) and no character",
                 self.name
             )));
         }
         Ok(())
+    }
+
+    /// Blocks or balls of fluid (a scene may hold a character alone).
+    pub fn has_fluid(&self) -> bool {
+        !(self.blocks.is_empty() && self.balls.is_empty())
     }
 
     /// The scene scaled about the origin by `s` (geometry and camera; the fluid's

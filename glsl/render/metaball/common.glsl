@@ -30,7 +30,7 @@ struct RenderParams {
     uint sky_w;
     uint sky_h;
     uint debug;
-    uint pad;
+    uint opaque;  // 1: the opaque layer is drawn (march.comp)
 };
 const uint NIL = 0xFFFFFFFFu;
 struct RenderStats {
@@ -57,6 +57,8 @@ layout(std430, binding = MB_B_PIXELS) writeonly buffer Pixels { uint pixels[]; }
 layout(std430, binding = MB_B_DEBUG) writeonly buffer Debug { vec4 debug_out[]; };  // t, normal
 layout(std430, binding = MB_B_SKY) readonly buffer Sky { uint sky[]; };  // RGBA8
 layout(std430, binding = MB_B_DEPTHS) buffer Depths { float depths[]; };  // view depths
+// Opaque layer (a character's mesh): W*H RGBA8 colours, then W*H depths (0..1, 1 = none).
+layout(std430, binding = MB_B_OPAQUE) readonly buffer Opaque { uint opaque[]; };
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
 

@@ -258,6 +258,15 @@ vec3 with_tank(vec3 color, vec3 o, vec3 d, float t_max) {
 }
 
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
+
+// Distance along the primary ray to the opaque layer (a character's mesh), or 1e30.
+float opaque_t(uint id, vec2 ndc, vec3 o, vec3 d) {
+    if (P.opaque == 0u) return 1e30;
+    float z = uintBitsToFloat(opaque[P.width * P.height + id]);
+    if (z >= 1.0) return 1e30;
+    vec4 w = P.inv_view_proj * vec4(ndc, z, 1.0);
+    return dot(w.xyz / w.w - o, d);
+}
 const int STACK = 8;
 
 void main() {
@@ -275,6 +284,9 @@ void main() {
 #else
     vec2 iv = list_interval(o, d, id);
 #endif
+    // Rays stop at the opaque layer, which shows where no fluid is in front of it.
+    float t_opaque = opaque_t(id, ndc, o, d);
+    iv.y = min(iv.y, t_opaque);
     vec3 color = vec3(0.0);
     vec4 dbg = vec4(-1.0, 0.0, 0.0, 0.0);
     Path stack[STACK];
@@ -286,8 +298,12 @@ void main() {
         vec2 span = primary ? iv : ray_box(r.o, r.d, box_lo(), box_hi());
         float t = span.x <= span.y ? march(r.o, r.d, span.x, span.y, r.inside, primary ? id : NIL) : -1.0;
         if (t < 0.0) {
-            // Left the fluid's bounds (or the screen, with offscreen_end): the sky.
-            color += r.w * sky_color(r.d);
+            // Left the fluid's bounds (or the screen, with offscreen_end): the sky, or the
+            // opaque layer for a primary ray that reached it. Secondary rays see the sky.
+            vec3 behind = primary && t_opaque < 1e30
+                ? pow(unpackUnorm4x8(opaque[id]).rgb, vec3(2.2))
+                : sky_color(r.d);
+            color += r.w * behind;
             continue;
         }
         vec3 x = r.o + r.d * t;
@@ -326,7 +342,7 @@ void main() {
 #endif
     }
     CUT_UNLESS(!(sp > 0))
-    color = with_tank(color, o, d, dbg.x >= 0.0 ? dbg.x : 1e30);
+    color = with_tank(color, o, d, min(dbg.x >= 0.0 ? dbg.x : 1e30, t_opaque));
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
     if (P.debug != 0u) debug_out[id] = dbg;

@@ -23,6 +23,8 @@ pub struct MetaballBuffers {
     pub(super) sky: Buffer,
     /// Sorted S-buffer: every metaball's view depth.
     pub(super) depths: Buffer,
+    /// The opaque layer the caller draws (settings.opaque): W*H RGBA8, then W*H f32 depths.
+    pub opaque: Buffer,
     pub(super) sky_size: (u32, u32),
     pub(super) bounds: BoundsBuffers,
     pub(super) scan: ScanScratch,
@@ -66,6 +68,7 @@ impl MetaballBuffers {
             &mut self.debug,
             &mut self.sky,
             &mut self.depths,
+            &mut self.opaque,
         ] {
             ctx.destroy_buffer(b);
         }
@@ -126,6 +129,7 @@ impl MetaballBuffers {
             "metaball depths",
             only(s.sorts_lists(), n_capacity.max(1) * 4),
         )?;
+        let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
         let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);
         let mut stats_readback = Guard::new(ctx, Vec::new());
@@ -157,6 +161,7 @@ impl MetaballBuffers {
                 debug: debug_buf.take(),
                 sky: sky.take(),
                 depths: depths.take(),
+                opaque: opaque.take(),
                 sky_size: (sky_w, sky_h),
                 bounds: bounds.take(),
                 scan: scan.take(),

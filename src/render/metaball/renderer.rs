@@ -22,7 +22,7 @@ crate::gpu_interface! {
     /// glsl/render/metaball/common.glsl: every metaball pass declares all of these.
     pub MetaballIo / MetaballBufs: "MB", push () {
         params = 0, centers = 1, bounds = 2, offsets = 3, list = 4, heads = 5, nodes = 6,
-        stats = 7, pixels = 8, debug = 9, sky = 10, depths = 11,
+        stats = 7, pixels = 8, debug = 9, sky = 10, depths = 11, opaque = 12,
     }
 }
 
@@ -135,6 +135,7 @@ impl MetaballRenderer {
             debug: &b.debug,
             sky: &b.sky,
             depths: &b.depths,
+            opaque: &b.opaque,
         }
     }
 

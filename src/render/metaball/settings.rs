@@ -41,6 +41,10 @@ pub struct MetaballSettings {
     pub tank: Option<[[f32; 3]; 2]>,
     /// Equirectangular sky image (else the procedural sky).
     pub sky: Option<String>,
+    /// An opaque layer (a character's mesh: colour and depth per pixel) is drawn into the
+    /// frame; primary rays stop at it and show it where no fluid is in front.
+    #[serde(default)]
+    pub opaque: bool,
 }
 
 pub const MAX_DEPTH: u32 = 6;
@@ -115,6 +119,7 @@ impl MetaballSettings {
             base: [0.08, 0.06, 0.05],
             tank: None,
             sky: sw.metaball.sky.clone(),
+            opaque: false,
         };
         if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
             return Err(Error::Param(format!(
@@ -264,7 +269,8 @@ pub struct RenderParams {
     pub sky_w: u32,
     pub sky_h: u32,
     pub debug: u32,
-    pub pad: u32,
+    /// 1: the opaque layer (colours, then depths) is bound and used.
+    pub opaque: u32,
 }
 const _: () = assert!(std::mem::size_of::<RenderParams>() == 368);
 
@@ -310,7 +316,7 @@ impl RenderParams {
             sky_w: sky.0,
             sky_h: sky.1,
             debug: debug as u32,
-            pad: 0,
+            opaque: s.opaque as u32,
         }
     }
 }

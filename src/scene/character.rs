@@ -1,0 +1,199 @@
+//! A character in a scene (TOML `[character]`): which file and clip, where it stands, how
+//! fast it plays; skinned every frame on the GPU (`skin` scope) and drawn by the view.
+use crate::character::{self, anim, skin::Skinner, Animator, Character};
+use crate::config::{ShowMesh, Skinning};
+use crate::error::{Error, Result};
+use crate::gpu::{sync, Context, Guard, Profiler};
+use crate::render::mesh::MeshDraw;
+use ash::vk;
+use glam::{Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+
+fn yes() -> bool {
+    true
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterDesc {
+    /// A .glb, .gltf or .obj file (relative to the scene file) or builtin:walker|giraffe.
+    pub file: String,
+    /// Clip name or index (default: the first, if the file has any).
+    #[serde(default)]
+    pub animation: Option<String>,
+    /// Loop the clip (else hold its last pose).
+    #[serde(default = "yes")]
+    pub looping: bool,
+    /// Scale the rest pose to this height in metres (Y up) ...
+    #[serde(default)]
+    pub height: Option<f32>,
+    /// ... or by this factor (default 1: the file's units, metres for glTF).
+    #[serde(default)]
+    pub scale: Option<f32>,
+    /// Where the rest pose's bottom centre stands.
+    #[serde(default)]
+    pub position: [f32; 3],
+    /// XYZ Euler angles in degrees, about the bottom centre.
+    #[serde(default)]
+    pub rotation: [f32; 3],
+    /// Playback rate (1: the clip's own timing).
+    #[serde(default = "one")]
+    pub speed: f32,
+}
+
+impl CharacterDesc {
+    pub fn validate(&self, scene: &str) -> Result<()> {
+        let bad = |m: String| Err(Error::Param(format!("scene {scene}: character {m}")));
+        if self.height.is_some() && self.scale.is_some() {
+            return bad("takes height or scale, not both".into());
+        }
+        for (k, v) in [("height", self.height), ("scale", self.scale)] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                return bad(format!("{k} must be positive, got {v}"));
+            }
+        }
+        if !(self.speed.is_finite() && self.speed >= 0.0) {
+            return bad(format!("speed must be at least 0, got {}", self.speed));
+        }
+        if self
+            .position
+            .iter()
+            .chain(&self.rotation)
+            .any(|v| !v.is_finite())
+        {
+            return bad("position and rotation must be finite".into());
+        }
+        Ok(())
+    }
+
+    /// The loaded character and its animator (clip chosen, placement made).
+    pub fn load(&self) -> Result<(Character, Animator)> {
+        let ch = character::load(&self.file)?;
+        let clip = match &self.animation {
+            Some(sel) => Some(ch.clip_index(sel)?),
+            None => (!ch.clips.is_empty()).then_some(0),
+        };
+        let (lo, hi) = ch.rest_bounds()?;
+        let s = match (self.height, self.scale) {
+            (Some(h), _) => h / (hi.y - lo.y).max(1e-9),
+            (_, Some(s)) => s,
+            _ => 1.0,
+        };
+        let bottom = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+        let placement = anim::placement(s, self.rotation.into(), self.position.into())
+            * Mat4::from_translation(-bottom);
+        let animator = Animator {
+            clip,
+            looping: self.looping,
+            placement,
+        };
+        Ok((ch, animator))
+    }
+}
+
+/// `stats.character` of summary.json.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CharacterStats {
+    pub file: String,
+    pub vertices: u64,
+    pub triangles: u64,
+    pub joints: u64,
+    pub animation: Option<String>,
+    pub skinning: Skinning,
+    pub show_mesh: ShowMesh,
+    /// Rest height after placement (metres).
+    pub height: f32,
+}
+
+/// A placed character skinned each frame.
+pub struct SceneCharacter {
+    pub ch: Character,
+    pub anim: Animator,
+    pub method: Skinning,
+    pub speed: f32,
+    pub show: ShowMesh,
+    skinner: Skinner,
+}
+
+impl SceneCharacter {
+    pub fn new(
+        ctx: &Context,
+        desc: &CharacterDesc,
+        method: Skinning,
+        show: ShowMesh,
+    ) -> Result<Self> {
+        let (ch, anim) = desc.load()?;
+        // Fail before the first frame on a pose the method cannot skin.
+        ch.gpu_joints(&anim.joint_matrices(&ch, 0.0), method)?;
+        let skinner = Guard::new(ctx, Skinner::new(ctx, &ch, method)?);
+        Ok(Self {
+            ch,
+            anim,
+            method,
+            speed: desc.speed,
+            show,
+            skinner: skinner.take(),
+        })
+    }
+
+    /// Record the pose at scene time `t`: joints uploaded, the `skin` pass, its output
+    /// made visible to the view's vertex shader (and compute passes).
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        t: f64,
+    ) -> Result<()> {
+        let mats = self
+            .anim
+            .joint_matrices(&self.ch, (t * self.speed as f64) as f32);
+        let joints = self.ch.gpu_joints(&mats, self.method)?;
+        prof.begin(ctx, cmd, crate::character::skin::SkinPass::NAME);
+        self.skinner.record(ctx, cmd, &joints)?;
+        prof.end(ctx, cmd);
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::GRAPHICS_READ | sync::COMPUTE_READ,
+        );
+        Ok(())
+    }
+
+    /// The skinned mesh for the view, unless it is hidden.
+    pub fn draw(&self) -> Option<MeshDraw<'_>> {
+        let m = &self.skinner.mesh;
+        (self.show != ShowMesh::Off).then_some(MeshDraw {
+            pos: &m.pos,
+            nrm: &m.nrm,
+            indices: &m.indices,
+            triangles: m.triangles,
+        })
+    }
+
+    pub fn stats(&self) -> Result<CharacterStats> {
+        let rest = self.ch.rest_matrices();
+        let placed: Vec<Mat4> = rest.iter().map(|m| self.anim.placement * *m).collect();
+        let (p, _) = self.ch.skinned_at(&placed, Skinning::Lbs)?;
+        let (lo, hi) = character::check::bounds(&p);
+        Ok(CharacterStats {
+            file: self.ch.source.clone(),
+            vertices: self.ch.mesh.vertices() as u64,
+            triangles: self.ch.mesh.triangles() as u64,
+            joints: self.ch.skeleton.joints.len() as u64,
+            animation: self.anim.clip.map(|c| self.ch.clips[c].name.clone()),
+            skinning: self.method,
+            show_mesh: self.show,
+            height: hi.y - lo.y,
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.skinner.destroy(ctx);
+    }
+}
+crate::impl_destroy!(SceneCharacter);
