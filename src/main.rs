@@ -247,7 +247,25 @@ impl BenchWhat {
     }
 }
 
-fn main() -> Result<()> {
+/// Errors print as one line: the error and any cause its message does not already hold.
+fn main() -> std::process::ExitCode {
+    match real_main() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            let mut msg = e.to_string();
+            for cause in e.chain().skip(1) {
+                let c = cause.to_string();
+                if !msg.contains(&c) {
+                    msg = format!("{msg}: {c}");
+                }
+            }
+            eprintln!("error: {}", msg.replace('\n', " "));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command.unwrap_or(Command::Run {
         scene: DEFAULT_SCENE.into(),

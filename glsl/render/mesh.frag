@@ -1,6 +1,6 @@
 #version 450
 // Shaded: two-sided diffuse and a little specular under a fixed sun and sky light.
-// Wireframe: triangle edges about 1.2 pixels wide, the rest discarded.
+// Wireframe: triangle edges about a pixel wide, the rest discarded.
 layout(push_constant) uniform Push {
     mat4 view_proj;
     vec4 eye;
@@ -13,7 +13,7 @@ layout(location = 0) out vec4 out_color;
 void main() {
     if (pc.color.w > 0.5) {
         vec3 w = fwidth(bary);
-        vec3 edge = smoothstep(vec3(0.0), 1.2 * w, bary);
+        vec3 edge = smoothstep(vec3(0.0), 0.8 * w, bary);
         float line = 1.0 - min(min(edge.x, edge.y), edge.z);
         if (line < 0.5) discard;
         out_color = vec4(pc.color.rgb, 1.0);

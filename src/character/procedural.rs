@@ -9,8 +9,9 @@ use std::collections::HashMap;
 
 pub const BUILT_IN: &[&str] = &["walker", "giraffe"];
 
-/// Grid step of the polygonisation (metres).
-const STEP: f32 = 0.0125;
+/// Grid steps of the polygonisation (metres): the giraffe's finer, for its thin neck.
+const WALKER_STEP: f32 = 0.018;
+const GIRAFFE_STEP: f32 = 0.0125;
 
 pub fn built_in(name: &str) -> Result<Character> {
     match name {
@@ -325,9 +326,9 @@ fn bind(mesh: &mut Mesh, bones: &[Bone]) {
     }
 }
 
-fn shape(caps: &[Capsule]) -> (Mesh, Vec<bool>) {
+fn shape(caps: &[Capsule], step: f32) -> (Mesh, Vec<bool>) {
     let (lo, hi) = shape_bounds(caps);
-    let (positions, indices) = polygonise(&|p| field(caps, p), lo, hi, STEP);
+    let (positions, indices) = polygonise(&|p| field(caps, p), lo, hi, step);
     let n = positions.len();
     (
         Mesh {
@@ -344,7 +345,7 @@ fn shape(caps: &[Capsule]) -> (Mesh, Vec<bool>) {
 fn walker() -> Result<Character> {
     let bones = walker_bones();
     let caps: Vec<Capsule> = bones.iter().map(|b| b.cap).collect();
-    let (mut mesh, has) = shape(&caps);
+    let (mut mesh, has) = shape(&caps, WALKER_STEP);
     bind(&mut mesh, &bones);
     let skel = skeleton_of(&bones);
     let clip = walk_clip(&bones);
@@ -378,7 +379,7 @@ fn giraffe() -> Result<Character> {
     for (x, z) in [(-0.13, 0.06), (-0.13, -0.06), (0.11, 0.06), (0.11, -0.06)] {
         caps.push(c([x, 0.40, z], [x, 0.03, z], 0.032));
     }
-    let (mut mesh, has) = shape(&caps);
+    let (mut mesh, has) = shape(&caps, GIRAFFE_STEP);
     let n = mesh.vertices();
     mesh.joints = vec![[0; MAX_INFLUENCES]; n];
     mesh.weights = vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; n];
