@@ -508,6 +508,24 @@ fn bad_files_are_one_line_errors_naming_the_file() {
         &err_of(character::load(&p)),
         &["lines.gltf", "Lines", "triangle"],
     );
+    // Accessors the spec does not allow: 2D positions, and normals short of the positions.
+    let mut g = triangle_gltf(4, None);
+    g["accessors"][0]["type"] = "VEC2".into();
+    let p = write_json(d, "vec2.gltf", &g);
+    one_line(
+        &err_of(character::load(&p)),
+        &["vec2.gltf", "Vec2", "does not allow"],
+    );
+    let mut g = triangle_gltf(4, None);
+    g["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 1.into();
+    g["accessors"].as_array_mut().unwrap().push(
+        serde_json::json!({"bufferView": 0, "componentType": 5126, "count": 2, "type": "VEC3"}),
+    );
+    let p = write_json(d, "short.gltf", &g);
+    one_line(
+        &err_of(character::load(&p)),
+        &["short.gltf", "2 entries for 3 vertices"],
+    );
     // Malformed OBJ: a face past the vertices, and a number that is not one.
     let p = d.join("bad.obj");
     std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();

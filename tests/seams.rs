@@ -343,6 +343,11 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             budget_pixels, pad0, pad1),
         ),
         (
+            "character/skin.comp",
+            "Joint",
+            fields!(fluidform::character::pose::GpuJoint; m, real, dual, s),
+        ),
+        (
             "common/live_args.comp",
             "LiveCount",
             fields!(LiveCount;

@@ -139,3 +139,41 @@ fn dqs_refuses_a_mirroring_joint() {
     );
     assert!(ch.gpu_joints(&mats, Skinning::Lbs).is_ok());
 }
+
+#[test]
+fn polar_split_at_any_scale_and_collapsed_joints() {
+    use fluidform::character::pose::polar;
+    let r = glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0);
+    for s in [1e-7f32, 1e-3, 1.0, 250.0] {
+        let stretch = glam::Mat3::from_diagonal(Vec3::new(s, 2.0 * s, 0.5 * s));
+        let a = glam::Mat3::from_quat(r) * stretch;
+        let (rr, ss) = polar(a).expect("converges");
+        let q = glam::Quat::from_mat3(&rr);
+        assert!(
+            q.angle_between(r) < 1e-4,
+            "scale {s}: rotation off by {}",
+            q.angle_between(r)
+        );
+        let err = (ss - stretch)
+            .to_cols_array()
+            .iter()
+            .map(|x| x.abs())
+            .fold(0.0, f32::max);
+        assert!(err <= 1e-4 * s, "scale {s}: stretch off by {err}");
+    }
+    // A joint scaled to nothing (hiding a part) skins under DQS as under LBS.
+    let ch = character::load("builtin:walker").unwrap();
+    let mut mats = Animator {
+        clip: Some(0),
+        looping: true,
+        placement: Mat4::IDENTITY,
+    }
+    .joint_matrices(&ch, 0.2);
+    mats[3] *= Mat4::from_scale(Vec3::ZERO);
+    let (l, _) = ch.skinned_at(&mats, Skinning::Lbs).unwrap();
+    let (d, _) = ch.skinned_at(&mats, Skinning::Dqs).unwrap();
+    assert!(l
+        .iter()
+        .zip(&d)
+        .all(|(a, b)| a.is_finite() && b.is_finite()));
+}

@@ -41,6 +41,7 @@ fn block_scene(fluid: FluidParams) -> Scene {
         camera: None,
         frames: 1,
         look: Default::default(),
+        character: None,
     }
 }
 

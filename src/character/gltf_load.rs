@@ -5,6 +5,7 @@
 use super::model::*;
 use crate::error::{Error, Result};
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
 use std::path::Path;
@@ -16,13 +17,84 @@ fn err(path: &Path, message: impl Into<String>) -> Error {
     }
 }
 
+/// Refuse an accessor the gltf reader would panic on: empty, or of a type the spec does
+/// not allow for its use (`allowed`: dimensions and component types).
+fn check_accessor(
+    path: &Path,
+    what: &str,
+    a: &gltf::Accessor,
+    allowed: &[(Dimensions, &[DataType])],
+) -> Result<()> {
+    if a.count() == 0 || a.sparse().is_some_and(|s| s.count() == 0) {
+        return Err(err(
+            path,
+            format!("{what}: accessor {} is empty", a.index()),
+        ));
+    }
+    let ok = allowed
+        .iter()
+        .any(|(d, types)| *d == a.dimensions() && types.contains(&a.data_type()));
+    match ok {
+        true => Ok(()),
+        false => Err(err(
+            path,
+            format!(
+                "{what}: accessor {} is {:?} of {:?}, which the glTF spec does not allow there",
+                a.index(),
+                a.dimensions(),
+                a.data_type()
+            ),
+        )),
+    }
+}
+
+/// Every attribute the loader reads has POSITION's count and an allowed type; the index
+/// accessor too.
+fn check_primitive(path: &Path, what: &str, prim: &gltf::Primitive) -> Result<()> {
+    use gltf::Semantic as S;
+    use DataType::{F32, U16, U32, U8};
+    let n = prim.get(&S::Positions).map(|a| a.count());
+    for (sem, a) in prim.attributes() {
+        let allowed: &[(Dimensions, &[DataType])] = match &sem {
+            S::Positions | S::Normals => &[(Dimensions::Vec3, &[F32])],
+            S::TexCoords(0) => &[(Dimensions::Vec2, &[F32, U8, U16])],
+            S::Joints(_) => &[(Dimensions::Vec4, &[U8, U16])],
+            S::Weights(_) => &[(Dimensions::Vec4, &[F32, U8, U16])],
+            _ => continue,
+        };
+        let label = format!("{what} {sem:?}");
+        check_accessor(path, &label, &a, allowed)?;
+        if Some(a.count()) != n {
+            return Err(err(
+                path,
+                format!(
+                    "{label} has {} entries for {} vertices",
+                    a.count(),
+                    n.unwrap_or(0)
+                ),
+            ));
+        }
+    }
+    if let Some(a) = prim.indices() {
+        check_accessor(
+            path,
+            &format!("{what} indices"),
+            &a,
+            &[(Dimensions::Scalar, &[U8, U16, U32])],
+        )?;
+    }
+    Ok(())
+}
+
 /// One primitive's vertices before merging.
 struct Part {
     positions: Vec<Vec3>,
-    normals: Option<Vec<Vec3>>,
+    normals: Vec<Vec3>,
     uvs: Option<Vec<Vec2>>,
     indices: Vec<u32>,
     influences: Vec<Vec<(u16, f32)>>,
+    /// The joint a vertex with all-zero weights is bound to (its skin's first, or its node).
+    fallback: u16,
 }
 
 pub fn load(path: &Path) -> Result<Character> {
@@ -103,6 +175,7 @@ pub fn load(path: &Path) -> Result<Character> {
     let mut parts = Vec::new();
     let mut skinned = false;
     let mut morph_warned = false;
+    let mut computed_normals = false;
     for &ni in &in_scene {
         let node = doc.nodes().nth(ni).unwrap();
         let Some(mesh) = node.mesh() else { continue };
@@ -115,6 +188,18 @@ pub fn load(path: &Path) -> Result<Character> {
                     Some(&o) => o,
                     None => {
                         let o = joints.len();
+                        let label = format!("skin {}", skin.index());
+                        if n == 0 {
+                            return Err(err(path, format!("{label} has no joints")));
+                        }
+                        if let Some(a) = skin.inverse_bind_matrices() {
+                            check_accessor(
+                                path,
+                                &label,
+                                &a,
+                                &[(Dimensions::Mat4, &[DataType::F32])],
+                            )?;
+                        }
                         let ibm: Vec<Mat4> = match skin
                             .reader(|b| Some(&buffers[b.index()]))
                             .read_inverse_bind_matrices()
@@ -171,6 +256,7 @@ pub fn load(path: &Path) -> Result<Character> {
                 mesh.name().unwrap_or(""),
                 prim.index()
             );
+            check_primitive(path, &what, &prim)?;
             let reader = prim.reader(|b| Some(&buffers[b.index()]));
             let positions: Vec<Vec3> = reader
                 .read_positions()
@@ -216,9 +302,9 @@ pub fn load(path: &Path) -> Result<Character> {
                             break;
                         }
                         sets += 1;
-                        for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate().take(n) {
+                        for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate() {
                             for k in 0..4 {
-                                if w[k] > 0.0 {
+                                if w[k] > 0.0 && w[k].is_finite() {
                                     if j[k] as usize >= count {
                                         return Err(err(path, format!("{what}: vertex {v} names joint {} of a skin with {count}", j[k])));
                                     }
@@ -240,12 +326,18 @@ pub fn load(path: &Path) -> Result<Character> {
                     .iter_mut()
                     .for_each(|i| i.push((offset as u16, 1.0))),
             }
+            // Normals computed per part: parts stored in their own nodes' spaces may overlap.
+            let normals = normals.unwrap_or_else(|| {
+                computed_normals = true;
+                super::check::area_normals(&positions, &indices)
+            });
             parts.push(Part {
                 positions,
                 normals,
                 uvs,
                 indices,
                 influences,
+                fallback: offset as u16,
             });
         }
     }
@@ -267,14 +359,16 @@ pub fn load(path: &Path) -> Result<Character> {
         joints,
         order,
     };
-    super::assemble(
+    let mut ch = super::assemble(
         path.display().to_string(),
         merge(parts, &mut warnings),
         skeleton,
         clips,
         skinned,
         warnings,
-    )
+    )?;
+    ch.normals_computed |= computed_normals;
+    Ok(ch)
 }
 
 /// Triangle list of a primitive's index list, or None for points and lines.
@@ -309,9 +403,8 @@ fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
         let n = p.positions.len();
         m.indices.extend(p.indices.iter().map(|i| i + base));
         m.positions.extend(&p.positions);
-        has_normal.extend(std::iter::repeat_n(p.normals.is_some(), n));
-        m.normals
-            .extend(p.normals.unwrap_or_else(|| vec![Vec3::ZERO; n]));
+        has_normal.extend(std::iter::repeat_n(true, n));
+        m.normals.extend(p.normals);
         if any_uv {
             m.uvs.extend(p.uvs.unwrap_or_else(|| vec![Vec2::ZERO; n]));
         }
@@ -322,9 +415,9 @@ fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
                 inf.truncate(MAX_INFLUENCES);
             }
             let sum: f32 = inf.iter().map(|x| x.1).sum();
-            if sum <= 0.0 {
+            if !(sum > 0.0 && sum.is_finite()) {
                 zero += 1;
-                inf = vec![(0, 1.0)];
+                inf = vec![(p.fallback, 1.0)];
             }
             let sum: f32 = inf.iter().map(|x| x.1).sum();
             if inf.len() > 4 {
@@ -368,6 +461,17 @@ fn read_clips(
         let mut channels = Vec::new();
         let mut duration = 0f32;
         for c in a.channels() {
+            use gltf::animation::Property as P;
+            use DataType::{F32, I16, I8, U16, U8};
+            let label = format!("animation '{name}'");
+            let s = c.sampler();
+            check_accessor(path, &label, &s.input(), &[(Dimensions::Scalar, &[F32])])?;
+            let out: &[(Dimensions, &[DataType])] = match c.target().property() {
+                P::Translation | P::Scale => &[(Dimensions::Vec3, &[F32])],
+                P::Rotation => &[(Dimensions::Vec4, &[F32, I8, U8, I16, U16])],
+                P::MorphTargetWeights => &[(Dimensions::Scalar, &[F32, I8, U8, I16, U16])],
+            };
+            check_accessor(path, &label, &s.output(), out)?;
             let reader = c.reader(|b| Some(&buffers[b.index()]));
             let times: Vec<f32> = reader
                 .read_inputs()
@@ -410,6 +514,12 @@ fn read_clips(
                     times.len(),
                     values.len()
                 )));
+            }
+            if times.iter().any(|t| !t.is_finite()) {
+                return Err(err(
+                    path,
+                    format!("animation '{name}': a key time is not finite"),
+                ));
             }
             if times.windows(2).any(|w| w[1] < w[0]) {
                 return Err(err(path, format!("animation '{name}': key times decrease")));

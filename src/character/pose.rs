@@ -21,23 +21,28 @@ pub struct GpuJoint {
 }
 const _: () = assert!(std::mem::size_of::<GpuJoint>() == 144);
 
-/// A = R S with R a rotation and S symmetric (A with positive determinant).
-pub fn polar(a: Mat3) -> (Mat3, Mat3) {
-    let mut r = a;
-    for _ in 0..32 {
-        let next = 0.5 * (r + r.inverse().transpose());
-        let diff = (next - r)
-            .to_cols_array()
-            .iter()
-            .map(|x| x.abs())
-            .fold(0.0, f32::max);
+/// A = R S with R a rotation and S symmetric (A with positive determinant), by Higham's
+/// scaled Newton iteration in f64 (a few steps at any scale); None when it does not reach
+/// an orthonormal R.
+pub fn polar(a: Mat3) -> Option<(Mat3, Mat3)> {
+    let norm = |m: glam::DMat3| m.to_cols_array().iter().map(|x| x * x).sum::<f64>().sqrt();
+    let mut r = a.as_dmat3();
+    for _ in 0..64 {
+        let inv_t = r.inverse().transpose();
+        let g = (norm(inv_t) / norm(r)).sqrt();
+        let next = (r * g + inv_t * (1.0 / g)) * 0.5;
+        let diff = norm(next - r);
         r = next;
-        if diff < 1e-7 {
+        if diff < 1e-12 {
             break;
         }
     }
-    let s = r.transpose() * a;
-    (r, 0.5 * (s + s.transpose()))
+    let ortho = norm(r.transpose() * r - glam::DMat3::IDENTITY);
+    if !(ortho < 1e-6) {
+        return None;
+    }
+    let s = r.transpose() * a.as_dmat3();
+    Some((r.as_mat3(), ((s + s.transpose()) * 0.5).as_mat3()))
 }
 
 /// The dual quaternion (real, dual) of rotation `q` then translation `t`.
@@ -57,13 +62,20 @@ pub fn gpu_joints(
         .map(|(i, m)| {
             let a = Mat3::from_mat4(*m);
             let det = a.determinant();
-            let (real, dual, s) = if det > 0.0 && det.is_finite() {
-                let (r, s) = polar(a);
-                let (real, dual) = dual_quat(Quat::from_mat3(&r).normalize(), m.w_axis.truncate());
+            let size = a.to_cols_array().iter().map(|x| x * x).sum::<f32>().sqrt();
+            let t = m.w_axis.truncate();
+            let split = (det > 0.0 && det.is_finite()).then(|| polar(a)).flatten();
+            let (real, dual, s) = if let Some((r, s)) = split {
+                let (real, dual) = dual_quat(Quat::from_mat3(&r).normalize(), t);
                 (real, dual, s)
+            } else if size.is_finite() && det.abs() <= 1e-9 * size * size * size {
+                // Collapsed (a part scaled to nothing to hide it): no rotation, the whole
+                // linear part as the stretch, so R S p + t is still A p + t.
+                let (real, dual) = dual_quat(Quat::IDENTITY, t);
+                (real, dual, a)
             } else if method == Skinning::Dqs {
                 return Err(Error::Unsupported(format!(
-                    "joint {i} ({}) has a matrix with determinant {det} (a mirror or a collapse): \
+                    "joint {i} ({}) has a matrix with determinant {det} (a mirror): \
                      dual quaternions cannot represent it; use --skinning lbs",
                     names(i)
                 )));

@@ -109,7 +109,7 @@ impl ColorTarget {
             self.depth.raw,
             vk::ImageAspectFlags::DEPTH,
             (
-                S::LATE_FRAGMENT_TESTS,
+                S::LATE_FRAGMENT_TESTS | S::COPY,
                 A::DEPTH_STENCIL_ATTACHMENT_WRITE,
                 L::UNDEFINED,
             ),

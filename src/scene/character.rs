@@ -73,6 +73,9 @@ impl CharacterDesc {
     /// The loaded character and its animator (clip chosen, placement made).
     pub fn load(&self) -> Result<(Character, Animator)> {
         let ch = character::load(&self.file)?;
+        if self.animation.is_some() && ch.clips.is_empty() && !ch.skinned {
+            ch.require_skin("an animation")?;
+        }
         let clip = match &self.animation {
             Some(sel) => Some(ch.clip_index(sel)?),
             None => (!ch.clips.is_empty()).then_some(0),
@@ -127,8 +130,23 @@ impl SceneCharacter {
         show: ShowMesh,
     ) -> Result<Self> {
         let (ch, anim) = desc.load()?;
-        // Fail before the first frame on a pose the method cannot skin.
-        ch.gpu_joints(&anim.joint_matrices(&ch, 0.0), method)?;
+        // Fail before the first frame on a pose the method cannot skin: every key's.
+        let mut times = vec![0.0];
+        if let Some(c) = anim.clip {
+            times.extend(
+                ch.clips[c]
+                    .channels
+                    .iter()
+                    .flat_map(|k| k.times.iter().copied()),
+            );
+        }
+        let held = Animator {
+            looping: false,
+            ..anim.clone()
+        };
+        for t in times {
+            ch.gpu_joints(&held.joint_matrices(&ch, t), method)?;
+        }
         let skinner = Guard::new(ctx, Skinner::new(ctx, &ch, method)?);
         Ok(Self {
             ch,
