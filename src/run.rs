@@ -70,7 +70,7 @@ pub struct CharacterRunStats {
 #[serde(untagged)]
 pub enum RunStats {
     Sph(Box<SphRunStats>),
-    Character(CharacterRunStats),
+    Character(Box<CharacterRunStats>),
     Orbits(OrbitsStats),
 }
 
@@ -612,10 +612,10 @@ fn run_character(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResul
         config,
         timings: &timings,
         memory,
-        stats: RunStats::Character(CharacterRunStats {
+        stats: RunStats::Character(Box::new(CharacterRunStats {
             character: stats?,
             render,
-        }),
+        })),
         validation: sw.common.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;

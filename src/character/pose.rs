@@ -38,7 +38,7 @@ pub fn polar(a: Mat3) -> Option<(Mat3, Mat3)> {
         }
     }
     let ortho = norm(r.transpose() * r - glam::DMat3::IDENTITY);
-    if !(ortho < 1e-6) {
+    if ortho.is_nan() || ortho >= 1e-6 {
         return None;
     }
     let s = r.transpose() * a.as_dmat3();
