@@ -52,7 +52,7 @@ switch_enum!(Placement {
 });
 switch_enum!(Skinning { Lbs, Dqs });
 switch_enum!(OnOff { On, Off });
-switch_enum!(BoneWeights { Eq8, Eq9 });
+switch_enum!(BoneWeights { Eq8, Eq9, Skin });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
 switch_enum!(ShowMesh { Off, Shaded, Wire });

@@ -4,6 +4,7 @@ pub mod animation;
 pub mod bench;
 pub mod character;
 pub mod config;
+pub mod control;
 pub mod error;
 pub mod export;
 pub mod gpu;

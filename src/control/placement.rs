@@ -1,0 +1,149 @@
+//! Control-particle placement in the rest pose (seed 000, 3.2): `vertices` (one per welded
+//! vertex, no inside test), `random` (seeded Poisson-disk points in the mesh's box kept by
+//! the inside test: uniform spacing, unlike plain random points), and the cubic lattice
+//! the other two are compared against.
+use super::inside::InsideTest;
+use crate::character::{check, Character};
+use crate::config::Placement;
+use crate::error::{Error, Result};
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+
+/// Rest-pose (placed) positions of the character's vertices.
+pub type RestMesh<'a> = (&'a [Vec3], &'a [u32]);
+
+/// One control particle per welded vertex.
+pub fn vertices(positions: &[Vec3]) -> Vec<Vec3> {
+    let (remap, n) = check::weld(positions);
+    let mut out = vec![Vec3::ZERO; n];
+    for (v, &w) in remap.iter().enumerate() {
+        out[w as usize] = positions[v];
+    }
+    out
+}
+
+/// Lattice points at `spacing` inside the mesh (the reference for uniformity).
+pub fn lattice(mesh: RestMesh, spacing: f32) -> Vec<Vec3> {
+    let inside = InsideTest::new(mesh.0, mesh.1);
+    let (lo, hi) = check::bounds(mesh.0);
+    let dims = ((hi - lo) / spacing).ceil().as_uvec3();
+    let mut out = Vec::new();
+    for k in 0..dims.z {
+        for j in 0..dims.y {
+            for i in 0..dims.x {
+                let p = lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * spacing;
+                if inside.inside(p) {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Ratio of the Poisson-disk radius to the spacing: a maximal Poisson-disk set of radius r
+/// holds about 0.6 / r^3 points per unit volume, so this gives the lattice's count (its
+/// nearest neighbours then lie about 0.93 spacings apart).
+const DISK: f32 = 0.84;
+
+/// Bridson's Poisson-disk sampling (2007) in the mesh's box, kept inside: no two points
+/// closer than `DISK * spacing`, the box filled (30 tries per active point).
+pub fn random(mesh: RestMesh, spacing: f32, seed: u64) -> Vec<Vec3> {
+    let inside = InsideTest::new(mesh.0, mesh.1);
+    let (lo, hi) = check::bounds(mesh.0);
+    let r = DISK * spacing;
+    let cell = r / 3f32.sqrt();
+    let dims = ((hi - lo) / cell).ceil().as_uvec3().max(glam::UVec3::ONE);
+    let (dx, dy, dz) = (dims.x as usize, dims.y as usize, dims.z as usize);
+    let mut grid = vec![u32::MAX; dx * dy * dz];
+    let cell_of = |p: Vec3| {
+        let c = ((p - lo) / cell).floor().as_uvec3().min(dims - 1);
+        (c.x as usize, c.y as usize, c.z as usize)
+    };
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    let mut pts: Vec<Vec3> = Vec::new();
+    let mut active = Vec::new();
+    let first = lo + (hi - lo) * Vec3::new(rng.random(), rng.random(), rng.random());
+    let (x, y, z) = cell_of(first);
+    grid[x + dx * (y + dy * z)] = 0;
+    pts.push(first);
+    active.push(0usize);
+    while let Some(k) = (!active.is_empty()).then(|| rng.random_range(0..active.len())) {
+        let base = pts[active[k]];
+        let mut found = false;
+        for _ in 0..30 {
+            // Uniform in the shell [r, 2r].
+            let dir = loop {
+                let d = Vec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - 1.0;
+                if d.length_squared() <= 1.0 && d.length_squared() > 1e-6 {
+                    break d.normalize();
+                }
+            };
+            let p = base + dir * r * (1.0 + rng.random::<f32>());
+            if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+                continue;
+            }
+            let (x, y, z) = cell_of(p);
+            let mut ok = true;
+            'near: for zz in z.saturating_sub(2)..(z + 3).min(dz) {
+                for yy in y.saturating_sub(2)..(y + 3).min(dy) {
+                    for xx in x.saturating_sub(2)..(x + 3).min(dx) {
+                        let q = grid[xx + dx * (yy + dy * zz)];
+                        if q != u32::MAX && pts[q as usize].distance_squared(p) < r * r {
+                            ok = false;
+                            break 'near;
+                        }
+                    }
+                }
+            }
+            if ok {
+                grid[x + dx * (y + dy * z)] = pts.len() as u32;
+                active.push(pts.len());
+                pts.push(p);
+                found = true;
+                break;
+            }
+        }
+        if !found {
+            active.swap_remove(k);
+        }
+    }
+    pts.into_iter().filter(|p| inside.inside(*p)).collect()
+}
+
+/// Control particles of `ch` (rest positions `rest`, placed) by `how` at `spacing`.
+pub fn place(
+    ch: &Character,
+    rest: &[Vec3],
+    how: Placement,
+    spacing: f32,
+    seed: u64,
+) -> Result<Vec<Vec3>> {
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(Error::Param(format!(
+            "--control-spacing must be positive, got {spacing}"
+        )));
+    }
+    let mesh = (rest, ch.mesh.indices.as_slice());
+    let pts = match how {
+        Placement::Vertices => vertices(rest),
+        Placement::Random => {
+            ch.require_closed("--placement random")?;
+            random(mesh, spacing, seed)
+        }
+        Placement::Rays => {
+            return Err(Error::Unsupported(
+                "--placement rays (GPU depth-peeled rays) is not implemented yet".into(),
+            ))
+        }
+    };
+    if pts.is_empty() {
+        return Err(Error::Model {
+            path: ch.source.clone(),
+            message: format!(
+                "gives no control particles at spacing {spacing} (the mesh is smaller than the spacing)"
+            ),
+        });
+    }
+    Ok(pts)
+}

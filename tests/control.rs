@@ -1,0 +1,195 @@
+//! Control particles: inside tests against the generalized winding number, placement
+//! uniformity against the lattice, binding weights (eq. 8, eq. 9, skin), bad input.
+use fluidform::character::{self, Character};
+use fluidform::config::{BoneWeights, Placement};
+use fluidform::control::binding::{self, pair_weights};
+use fluidform::control::inside::{winding_number, InsideTest};
+use fluidform::control::placement;
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use std::path::PathBuf;
+
+fn asset(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets")
+        .join(name);
+    assert!(
+        p.exists(),
+        "test asset {} is missing (CI has ../shared/assets)",
+        p.display()
+    );
+    p.display().to_string()
+}
+
+fn load(name: &str) -> Character {
+    character::load(&asset(name)).unwrap()
+}
+
+#[test]
+fn inside_test_agrees_with_the_winding_number() {
+    for name in ["giraffe.obj", "spot.obj"] {
+        let ch = load(name);
+        let (pos, idx) = (&ch.mesh.positions, &ch.mesh.indices);
+        let test = InsideTest::new(pos, idx);
+        let (lo, hi) = character::check::bounds(pos);
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(3);
+        let (mut checked, mut inside, mut wrong) = (0, 0, Vec::new());
+        for _ in 0..3000 {
+            let p = lo + (hi - lo) * Vec3::new(rng.random(), rng.random(), rng.random());
+            let w = winding_number(pos, idx, p);
+            if (w - 0.5).abs() < 0.4 {
+                continue; // on the surface to within numerical noise
+            }
+            checked += 1;
+            inside += (w > 0.5) as usize;
+            if test.inside(p) != (w > 0.5) {
+                wrong.push((p, w));
+            }
+        }
+        assert!(
+            checked > 2900 && inside > 100,
+            "{name}: {checked} checked, {inside} inside"
+        );
+        assert!(
+            wrong.is_empty(),
+            "{name}: {} disagree: {:?}",
+            wrong.len(),
+            &wrong[..wrong.len().min(5)]
+        );
+    }
+}
+
+/// Nearest-neighbour distances of a point set (brute force over a grid of buckets).
+fn nearest_distances(pts: &[Vec3]) -> Vec<f32> {
+    pts.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            pts.iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| p.distance(*q))
+                .fold(f32::INFINITY, f32::min)
+        })
+        .collect()
+}
+
+fn mean(v: &[f32]) -> f32 {
+    v.iter().sum::<f32>() / v.len() as f32
+}
+
+#[test]
+fn random_placement_is_as_uniform_as_the_lattice() {
+    let ch = load("giraffe.obj");
+    let mesh = (ch.mesh.positions.as_slice(), ch.mesh.indices.as_slice());
+    let spacing = 0.06;
+    let lattice = placement::lattice(mesh, spacing);
+    let random = placement::random(mesh, spacing, 5);
+    let (nl, nr) = (nearest_distances(&lattice), nearest_distances(&random));
+    let (ml, mr) = (mean(&nl), mean(&nr));
+    assert!((ml - spacing).abs() < 1e-4, "lattice mean {ml}");
+    assert!(
+        (mr / ml - 1.0).abs() <= 0.2,
+        "random mean nearest distance {mr} vs lattice {ml}"
+    );
+    // Blue noise: no two points closer than 0.8 spacing; 95% within 1.5 spacing of their
+    // nearest (the rest sit alone in thin parts, where the lattice has lone points too).
+    let mut sorted = nr.clone();
+    sorted.sort_by(f32::total_cmp);
+    let (lo, p95) = (sorted[0], sorted[sorted.len() * 95 / 100]);
+    assert!(
+        lo >= 0.8 * spacing && p95 <= 1.5 * spacing,
+        "nearest distances {lo}, p95 {p95}"
+    );
+    let spread = |v: &[f32]| {
+        let m = mean(v);
+        (v.iter().map(|d| (d - m) * (d - m)).sum::<f32>() / v.len() as f32).sqrt() / m
+    };
+    assert!(
+        spread(&nr) <= 0.2,
+        "relative spread of nearest distances {}",
+        spread(&nr)
+    );
+    // About the lattice's count (the same volume at the same density).
+    let ratio = random.len() as f32 / lattice.len() as f32;
+    assert!(
+        (0.8..1.25).contains(&ratio),
+        "{} random vs {} lattice",
+        random.len(),
+        lattice.len()
+    );
+    // Every random point is inside.
+    let test = InsideTest::new(mesh.0, mesh.1);
+    assert!(random.iter().all(|p| test.inside(*p)));
+}
+
+#[test]
+fn placement_needs_closed_meshes_and_room() {
+    let open = load("SimpleSkin.gltf");
+    let rest = open.rest_positions().unwrap();
+    let v = placement::place(&open, &rest, Placement::Vertices, 0.1, 1).unwrap();
+    assert_eq!(v.len(), open.check.welded_vertices);
+    let e = placement::place(&open, &rest, Placement::Random, 0.1, 1)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("SimpleSkin.gltf")
+            && e.contains("10 boundary")
+            && e.contains("--placement random"),
+        "{e}"
+    );
+    let g = load("giraffe.obj");
+    let rest = g.rest_positions().unwrap();
+    let e = placement::place(&g, &rest, Placement::Random, 50.0, 1)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no control particles") && e.contains("giraffe.obj"),
+        "{e}"
+    );
+    let e = placement::place(&g, &rest, Placement::Random, -1.0, 1)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must be positive"), "{e}");
+}
+
+#[test]
+fn bone_weights_by_eq8_eq9_and_skin() {
+    // eq. 8 with n = 2: w_1 = d_2 / (d_1 + d_2); eq. 9 (reconstructed): inverse squares.
+    assert_eq!(pair_weights(BoneWeights::Eq8, 1.0, 3.0), [0.75, 0.25]);
+    let w = pair_weights(BoneWeights::Eq9, 1.0, 3.0);
+    assert!(
+        (w[0] - 0.9).abs() < 1e-6 && (w[1] - 0.1).abs() < 1e-6,
+        "{w:?}"
+    );
+    assert_eq!(pair_weights(BoneWeights::Eq9, 0.0, 2.0), [1.0, 0.0]);
+    let ch = character::load("builtin:walker").unwrap();
+    let g = ch.skeleton.globals(&ch.skeleton.rest_locals());
+    let bones = binding::bones(&ch, &g);
+    assert_eq!(bones.len(), ch.skeleton.joints.len());
+    let find = |n: &str| {
+        ch.skeleton
+            .joints
+            .iter()
+            .position(|j| ch.skeleton.nodes[j.node].name == n)
+            .unwrap()
+    };
+    // Mid-thigh binds to the thigh first, the knee half to thigh and shin.
+    let (thigh, shin) = (find("thigh_l"), find("shin_l"));
+    let hip = g[ch.skeleton.joints[thigh].node].w_axis.truncate();
+    let knee = g[ch.skeleton.joints[shin].node].w_axis.truncate();
+    let rest = ch.rest_positions().unwrap();
+    for how in [BoneWeights::Eq8, BoneWeights::Eq9] {
+        let (j, w) = binding::bind(&ch, &bones, &[hip.lerp(knee, 0.5), knee], how, &rest);
+        assert_eq!(j[0][0] as usize, thigh, "{how:?}");
+        assert!(w[0][0] > 0.5 && (w[0][0] + w[0][1] - 1.0).abs() < 1e-6);
+        assert!(
+            w[1][0] >= 0.5
+                && [j[1][0], j[1][1]].contains(&(shin as u16))
+                && [j[1][0], j[1][1]].contains(&(thigh as u16))
+        );
+    }
+    // skin: the weights of the nearest vertex.
+    let p = rest[100] + Vec3::splat(1e-4);
+    let (j, w) = binding::bind(&ch, &bones, &[p], BoneWeights::Skin, &rest);
+    assert_eq!((j[0], w[0]), (ch.mesh.joints[100], ch.mesh.weights[100]));
+}
