@@ -52,6 +52,7 @@ switch_enum!(Placement {
 });
 switch_enum!(Skinning { Lbs, Dqs });
 switch_enum!(OnOff { On, Off });
+switch_enum!(Adaptive { Off, On, Smooth });
 switch_enum!(BoneWeights { Eq8, Eq9, Skin });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
@@ -210,7 +211,7 @@ pub struct ControlArgs {
     #[arg(long)]
     pub control_pressure: Option<f32>,
     #[arg(long, value_enum)]
-    pub adaptive: Option<OnOff>,
+    pub adaptive: Option<Adaptive>,
     #[arg(long, value_enum)]
     pub bone_weights: Option<BoneWeights>,
 }

@@ -78,6 +78,18 @@ pub fn variants() -> Vec<Variant> {
             for f in ["sph/density.comp", "sph/forces.comp", "sph/integrate.comp"] {
                 v.push(with::<crate::sph::solver::SphIo>(f, &sph));
             }
+            use crate::control::force::{ControlIo, ControlSettings};
+            for a in crate::config::Adaptive::value_variants() {
+                let mut c = sph.clone();
+                c.extend(
+                    ControlSettings::defines(*a)
+                        .into_iter()
+                        .map(|(k, v)| (k.to_string(), v)),
+                );
+                for f in ["control/density.comp", "control/force.comp"] {
+                    v.push(with::<ControlIo>(f, &c));
+                }
+            }
         }
     }
     use crate::render::metaball::renderer::MetaballIo;

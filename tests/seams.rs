@@ -343,6 +343,13 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             budget_pixels, pad0, pad1),
         ),
         (
+            "control/force.comp",
+            "ControlParams",
+            fields!(fluidform::control::force::ControlGpuParams;
+            grid, dims, pressure, radius, spiky_grad, velocity, adaptive, low, high, up, down,
+            inv_frame, group, pad),
+        ),
+        (
             "character/skin.comp",
             "Joint",
             fields!(fluidform::character::pose::GpuJoint; m, real, dual, s),

@@ -1,5 +1,6 @@
 //! Control particles (seed 000, section 3): placement inside a character's mesh, binding to
 //! its skeleton, and the inside tests they need.
 pub mod binding;
+pub mod force;
 pub mod inside;
 pub mod placement;

@@ -10,9 +10,15 @@ use bytemuck::{Pod, Zeroable};
 pub trait SphHook {
     /// Timestamp scope and debug label (under `sph/`).
     fn name(&self) -> &str;
-    /// Record the hook's passes for the state's `n` particles; the solver orders them
-    /// after the previous pass and before the next.
-    fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) -> Result<()>;
+    /// Record the hook's passes for the state's `n` particles (sub-scopes in `scopes`);
+    /// the solver orders them after the previous pass and before the next.
+    fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn crate::gpu::Scopes,
+        st: &SphState,
+    ) -> Result<()>;
     fn destroy(&mut self, ctx: &Context);
 }
 
@@ -74,7 +80,13 @@ impl SphHook for ConstantForce {
         "constant-force"
     }
 
-    fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) -> Result<()> {
+    fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        _: &mut dyn crate::gpu::Scopes,
+        st: &SphState,
+    ) -> Result<()> {
         let push = ConstantForcePush {
             accel: [self.accel[0], self.accel[1], self.accel[2], 0.0],
             n: st.n,

@@ -376,7 +376,7 @@ impl SphSolver {
     ) -> Result<()> {
         for h in hooks {
             scopes.begin(ctx, cmd, h.name());
-            h.record(ctx, cmd, st)?;
+            h.record(ctx, cmd, scopes, st)?;
             scopes.end(ctx, cmd);
             ctx.compute_barrier(cmd); // the hook's writes -> the next pass
         }

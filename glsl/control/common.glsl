@@ -1,0 +1,59 @@
+// Control particles (seed 000, 3.1): the SPH bindings (as CTL_B_* numbers) and the control
+// set, sorted by its own grid (cell = control radius h_c). Bindings: ControlIo in
+// src/control/force.rs; ControlParams mirrors ControlGpuParams there (offsets tested).
+#ifndef CONTROL_COMMON_GLSL
+#define CONTROL_COMMON_GLSL
+#define SPH_B_PARAMS CTL_B_PARAMS
+#define SPH_B_NB_KEYS CTL_B_NB_KEYS
+#define SPH_B_NB_START CTL_B_NB_START
+#define SPH_B_NB_END CTL_B_NB_END
+#define SPH_B_NB_BOX CTL_B_NB_BOX
+#define SPH_B_POS CTL_B_POS
+#define SPH_B_VEL CTL_B_VEL
+#define SPH_B_RHO_P CTL_B_RHO_P
+#define SPH_B_ACC CTL_B_ACC
+#define SPH_B_VHALF CTL_B_VHALF
+#define SPH_B_COLLIDERS CTL_B_COLLIDERS
+#include "../sph/common.glsl"
+
+struct ControlParams {
+    vec4 grid;        // xyz control-grid origin, w = cell (= h_c)
+    uvec4 dims;       // xyz control-grid cells, w = control particles m
+    float pressure;   // c_cp
+    float radius;     // h_c
+    float spiky_grad; // -45 / (pi h_c^6)
+    float velocity;   // K of the velocity term (0: off, the thesis)
+    uint adaptive;    // ADAPTIVE_OFF | ADAPTIVE_ON | ADAPTIVE_SMOOTH
+    float low;        // below low * rho0: x up (0.8, 2)
+    float high;       // above high * rho0: x down (1.2, 0.5)
+    float up;
+    float down;
+    float inv_frame;  // 1 / frame time: control velocity from two poses
+    uint group;       // controlled group, or 0xFFFFFFFF: all
+    uint pad;
+};
+layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
+layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
+layout(std430, binding = CTL_B_CPREV) readonly buffer Cprev { vec4 cprev[]; };  // previous pose
+layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };            // fluid density there
+layout(std430, binding = CTL_B_CSTART) readonly buffer Cstart { uint cstart[]; };
+layout(std430, binding = CTL_B_CCOUNT) readonly buffer Ccount { uint ccount[]; };
+layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     // rgb, w = group
+
+const uint ALL_GROUPS = 0xFFFFFFFFu;
+bool controlled(uint i) { return C.group == ALL_GROUPS || floatBitsToUint(attr[i].w) == C.group; }
+
+// Adaptive control pressure (3.1.2) from the fluid density at a control particle.
+float adaptive_factor(float rho) {
+    float f = rho / P.rest_density;
+#if ADAPTIVE == ADAPTIVE_ON
+    return f < C.low ? C.up : (f > C.high ? C.down : 1.0);
+#elif ADAPTIVE == ADAPTIVE_SMOOTH
+    // Ours: the pull fades continuously as the particle fills: up below low, none above
+    // high, linear between (1 at the midpoint when up = 2).
+    return C.up * clamp((C.high - f) / (C.high - C.low), 0.0, 1.0);
+#else
+    return 1.0;
+#endif
+}
+#endif

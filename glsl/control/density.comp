@@ -1,0 +1,17 @@
+#version 450
+// Fluid density at every control particle (poly6 over the fluid grid, controlled groups).
+#include "common.glsl"
+void main() {
+    uint j = global_id();
+    if (j >= C.dims.w) return;
+    vec3 xj = cpos[j].xyz;
+    float h2 = P.h * P.h;
+    float sum = 0.0;
+    NB_BEGIN(xj, P.h, i)
+        if (!controlled(i)) continue;
+        vec3 d = xj - pos[i].xyz;
+        float r2 = dot(d, d);
+        if (r2 < h2) { float q = h2 - r2; sum += q * q * q; }
+    NB_END
+    crho[j] = P.mass * P.poly6 * sum;
+}

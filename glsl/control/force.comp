@@ -1,0 +1,41 @@
+#version 450
+// The driving force (eq. 7): f_i = c_cp sum_j rho_j grad W_spiky(r_i - r_j, h_c) over
+// control particles j within h_c (their own grid), each term scaled by the adaptive
+// factor; added to the acceleration as f_i / rho_i. With K > 0, a velocity term pulls the
+// fluid velocity towards the control particles' (kernel-weighted mean).
+#include "common.glsl"
+void main() {
+    uint i = global_id();
+    if (i >= pc.n || !controlled(i)) return;
+    vec3 xi = pos[i].xyz;
+    float hc = C.radius, hc2 = hc * hc;
+    ivec3 c0 = clamp(ivec3(floor((xi - C.grid.xyz) / C.grid.w)), ivec3(0), ivec3(C.dims.xyz) - 1);
+    vec3 f = vec3(0.0);
+    vec3 vsum = vec3(0.0);
+    float wsum = 0.0;
+    for (int dz = -1; dz <= 1; ++dz) for (int dy = -1; dy <= 1; ++dy) for (int dx = -1; dx <= 1; ++dx) {
+        ivec3 c = c0 + ivec3(dx, dy, dz);
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
+        uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
+        uint s = cstart[id], e = s + ccount[id];
+        for (uint j = s; j < e; ++j) {
+            vec3 d = xi - cpos[j].xyz;
+            float r2 = dot(d, d);
+            if (r2 >= hc2 || r2 == 0.0) continue;
+            float r = sqrt(r2);
+            float q = hc - r;
+            // grad W_spiky = spiky_grad (h - r)^2 d / r with spiky_grad < 0 points from i
+            // to j, so a positive c_cp pulls i towards j.
+            f += (C.pressure * crho[j] * adaptive_factor(crho[j])) * (C.spiky_grad * q * q / r) * d;
+            if (C.velocity > 0.0) {
+                float w = q * q * q;
+                vsum += w * (cpos[j].xyz - cprev[j].xyz) * C.inv_frame;
+                wsum += w;
+            }
+        }
+    }
+    float rho = max(rho_p[i].x, 1e-6);
+    vec3 a = f / rho;
+    if (wsum > 0.0) a += C.velocity * (vsum / wsum - vel[i].xyz);
+    acc[i].xyz += a;
+}

@@ -1,0 +1,441 @@
+//! The driving force (seed 000, eq. 7) as an SPH force hook: per frame the control
+//! particles are skinned to the pose (`skin`), binned on their own grid (cell h_c) by the
+//! counting sort (`control-grid`); per step the fluid density at each control particle
+//! (`control-density`, over the fluid grid) and the force on each fluid particle
+//! (`control-force`, over the control grid), with adaptive control pressure and an
+//! optional velocity term.
+use crate::character::pose::GpuJoint;
+use crate::character::skin::{SkinPass, SkinnedMesh};
+use crate::character::Mesh;
+use crate::config::{Adaptive, Neighbors, SortAlgo};
+use crate::error::{Error, Result};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::primitives::counting::GatherPass;
+use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
+use crate::sph::hooks::SphHook;
+use crate::sph::solver::SphState;
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+crate::gpu_interface! {
+    /// glsl/control/common.glsl: the SPH bindings, then the control set's.
+    pub ControlIo / ControlBufs: "CTL", push NeighborPush {
+        params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
+        pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
+        control = 11, cpos = 12, cprev = 13, crho = 14, cstart = 15, ccount = 16, attr = 17,
+    }
+}
+
+/// glsl/control/common.glsl `ControlParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ControlGpuParams {
+    pub grid: [f32; 4],
+    pub dims: [u32; 4],
+    pub pressure: f32,
+    pub radius: f32,
+    pub spiky_grad: f32,
+    pub velocity: f32,
+    pub adaptive: u32,
+    pub low: f32,
+    pub high: f32,
+    pub up: f32,
+    pub down: f32,
+    pub inv_frame: f32,
+    pub group: u32,
+    pub pad: u32,
+}
+const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 80);
+
+/// Every group is controlled.
+pub const ALL_GROUPS: u32 = u32::MAX;
+
+/// The control switches and their defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ControlSettings {
+    /// c_cp (eq. 7).
+    pub pressure: f32,
+    /// h_c (metres).
+    pub radius: f32,
+    pub adaptive: Adaptive,
+    /// Thresholds (fractions of rho_0) and factors of adaptive control pressure.
+    pub low: f32,
+    pub high: f32,
+    pub up: f32,
+    pub down: f32,
+    /// K of the velocity term (0: off, the thesis).
+    pub velocity: f32,
+    /// The controlled group, or ALL_GROUPS.
+    pub group: u32,
+}
+
+impl ControlSettings {
+    pub fn validate(&self) -> Result<()> {
+        let pos = [
+            ("--control-pressure", self.pressure),
+            ("--control-radius", self.radius),
+        ];
+        for (k, v) in pos {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Param(format!("{k} must be positive, got {v}")));
+            }
+        }
+        if !(self.velocity.is_finite() && self.velocity >= 0.0) {
+            return Err(Error::Param(format!(
+                "--control-velocity must be at least 0, got {}",
+                self.velocity
+            )));
+        }
+        if !(0.0 < self.low && self.low < self.high && self.up > 0.0 && self.down > 0.0) {
+            return Err(Error::Param(format!(
+                "adaptive pressure needs 0 < low < high and positive factors, got low {} high {} up {} down {}",
+                self.low, self.high, self.up, self.down
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn adaptive_id(a: Adaptive) -> u32 {
+        match a {
+            Adaptive::Off => 0,
+            Adaptive::On => 1,
+            Adaptive::Smooth => 2,
+        }
+    }
+
+    /// The shader defines of adaptive mode `a`.
+    pub fn defines(a: Adaptive) -> Vec<(&'static str, String)> {
+        vec![
+            ("ADAPTIVE_OFF", "0".into()),
+            ("ADAPTIVE_ON", "1".into()),
+            ("ADAPTIVE_SMOOTH", "2".into()),
+            ("ADAPTIVE", Self::adaptive_id(a).to_string()),
+        ]
+    }
+}
+
+/// A frame's pose for the control particles: rest-relative joint matrices and the frame
+/// time (for their velocity).
+pub struct Pose {
+    pub joints: Vec<GpuJoint>,
+    pub frame_dt: f32,
+}
+
+/// GPU state of a control set.
+struct ControlGpu {
+    density: ComputePipeline<ControlIo>,
+    force: ComputePipeline<ControlIo>,
+    skin: SkinPass,
+    mesh: SkinnedMesh,
+    search: NeighborSearch,
+    nb: NeighborBuffers,
+    grid: GridSpec,
+    gather: GatherPass,
+    prev: Buffer,
+    sorted_pos: Buffer,
+    sorted_prev: Buffer,
+    crho: Buffer,
+    params: Buffer,
+}
+
+crate::impl_destroy!(ControlGpu);
+impl ControlGpu {
+    fn destroy(&mut self, ctx: &Context) {
+        self.density.destroy(ctx);
+        self.force.destroy(ctx);
+        self.skin.destroy(ctx);
+        self.mesh.destroy(ctx);
+        self.search.destroy(ctx);
+        self.nb.destroy(ctx);
+        self.gather.destroy(ctx);
+        for b in [
+            &mut self.prev,
+            &mut self.sorted_pos,
+            &mut self.sorted_prev,
+            &mut self.crho,
+            &mut self.params,
+        ] {
+            ctx.destroy_buffer(b);
+        }
+    }
+}
+
+/// The control force: shared by the solver's hook and the scene that feeds it poses.
+pub struct ControlForce {
+    gpu: RefCell<Option<ControlGpu>>,
+    pending: RefCell<Option<Pose>>,
+    /// No pose recorded yet: the first one is also the previous (zero velocity).
+    first: RefCell<bool>,
+    pub settings: ControlSettings,
+    /// Control particles.
+    pub m: u32,
+}
+
+impl ControlForce {
+    /// For control particles at rest positions `mesh.positions`, bound by its joints and
+    /// weights (normals unused), skinned by `joints` joints, for fluid searched by
+    /// `solver`, in the domain [lo, hi].
+    pub fn new(
+        ctx: &Context,
+        solver: &crate::sph::SphSolver,
+        mesh: &Mesh,
+        joints: usize,
+        settings: ControlSettings,
+        domain: ([f32; 3], [f32; 3]),
+    ) -> Result<Self> {
+        settings.validate()?;
+        let m = mesh.vertices();
+        if m == 0 {
+            return Err(Error::Param("no control particles".into()));
+        }
+        // The control grid: the grid strategy with the counting sort (cell counts).
+        let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
+        if !NeighborSearch::defines_for(kind, sort).contains(&("NB_CELL_COUNTS", "1".into())) {
+            return Err(Error::Param(
+                "the control grid expects cell counts from the counting sort".into(),
+            ));
+        }
+        // The passes walk the fluid's grid with the fluid search's defines.
+        let eos = crate::sph::params::Eos::defines();
+        let mut defines = solver.search.defines();
+        defines.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        defines.extend(ControlSettings::defines(settings.adaptive));
+        let pipeline = |name, shader| {
+            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, 64))
+                .map(|p| Guard::new(ctx, p))
+        };
+        let density = pipeline("control-density", "control/density.comp")?;
+        let force = pipeline("control-force", "control/force.comp")?;
+        let grid = GridSpec::covering(domain.0, domain.1, settings.radius)?;
+        let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
+        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
+        let skin = SkinPass::new(ctx, crate::config::Skinning::Lbs, mesh.influence_sets)?;
+        let skin = Guard::new(ctx, skin);
+        let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
+        let gather = Guard::new(ctx, GatherPass::new(ctx)?);
+        let buf =
+            |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let v4 = m as u64 * 16;
+        let prev = buf("control previous", v4)?;
+        let sorted_pos = buf("control sorted positions", v4)?;
+        let sorted_prev = buf("control sorted previous", v4)?;
+        let crho = buf("control densities", m as u64 * 4)?;
+        let params = buf(
+            "control params",
+            std::mem::size_of::<ControlGpuParams>() as u64,
+        )?;
+        Ok(Self {
+            gpu: RefCell::new(Some(ControlGpu {
+                density: density.take(),
+                force: force.take(),
+                skin: skin.take(),
+                mesh: cmesh.take(),
+                search: search.take(),
+                nb: nb.take(),
+                grid,
+                gather: gather.take(),
+                prev: prev.take(),
+                sorted_pos: sorted_pos.take(),
+                sorted_prev: sorted_prev.take(),
+                crho: crho.take(),
+                params: params.take(),
+            })),
+            pending: RefCell::new(None),
+            first: RefCell::new(true),
+            settings,
+            m: m as u32,
+        })
+    }
+
+    /// The pose the next step uses (once per frame).
+    pub fn set_pose(&self, pose: Pose) {
+        *self.pending.borrow_mut() = Some(pose);
+    }
+
+    fn gpu_params(&self, g: &ControlGpu, frame_dt: f32) -> ControlGpuParams {
+        let s = &self.settings;
+        let h = s.radius;
+        ControlGpuParams {
+            grid: [
+                g.grid.origin[0],
+                g.grid.origin[1],
+                g.grid.origin[2],
+                g.grid.cell,
+            ],
+            dims: [g.grid.dims[0], g.grid.dims[1], g.grid.dims[2], self.m],
+            pressure: s.pressure,
+            radius: h,
+            spiky_grad: -45.0 / (std::f32::consts::PI * h.powi(6)),
+            velocity: s.velocity,
+            adaptive: ControlSettings::adaptive_id(s.adaptive),
+            low: s.low,
+            high: s.high,
+            up: s.up,
+            down: s.down,
+            inv_frame: if frame_dt > 0.0 { 1.0 / frame_dt } else { 0.0 },
+            group: s.group,
+            pad: 0,
+        }
+    }
+
+    /// Skin to the pending pose, bin, and sort the control set (once per frame).
+    fn record_pose(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        g: &ControlGpu,
+        pose: &Pose,
+    ) -> Result<()> {
+        let bytes = self.m as u64 * 16;
+        let first = std::mem::replace(&mut *self.first.borrow_mut(), false);
+        scopes.begin(ctx, cmd, "skin");
+        // The last pose becomes the previous one; earlier steps' passes read both.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
+            sync::TRANSFER_READ | sync::TRANSFER_WRITE,
+        );
+        if !first {
+            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+        }
+        ctx.update(cmd, &g.params, 0, &[self.gpu_params(g, pose.frame_dt)]);
+        g.mesh.set_pose(ctx, cmd, &pose.joints)?;
+        ctx.barrier(
+            cmd,
+            sync::TRANSFER_WRITE | sync::TRANSFER_READ,
+            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
+        );
+        g.skin.record(ctx, cmd, &g.mesh)?;
+        if first {
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
+            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+        }
+        ctx.compute_barrier(cmd); // skinned positions -> the control grid
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "control-grid");
+        g.search
+            .record_build(ctx, cmd, scopes, &g.nb, &g.mesh.pos, self.m, &g.grid)?;
+        ctx.compute_barrier(cmd); // permutation -> gathers
+        g.gather
+            .record(ctx, cmd, &g.nb.perm, &g.mesh.pos, &g.sorted_pos, self.m);
+        g.gather
+            .record(ctx, cmd, &g.nb.perm, &g.prev, &g.sorted_prev, self.m);
+        ctx.compute_barrier(cmd); // sorted control set -> density and force
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    fn bufs<'a>(&self, g: &'a ControlGpu, st: &'a SphState) -> ControlBufs<'a> {
+        let s = st.bufs();
+        let (cstart, ccount) = g.nb.cell_buffers();
+        ControlBufs {
+            params: s.params,
+            nb_keys: s.nb_keys,
+            nb_start: s.nb_start,
+            nb_end: s.nb_end,
+            nb_box: s.nb_box,
+            pos: s.pos,
+            vel: s.vel,
+            rho_p: s.rho_p,
+            acc: s.acc,
+            vhalf: s.vhalf,
+            colliders: s.colliders,
+            control: &g.params,
+            cpos: &g.sorted_pos,
+            cprev: &g.sorted_prev,
+            crho: &g.crho,
+            cstart,
+            ccount,
+            attr: st.attr(),
+        }
+    }
+
+    /// Fluid density at the control particles of the last step (sorted by the control
+    /// grid), read after the frame's fence.
+    pub fn densities(&self, ctx: &Context) -> Result<Vec<f32>> {
+        match &*self.gpu.borrow() {
+            Some(g) => ctx.readback(&g.crho, 0, self.m as usize),
+            None => Err(Error::Param("the control set is destroyed".into())),
+        }
+    }
+
+    /// Skinned control positions of the last pose (unsorted), after the frame's fence.
+    pub fn positions(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
+        match &*self.gpu.borrow() {
+            Some(g) => ctx.readback(&g.mesh.pos, 0, self.m as usize),
+            None => Err(Error::Param("the control set is destroyed".into())),
+        }
+    }
+
+    pub fn destroy(&self, ctx: &Context) {
+        if let Some(mut g) = self.gpu.borrow_mut().take() {
+            g.destroy(ctx);
+        }
+    }
+}
+
+/// The solver's handle on a shared control force.
+pub struct ControlHook(pub Rc<ControlForce>);
+
+impl SphHook for ControlHook {
+    fn name(&self) -> &str {
+        "control"
+    }
+
+    fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()> {
+        let c = &self.0;
+        let gpu = c.gpu.borrow();
+        let g = gpu
+            .as_ref()
+            .ok_or_else(|| Error::Param("the control set is destroyed".into()))?;
+        if let Some(pose) = c.pending.borrow_mut().take() {
+            c.record_pose(ctx, cmd, scopes, g, &pose)?;
+        } else if *c.first.borrow() {
+            return Err(Error::Param(
+                "control particles stepped before their first pose".into(),
+            ));
+        }
+        let push = NeighborPush {
+            origin_cell: [
+                st.grid.origin[0],
+                st.grid.origin[1],
+                st.grid.origin[2],
+                st.grid.cell,
+            ],
+            dims: [
+                st.grid.dims[0],
+                st.grid.dims[1],
+                st.grid.dims[2],
+                st.nb.table,
+            ],
+            radius: st.fluid.h,
+            n: st.n,
+            max_neighbors: st.nb.max_neighbors,
+            pad: 0,
+        };
+        let bufs = c.bufs(g, st);
+        scopes.begin(ctx, cmd, "control-density");
+        g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
+        scopes.end(ctx, cmd);
+        ctx.compute_barrier(cmd); // control densities -> force
+        scopes.begin(ctx, cmd, "control-force");
+        g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.0.destroy(ctx);
+    }
+}

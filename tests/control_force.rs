@@ -1,0 +1,261 @@
+//! The driving force (eq. 7) on the GPU against an f64 CPU reference: control densities
+//! and the acceleration it adds, for every adaptive mode and a controlled group.
+mod common;
+use fluidform::character::Mesh;
+use fluidform::config::{Adaptive, Neighbors, Skinning};
+use fluidform::control::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
+use fluidform::gpu::Labels;
+use fluidform::sph::hooks::SphHook;
+use fluidform::sph::scene::{Ball, Block, Domain, Scene};
+use fluidform::sph::{FluidParams, SphSolver};
+use glam::{Mat4, Vec3};
+use std::rc::Rc;
+
+fn scene() -> Scene {
+    Scene {
+        name: "control test".into(),
+        domain: Domain {
+            min: [0.0; 3],
+            max: [0.5, 0.5, 0.5],
+        },
+        fluid: FluidParams::default(),
+        blocks: vec![Block {
+            min: [0.05, 0.0, 0.05],
+            max: [0.3, 0.15, 0.3],
+            group: 0,
+            color: [0.2, 0.5, 1.0],
+            velocity: [0.0; 3],
+        }],
+        balls: vec![Ball {
+            center: [0.3, 0.3, 0.3],
+            radius: 0.06,
+            group: 1,
+            color: [1.0, 0.5, 0.1],
+            velocity: [0.0; 3],
+        }],
+        colliders: vec![],
+        camera: None,
+        frames: 1,
+        look: Default::default(),
+        character: None,
+    }
+}
+
+/// Control particles on a lattice in a box over the pool, bound rigidly to one joint.
+fn control_mesh(spacing: f32) -> Mesh {
+    let mut m = Mesh {
+        influence_sets: 1,
+        ..Default::default()
+    };
+    for k in 0..6 {
+        for j in 0..8 {
+            for i in 0..6 {
+                m.positions.push(
+                    Vec3::new(0.1, 0.08, 0.1) + Vec3::new(i as f32, j as f32, k as f32) * spacing,
+                );
+            }
+        }
+    }
+    let n = m.positions.len();
+    m.normals = vec![Vec3::ZERO; n];
+    m.joints = vec![[0; 8]; n];
+    m.weights = vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; n];
+    m
+}
+
+fn poly6(r2: f64, h: f64) -> f64 {
+    if r2 >= h * h {
+        return 0.0;
+    }
+    315.0 / (64.0 * std::f64::consts::PI * h.powi(9)) * (h * h - r2).powi(3)
+}
+
+/// Largest relative error of the control acceleration, and of the control densities.
+fn compare(settings: ControlSettings) -> (f64, f64) {
+    let ctx = common::ctx();
+    let sc = scene();
+    let solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+    let parts = sc.particles(1);
+    let mesh = control_mesh(0.03);
+    let control = Rc::new(
+        ControlForce::new(
+            &ctx,
+            &solver,
+            &mesh,
+            1,
+            settings.clone(),
+            (sc.domain.min, sc.domain.max),
+        )
+        .unwrap(),
+    );
+    let hook = ControlHook(control.clone());
+    let mut st = solver.state(&ctx, &sc, &parts).unwrap();
+    let joints =
+        fluidform::character::pose::gpu_joints(&[Mat4::IDENTITY], Skinning::Lbs, &|_| "j".into())
+            .unwrap();
+    let mut accs = Vec::new();
+    for with in [false, true] {
+        if with {
+            control.set_pose(Pose {
+                joints: joints.clone(),
+                frame_dt: 1.0 / 30.0,
+            });
+        }
+        ctx.one_shot(|cmd| {
+            solver.record_params(&ctx, cmd, &st);
+            solver.record_arrange(&ctx, cmd, &mut Labels, &mut st)?;
+            solver.record_density(&ctx, cmd, &mut Labels, &st);
+            solver.record_forces(&ctx, cmd, &mut Labels, &st);
+            if with {
+                hook.record(&ctx, cmd, &mut Labels, &st)?;
+            }
+            Ok::<_, fluidform::Error>(())
+        })
+        .unwrap()
+        .unwrap();
+        accs.push(st.read(&ctx).unwrap());
+    }
+    let crho = control.densities(&ctx).unwrap();
+    let (d0, d1) = (&accs[0], &accs[1]);
+    let f = &sc.fluid;
+    let (h, hc, m) = (f.h as f64, settings.radius as f64, f.mass as f64);
+    let group = |a: &[f32; 4]| a[3].to_bits();
+    let controlled = |a: &[f32; 4]| settings.group == ALL_GROUPS || group(a) == settings.group;
+    // Control densities (as a multiset: the GPU holds them in control-grid order).
+    let mut want: Vec<f64> = mesh
+        .positions
+        .iter()
+        .map(|c| {
+            let c = c.as_dvec3();
+            (0..d1.pos.len())
+                .filter(|&i| controlled(&d1.attr[i]))
+                .map(|i| {
+                    m * poly6(
+                        (glam::DVec3::new(
+                            d1.pos[i][0] as f64,
+                            d1.pos[i][1] as f64,
+                            d1.pos[i][2] as f64,
+                        ) - c)
+                            .length_squared(),
+                        h,
+                    )
+                })
+                .sum()
+        })
+        .collect();
+    let mut got: Vec<f64> = crho.iter().map(|&x| x as f64).collect();
+    want.sort_by(f64::total_cmp);
+    got.sort_by(f64::total_cmp);
+    let rho0 = f.rest_density as f64;
+    let err_rho = want
+        .iter()
+        .zip(&got)
+        .map(|(w, g)| (w - g).abs() / rho0)
+        .fold(0.0, f64::max);
+    assert!(
+        want.iter().any(|&r| r > 0.3 * rho0),
+        "some control particles sit in fluid"
+    );
+    let factor = |r: f64| {
+        let fr = r / rho0;
+        match settings.adaptive {
+            Adaptive::Off => 1.0,
+            Adaptive::On if fr < settings.low as f64 => settings.up as f64,
+            Adaptive::On if fr > settings.high as f64 => settings.down as f64,
+            Adaptive::On => 1.0,
+            Adaptive::Smooth => {
+                settings.up as f64
+                    * ((settings.high as f64 - fr) / (settings.high - settings.low) as f64)
+                        .clamp(0.0, 1.0)
+            }
+        }
+    };
+    let spiky = -45.0 / (std::f64::consts::PI * hc.powi(6));
+    let (mut err, mut scale, mut touched) = (0.0f64, 0.0f64, 0);
+    let mut rows = Vec::new();
+    for i in 0..d1.pos.len() {
+        let x = glam::DVec3::new(
+            d1.pos[i][0] as f64,
+            d1.pos[i][1] as f64,
+            d1.pos[i][2] as f64,
+        );
+        let mut fsum = glam::DVec3::ZERO;
+        if controlled(&d1.attr[i]) {
+            for (c, rho_j) in mesh.positions.iter().zip(mesh.positions.iter().map(|c| {
+                let c = c.as_dvec3();
+                (0..d1.pos.len())
+                    .filter(|&k| controlled(&d1.attr[k]))
+                    .map(|k| {
+                        m * poly6(
+                            (glam::DVec3::new(
+                                d1.pos[k][0] as f64,
+                                d1.pos[k][1] as f64,
+                                d1.pos[k][2] as f64,
+                            ) - c)
+                                .length_squared(),
+                            h,
+                        )
+                    })
+                    .sum::<f64>()
+            })) {
+                let d = x - c.as_dvec3();
+                let r = d.length();
+                if r < hc && r > 0.0 {
+                    fsum +=
+                        settings.pressure as f64 * rho_j * factor(rho_j) * spiky * (hc - r).powi(2)
+                            / r
+                            * d;
+                }
+            }
+        }
+        let want = fsum / d1.rho_p[i][0] as f64;
+        let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - d0.acc[i][k]) as f64));
+        rows.push((want, got));
+        scale = scale.max(want.length());
+        touched += (want.length() > 0.0) as usize;
+    }
+    for (w, g) in &rows {
+        err = err.max((*w - *g).length() / scale);
+    }
+    assert!(touched > 50, "{touched} fluid particles feel the control");
+    control.destroy(&ctx);
+    let mut s = solver;
+    st.destroy(&ctx);
+    s.destroy(&ctx);
+    common::finish(&ctx);
+    (err, err_rho)
+}
+
+fn settings(adaptive: Adaptive, group: u32) -> ControlSettings {
+    ControlSettings {
+        pressure: 2.0,
+        radius: 0.06,
+        adaptive,
+        low: 0.8,
+        high: 1.2,
+        up: 2.0,
+        down: 0.5,
+        velocity: 0.0,
+        group,
+    }
+}
+
+#[test]
+fn driving_force_matches_the_f64_reference() {
+    for (a, g) in [
+        (Adaptive::Off, ALL_GROUPS),
+        (Adaptive::On, ALL_GROUPS),
+        (Adaptive::Smooth, ALL_GROUPS),
+        (Adaptive::Off, 0),
+    ] {
+        let (err, err_rho) = compare(settings(a, g));
+        assert!(
+            err_rho < 1e-4,
+            "{a:?} group {g}: control density error {err_rho} of rho0"
+        );
+        assert!(
+            err < 1e-3,
+            "{a:?} group {g}: acceleration error {err} of the largest"
+        );
+    }
+}
