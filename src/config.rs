@@ -202,16 +202,32 @@ pub struct CharacterArgs {
     pub show_mesh: Option<ShowMesh>,
 }
 
-/// Control particles: not built yet, each fails naming what brings it.
+/// Control particles (scenes with a `[control]` target).
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ControlArgs {
+    /// Control-particle placement: one per welded vertex, or Poisson-disk points inside
+    /// (closed meshes); rays (GPU) is not built yet
     #[arg(long, value_enum)]
     pub placement: Option<Placement>,
-    /// Control pressure c_cp
+    /// Control-particle spacing in metres (default: the fluid's rest spacing)
+    #[arg(long)]
+    pub control_spacing: Option<f32>,
+    /// Control pressure c_cp of the driving force (eq. 7)
     #[arg(long)]
     pub control_pressure: Option<f32>,
+    /// Control radius h_c in metres (default: twice the fluid's h)
+    #[arg(long)]
+    pub control_radius: Option<f32>,
+    /// Adaptive control pressure: off, on (x2 below 80%, x0.5 above 120% of rho_0), or
+    /// smooth (ours: fades from x2 to 0 between 80% and 120%)
     #[arg(long, value_enum)]
     pub adaptive: Option<Adaptive>,
+    /// K of a velocity term pulling the fluid to the control particles' velocity (0: off)
+    #[arg(long)]
+    pub control_velocity: Option<f32>,
+    /// Bone weights of control particles: eq8 (the thesis), eq9 (the thesis's eq. 9 is
+    /// lost: normalised inverse squared distance stands in), or skin (the nearest vertex's
+    /// skin weights)
     #[arg(long, value_enum)]
     pub bone_weights: Option<BoneWeights>,
 }
@@ -304,6 +320,7 @@ pub enum Group {
     Camera,
     Export,
     Character,
+    Control,
 }
 
 /// The switches of `g` that differ from the group's defaults, as written on the command
@@ -327,7 +344,7 @@ impl Switches {
     /// applies, and for every control switch (not built yet), naming what brings it: a
     /// switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
-        let groups: [(Group, Vec<String>, &str); 8] = [
+        let groups: [(Group, Vec<String>, &str); 9] = [
             (
                 Group::Sort,
                 set_in(&self.sorting),
@@ -360,6 +377,11 @@ impl Switches {
                 set_in(&self.character),
                 "scenes with a character (run) and bench skin",
             ),
+            (
+                Group::Control,
+                set_in(&self.control),
+                "scenes with a [control] target (control particles)",
+            ),
         ];
         for (g, set, owner) in groups {
             if let Some(name) = set.first().filter(|_| !uses.contains(&g)) {
@@ -367,11 +389,6 @@ impl Switches {
                     "{name} does not apply to {what}: it is used by {owner}"
                 )));
             }
-        }
-        if let Some(name) = set_in(&self.control).first() {
-            return Err(Error::Unsupported(format!(
-                "{name} is not implemented yet: it arrives with control particles (issue 13)"
-            )));
         }
         Ok(())
     }

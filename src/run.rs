@@ -268,6 +268,7 @@ struct SphWork<'a> {
     frames: Frames<'a>,
     export: Option<crate::export::ParticleExport>,
     character: Option<SceneCharacter>,
+    control: Option<crate::control::target::ControlTarget>,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -279,6 +280,11 @@ impl FrameWork for SphWork<'_> {
         frame: u64,
         slot: usize,
     ) -> Result<()> {
+        if let (Some(c), Some(ch)) = (&self.control, &self.character) {
+            let t = self.stepper.sim_time * ch.speed as f64;
+            let mats = ch.anim.joint_matrices(&ch.ch, t as f32);
+            c.set_pose(&ch.ch, &mats, self.stepper.frame_time as f32)?;
+        }
         self.stepper
             .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
         if let Some(c) = &self.character {
@@ -356,6 +362,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     if scene.character.is_some() {
         uses.push(Group::Character);
     }
+    if scene.control.is_some() {
+        uses.push(Group::Control);
+    }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
     let mut scene = scene;
@@ -400,6 +409,20 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let cam = camera_with_switches(cam, sw);
     let character = scene_character(&ctx, &scene, sw)?;
     let character = Guard::new(&ctx, character);
+    let mut solver = solver;
+    let control = match (&scene.control, character.as_ref()) {
+        (Some(desc), Some(c)) => Some(crate::control::target::ControlTarget::new(
+            &ctx,
+            &mut solver,
+            &c.ch,
+            &c.anim,
+            &desc.with_switches(sw),
+            &scene.fluid,
+            (scene.domain.min, scene.domain.max),
+            sw.common.seed,
+        )?),
+        _ => None,
+    };
     let show = character.as_ref().map(|c| c.show).unwrap_or(ShowMesh::Off);
     let view: Box<dyn View> = match render {
         RenderKind::Metaballs => {
@@ -436,6 +459,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
         character: character.take(),
+        control,
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -501,7 +525,12 @@ fn scene_character(
     sw: &Switches,
 ) -> Result<Option<SceneCharacter>> {
     let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
-    let show = sw.character.show_mesh.unwrap_or(ShowMesh::Shaded);
+    // A liquid character hides its mesh unless asked.
+    let hidden = scene.control.is_some();
+    let show = sw.character.show_mesh.unwrap_or(match hidden {
+        true => ShowMesh::Off,
+        false => ShowMesh::Shaded,
+    });
     scene
         .character
         .as_ref()

@@ -38,6 +38,7 @@ fn scene() -> Scene {
         frames: 1,
         look: Default::default(),
         character: None,
+        control: None,
     }
 }
 

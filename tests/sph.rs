@@ -42,6 +42,7 @@ fn block_scene(fluid: FluidParams) -> Scene {
         frames: 1,
         look: Default::default(),
         character: None,
+        control: None,
     }
 }
 

@@ -4,3 +4,4 @@ pub mod binding;
 pub mod force;
 pub mod inside;
 pub mod placement;
+pub mod target;

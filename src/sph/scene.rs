@@ -84,6 +84,9 @@ pub struct Scene {
     /// An animated character (a scene may have it alone, with no fluid).
     #[serde(default)]
     pub character: Option<crate::scene::character::CharacterDesc>,
+    /// Control particles pulling the fluid into the character (needs `character`).
+    #[serde(default)]
+    pub control: Option<crate::control::target::ControlDesc>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -183,6 +186,7 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         frames: 600,
         look: Look::default(),
         character: None,
+        control: None,
     }
 }
 
@@ -241,6 +245,7 @@ impl Scene {
                 frames: 240,
                 look: Look::default(),
                 character: None,
+                control: None,
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -267,6 +272,7 @@ impl Scene {
                 frames: 240,
                 look: Look::default(),
                 character: None,
+                control: None,
             },
             // The built-in character alone, walking in place: two cycles at 30 fps.
             "walker" => Scene {
@@ -299,6 +305,7 @@ impl Scene {
                     rotation: [0.0; 3],
                     speed: 1.0,
                 }),
+                control: None,
             },
             _ => return None,
         })
@@ -400,6 +407,12 @@ impl Scene {
         }
         if let Some(c) = &self.character {
             c.validate(&self.name)?;
+        }
+        if self.control.is_some() && (self.character.is_none() || !self.has_fluid()) {
+            return Err(Error::Param(format!(
+                "scene {}: [control] needs a [character] and fluid",
+                self.name
+            )));
         }
         if !self.has_fluid() && self.character.is_none() {
             return Err(Error::Param(format!(

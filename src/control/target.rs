@@ -1,0 +1,201 @@
+//! A scene's control target (TOML `[control]`, switches override): the character's
+//! control particles placed and bound in the rest pose, and each frame's pose for them
+//! (joint matrices relative to the rest pose, so bound particles follow the animation).
+use super::binding;
+use super::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
+use super::placement;
+use crate::character::{pose, Animator, Character, Mesh, MAX_INFLUENCES};
+use crate::config::{Adaptive, BoneWeights, Placement, Skinning, Switches};
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use glam::{Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+use std::rc::Rc;
+
+fn random() -> Placement {
+    Placement::Random
+}
+fn eq8() -> BoneWeights {
+    BoneWeights::Eq8
+}
+fn off() -> Adaptive {
+    Adaptive::Off
+}
+fn default_pressure() -> f32 {
+    DEFAULT_PRESSURE
+}
+
+/// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
+/// built-in walker fills from a pool in about two seconds).
+pub const DEFAULT_PRESSURE: f32 = 6e-4;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlDesc {
+    #[serde(default = "random")]
+    pub placement: Placement,
+    /// Control-particle spacing (default: the fluid's rest spacing).
+    #[serde(default)]
+    pub spacing: Option<f32>,
+    #[serde(default = "eq8")]
+    pub bone_weights: BoneWeights,
+    /// c_cp.
+    #[serde(default = "default_pressure")]
+    pub pressure: f32,
+    /// h_c (default: twice the fluid's h).
+    #[serde(default)]
+    pub radius: Option<f32>,
+    #[serde(default = "off")]
+    pub adaptive: Adaptive,
+    #[serde(default)]
+    pub velocity: f32,
+    /// The controlled group (default: all).
+    #[serde(default)]
+    pub group: Option<u32>,
+}
+
+impl ControlDesc {
+    /// This target with the control switches applied.
+    pub fn with_switches(&self, sw: &Switches) -> Self {
+        let c = &sw.control;
+        Self {
+            placement: c.placement.unwrap_or(self.placement),
+            spacing: c.control_spacing.or(self.spacing),
+            bone_weights: c.bone_weights.unwrap_or(self.bone_weights),
+            pressure: c.control_pressure.unwrap_or(self.pressure),
+            radius: c.control_radius.or(self.radius),
+            adaptive: c.adaptive.unwrap_or(self.adaptive),
+            velocity: c.control_velocity.unwrap_or(self.velocity),
+            group: self.group,
+        }
+    }
+
+    pub fn settings(&self, h: f32) -> ControlSettings {
+        ControlSettings {
+            pressure: self.pressure,
+            radius: self.radius.unwrap_or(2.0 * h),
+            adaptive: self.adaptive,
+            low: 0.8,
+            high: 1.2,
+            up: 2.0,
+            down: 0.5,
+            velocity: self.velocity,
+            group: self.group.unwrap_or(ALL_GROUPS),
+        }
+    }
+}
+
+/// Control particles of a placed character, driving the fluid through the solver's hook.
+pub struct ControlTarget {
+    pub force: Rc<ControlForce>,
+    pub desc: ControlDesc,
+    /// Placed rest-pose joint matrices (the bind of the control particles).
+    rest_inv: Vec<Mat4>,
+    /// Control particles' rest positions.
+    pub rest: Vec<Vec3>,
+}
+
+impl ControlTarget {
+    /// Place and bind control particles in `ch` (posed by `anim`) and hook the force into
+    /// `solver`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &Context,
+        solver: &mut crate::sph::SphSolver,
+        ch: &Character,
+        anim: &Animator,
+        desc: &ControlDesc,
+        fluid: &crate::sph::FluidParams,
+        domain: ([f32; 3], [f32; 3]),
+        seed: u64,
+    ) -> Result<Self> {
+        let placed_rest: Vec<Mat4> = ch
+            .rest_matrices()
+            .iter()
+            .map(|m| anim.placement * *m)
+            .collect();
+        let (rest_mesh, _) = ch.skinned_at(&placed_rest, Skinning::Lbs)?;
+        let spacing = desc.spacing.unwrap_or(fluid.spacing());
+        let points = placement::place(ch, &rest_mesh, desc.placement, spacing, seed)?;
+        let (lo, hi) = (Vec3::from(domain.0), Vec3::from(domain.1));
+        if let Some(p) = points
+            .iter()
+            .find(|p| p.cmplt(lo).any() || p.cmpgt(hi).any())
+        {
+            return Err(Error::Param(format!(
+                "the control target {} reaches outside the domain {lo}..{hi} (a control particle at {p})",
+                ch.source
+            )));
+        }
+        let globals: Vec<Mat4> = ch
+            .skeleton
+            .globals(&ch.skeleton.rest_locals())
+            .iter()
+            .map(|g| anim.placement * *g)
+            .collect();
+        let bones = binding::bones(ch, &globals);
+        let (joints, weights) = binding::bind(ch, &bones, &points, desc.bone_weights, &rest_mesh);
+        let sets = match desc.bone_weights {
+            BoneWeights::Skin => ch.mesh.influence_sets,
+            _ => 1,
+        };
+        let n = points.len();
+        let mesh = Mesh {
+            positions: points.clone(),
+            normals: vec![Vec3::ZERO; n],
+            uvs: Vec::new(),
+            indices: Vec::new(),
+            joints,
+            weights,
+            influence_sets: sets.min(MAX_INFLUENCES / 4),
+        };
+        let rest_inv = placed_rest
+            .iter()
+            .map(|m| {
+                let inv = m.inverse();
+                match inv.is_finite() {
+                    true => Ok(inv),
+                    false => Err(Error::Model {
+                        path: ch.source.clone(),
+                        message:
+                            "a joint's rest matrix is singular: control particles cannot be bound"
+                                .into(),
+                    }),
+                }
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let settings = desc.settings(fluid.h);
+        let force = Rc::new(ControlForce::new(
+            ctx,
+            solver,
+            &mesh,
+            ch.skeleton.joints.len(),
+            settings,
+            domain,
+        )?);
+        solver.add_force(Box::new(ControlHook(force.clone())));
+        Ok(Self {
+            force,
+            desc: desc.clone(),
+            rest_inv,
+            rest: points,
+        })
+    }
+
+    /// Set the pose of scene time `t` (the animator's joint matrices, placed) for the next
+    /// frame's steps, `frame_dt` seconds after the previous pose.
+    pub fn set_pose(&self, ch: &Character, mats: &[Mat4], frame_dt: f32) -> Result<()> {
+        let rel: Vec<Mat4> = mats
+            .iter()
+            .zip(&self.rest_inv)
+            .map(|(m, r)| *m * *r)
+            .collect();
+        let joints = pose::gpu_joints(&rel, Skinning::Lbs, &|j| ch.joint_name(j))?;
+        self.force.set_pose(Pose { joints, frame_dt });
+        Ok(())
+    }
+
+    pub fn count(&self) -> u32 {
+        self.force.m
+    }
+}
