@@ -269,6 +269,9 @@ struct SphWork<'a> {
     export: Option<crate::export::ParticleExport>,
     character: Option<SceneCharacter>,
     control: Option<crate::control::target::ControlTarget>,
+    metrics: Option<crate::control::metrics::ControlMetrics>,
+    /// Per slot: the target's placed joint matrices and the scene time of its frame.
+    poses: Vec<Option<(Vec<glam::Mat4>, f64)>>,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -281,12 +284,18 @@ impl FrameWork for SphWork<'_> {
         slot: usize,
     ) -> Result<()> {
         if let (Some(c), Some(ch)) = (&self.control, &self.character) {
-            let t = self.stepper.sim_time * ch.speed as f64;
-            let mats = ch.anim.joint_matrices(&ch.ch, t as f32);
+            let time = self.stepper.sim_time;
+            let mats = ch.anim.joint_matrices(&ch.ch, (time * ch.speed as f64) as f32);
             c.set_pose(&ch.ch, &mats, self.stepper.frame_time as f32)?;
+            self.poses[slot] = Some((mats, time));
         }
         self.stepper
             .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
+        if let (Some(m), Some(c)) = (&self.metrics, &self.control) {
+            prof.begin(ctx, cmd, "control-metrics");
+            m.record(ctx, cmd, &self.st, &c.force, slot)?;
+            prof.end(ctx, cmd);
+        }
         if let Some(c) = &self.character {
             c.record(ctx, cmd, prof, self.stepper.sim_time)?;
         }
@@ -317,6 +326,18 @@ impl FrameWork for SphWork<'_> {
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         self.stepper.retire_slot(slot, frame)?;
+        if let (Some(m), Some(c), Some(ch), Some((mats, time))) = (
+            &mut self.metrics,
+            &self.control,
+            &self.character,
+            self.poses[slot].take(),
+        ) {
+            let (mesh, _) = ch.ch.skinned_at(&mats, ch.method)?;
+            let f = &self.st.fluid;
+            let group = c.force.settings.group;
+            let spacing = c.desc.spacing.unwrap_or(f.spacing());
+            m.retire(slot, frame, time, (&mesh, &ch.ch.mesh.indices), group, f.rest_density, spacing)?;
+        }
         if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
             e.retire(frame, slot)?;
         }
@@ -333,6 +354,9 @@ impl SphWork<'_> {
             e.destroy(ctx);
         }
         self.view.destroy(ctx);
+        if let Some(m) = &mut self.metrics {
+            m.destroy(ctx);
+        }
         if let Some(c) = &mut self.character {
             c.destroy(ctx);
         }
@@ -423,6 +447,10 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         )?),
         _ => None,
     };
+    let metrics = control
+        .as_ref()
+        .map(|c| crate::control::metrics::ControlMetrics::new(&ctx, st.n, c.count(), SLOTS))
+        .transpose()?;
     let show = character.as_ref().map(|c| c.show).unwrap_or(ShowMesh::Off);
     let view: Box<dyn View> = match render {
         RenderKind::Metaballs => {
@@ -459,7 +487,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
         character: character.take(),
+        metrics,
         control,
+        poses: vec![None; SLOTS],
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -470,6 +500,15 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
     let render_stats = work.view.stats();
     let character_stats = work.character.as_ref().map(|c| c.stats()).transpose();
+    let control_stats = match (&work.metrics, &work.control) {
+        (Some(m), Some(c)) => {
+            m.write_csv(&opts.out.join("control.csv"))?;
+            let mut s = m.stats.clone();
+            s.settings = Some(c.force.settings.clone());
+            Some(s)
+        }
+        _ => None,
+    };
     let sort = work.solver.search.sort;
     let exports = work
         .export
@@ -485,6 +524,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         simulated_seconds,
         render: render_stats,
         character: character_stats?,
+        control: control_stats,
     };
     let config = RunConfig {
         command: "run".into(),

@@ -3,5 +3,6 @@
 pub mod binding;
 pub mod force;
 pub mod inside;
+pub mod metrics;
 pub mod placement;
 pub mod target;

@@ -112,6 +112,8 @@ pub struct SphRunStats {
     pub render: crate::viewer::RenderSummary,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub character: Option<crate::scene::character::CharacterStats>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<crate::control::metrics::ControlStats>,
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

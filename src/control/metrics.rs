@@ -1,0 +1,201 @@
+//! Shape-fidelity metrics of a control target, every frame (`control.csv`, and
+//! `stats.control` of summary.json): the fluid of the controlled groups inside the current
+//! (skinned) target, control particles covered by fluid (density >= 50% rho_0), the
+//! voxel IoU of fluid and target at the particle spacing, the fluid's density error, and
+//! the first time coverage reaches 0.9.
+use super::force::{ControlForce, ALL_GROUPS};
+use super::inside::InsideTest;
+use crate::character::check;
+use crate::error::{Error, Result};
+use crate::gpu::{sync, Buffer, Context, MemoryLocation};
+use crate::sph::SphState;
+use ash::vk;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ControlRow {
+    pub frame: u64,
+    pub time: f64,
+    pub inside_fraction: f64,
+    pub coverage: f64,
+    pub iou: f64,
+    pub density_error_mean: f64,
+    pub density_error_max: f64,
+    pub control_particles: u32,
+}
+
+/// `stats.control` of summary.json.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ControlStats {
+    pub control_particles: u32,
+    pub settings: Option<super::force::ControlSettings>,
+    /// First scene time at which coverage reached 0.9 (None: never).
+    pub time_to_90: Option<f64>,
+    pub last: Option<ControlRow>,
+    /// Means over every frame.
+    pub mean_inside_fraction: f64,
+    pub mean_coverage: f64,
+    /// Frames whose largest density error left the kernels' valid band (|rho/rho0 - 1| > 0.5).
+    pub frames_out_of_band: u64,
+}
+
+/// Per-slot host copies of what the metrics read.
+struct Slot {
+    pos: Buffer,
+    rho: Buffer,
+    attr: Buffer,
+    crho: Buffer,
+}
+
+pub struct ControlMetrics {
+    slots: Vec<Slot>,
+    n: u32,
+    m: u32,
+    pub rows: Vec<ControlRow>,
+    pub stats: ControlStats,
+}
+
+impl ControlMetrics {
+    pub fn new(ctx: &Context, n: u32, m: u32, slots: usize) -> Result<Self> {
+        let host = |name: &str, bytes: u64| {
+            ctx.create_buffer(name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
+        };
+        let mut out = crate::gpu::Guard::new(ctx, Vec::new());
+        for _ in 0..slots {
+            out.push(host("metrics positions", n as u64 * 16)?);
+            out.push(host("metrics densities", n as u64 * 8)?);
+            out.push(host("metrics attributes", n as u64 * 16)?);
+            out.push(host("metrics control densities", m as u64 * 4)?);
+        }
+        let mut it = out.take().into_iter();
+        let slots = (0..slots)
+            .map(|_| Slot {
+                pos: it.next().unwrap(),
+                rho: it.next().unwrap(),
+                attr: it.next().unwrap(),
+                crho: it.next().unwrap(),
+            })
+            .collect();
+        Ok(Self {
+            slots,
+            n,
+            m,
+            rows: Vec::new(),
+            stats: ControlStats {
+                control_particles: m,
+                ..Default::default()
+            },
+        })
+    }
+
+    /// Record the copies of the frame's last state into `slot`.
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState, force: &ControlForce, slot: usize) -> Result<()> {
+        let s = &self.slots[slot];
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
+        ctx.copy(cmd, st.pos(), 0, &s.pos, 0, self.n as u64 * 16);
+        ctx.copy(cmd, st.rho_p(), 0, &s.rho, 0, self.n as u64 * 8);
+        ctx.copy(cmd, st.attr(), 0, &s.attr, 0, self.n as u64 * 16);
+        force.record_copy_densities(ctx, cmd, &s.crho)?;
+        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ);
+        Ok(())
+    }
+
+    /// After the slot's fence: the row of frame `frame` at scene time `time`, with the
+    /// target mesh skinned to that frame (`mesh`: positions and triangles).
+    #[allow(clippy::too_many_arguments)]
+    pub fn retire(
+        &mut self,
+        slot: usize,
+        frame: u64,
+        time: f64,
+        mesh: (&[Vec3], &[u32]),
+        group: u32,
+        rest_density: f32,
+        spacing: f32,
+    ) -> Result<&ControlRow> {
+        let s = &self.slots[slot];
+        fn read(b: &Buffer) -> Result<&[u8]> {
+            b.mapped()
+                .ok_or_else(|| Error::Param("metrics buffer not mapped".into()))
+        }
+        let pos: &[[f32; 4]] = bytemuck::cast_slice(&read(&s.pos)?[..self.n as usize * 16]);
+        let rho: &[[f32; 2]] = bytemuck::cast_slice(&read(&s.rho)?[..self.n as usize * 8]);
+        let attr: &[[f32; 4]] = bytemuck::cast_slice(&read(&s.attr)?[..self.n as usize * 16]);
+        let crho: &[f32] = bytemuck::cast_slice(&read(&s.crho)?[..self.m as usize * 4]);
+        let inside = InsideTest::new(mesh.0, mesh.1);
+        let controlled: Vec<Vec3> = pos
+            .iter()
+            .zip(attr)
+            .filter(|(_, a)| group == ALL_GROUPS || a[3].to_bits() == group)
+            .map(|(p, _)| Vec3::new(p[0], p[1], p[2]))
+            .collect();
+        let inside_count = controlled.iter().filter(|p| inside.inside(**p)).count();
+        let covered = crho.iter().filter(|&&r| r >= 0.5 * rest_density).count();
+        // Voxels at the spacing: fluid occupancy against voxels whose centre is inside.
+        let (lo, hi) = check::bounds(mesh.0);
+        let key = |p: Vec3| ((p - lo) / spacing).floor().as_ivec3();
+        let fluid: HashSet<glam::IVec3> = controlled.iter().map(|p| key(*p)).collect();
+        let dims = ((hi - lo) / spacing).ceil().as_ivec3();
+        let mut target = HashSet::new();
+        for z in 0..dims.z {
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let c = lo + (glam::IVec3::new(x, y, z).as_vec3() + 0.5) * spacing;
+                    if inside.inside(c) {
+                        target.insert(glam::IVec3::new(x, y, z));
+                    }
+                }
+            }
+        }
+        let inter = fluid.intersection(&target).count();
+        let union = fluid.union(&target).count().max(1);
+        let errs: Vec<f64> = rho.iter().map(|r| (r[0] as f64 / rest_density as f64 - 1.0).abs()).collect();
+        let row = ControlRow {
+            frame,
+            time,
+            inside_fraction: inside_count as f64 / controlled.len().max(1) as f64,
+            coverage: covered as f64 / self.m.max(1) as f64,
+            iou: inter as f64 / union as f64,
+            density_error_mean: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
+            density_error_max: errs.iter().cloned().fold(0.0, f64::max),
+            control_particles: self.m,
+        };
+        let st = &mut self.stats;
+        if st.time_to_90.is_none() && row.coverage >= 0.9 {
+            st.time_to_90 = Some(time);
+        }
+        if row.density_error_max > 0.5 {
+            st.frames_out_of_band += 1;
+        }
+        let k = self.rows.len() as f64;
+        st.mean_inside_fraction = (st.mean_inside_fraction * k + row.inside_fraction) / (k + 1.0);
+        st.mean_coverage = (st.mean_coverage * k + row.coverage) / (k + 1.0);
+        st.last = Some(row.clone());
+        self.rows.push(row);
+        Ok(self.rows.last().unwrap())
+    }
+
+    /// control.csv: one row per frame.
+    pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
+        let io = |e: std::io::Error| Error::Io {
+            path: path.display().to_string(),
+            source: e,
+        };
+        let mut w = csv::Writer::from_path(path).map_err(|e| io(e.into()))?;
+        for r in &self.rows {
+            w.serialize(r).map_err(|e| io(e.into()))?;
+        }
+        w.flush().map_err(io)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for s in &mut self.slots {
+            for b in [&mut s.pos, &mut s.rho, &mut s.attr, &mut s.crho] {
+                ctx.destroy_buffer(b);
+            }
+        }
+    }
+}
+crate::impl_destroy!(ControlMetrics);
