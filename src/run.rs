@@ -285,7 +285,9 @@ impl FrameWork for SphWork<'_> {
     ) -> Result<()> {
         if let (Some(c), Some(ch)) = (&self.control, &self.character) {
             let time = self.stepper.sim_time;
-            let mats = ch.anim.joint_matrices(&ch.ch, (time * ch.speed as f64) as f32);
+            let mats = ch
+                .anim
+                .joint_matrices(&ch.ch, (time * ch.speed as f64) as f32);
             c.set_pose(&ch.ch, &mats, self.stepper.frame_time as f32)?;
             self.poses[slot] = Some((mats, time));
         }
@@ -336,7 +338,15 @@ impl FrameWork for SphWork<'_> {
             let f = &self.st.fluid;
             let group = c.force.settings.group;
             let spacing = c.desc.spacing.unwrap_or(f.spacing());
-            m.retire(slot, frame, time, (&mesh, &ch.ch.mesh.indices), group, f.rest_density, spacing)?;
+            m.retire(
+                slot,
+                frame,
+                time,
+                (&mesh, &ch.ch.mesh.indices),
+                group,
+                f.rest_density,
+                spacing,
+            )?;
         }
         if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
             e.retire(frame, slot)?;

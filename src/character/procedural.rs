@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use glam::{Mat4, Quat, Vec3, Vec4};
 use std::collections::HashMap;
 
-pub const BUILT_IN: &[&str] = &["walker", "giraffe"];
+pub const BUILT_IN: &[&str] = &["walker", "giraffe", "capsule"];
 
 /// Grid steps of the polygonisation (metres): the giraffe's finer, for its thin neck.
 const WALKER_STEP: f32 = 0.018;
@@ -17,6 +17,7 @@ pub fn built_in(name: &str) -> Result<Character> {
     match name {
         "walker" => walker(),
         "giraffe" => giraffe(),
+        "capsule" => capsule(),
         _ => Err(Error::Param(format!(
             "unknown built-in shape '{name}' (builtin:{})",
             BUILT_IN.join(", builtin:")
@@ -387,6 +388,27 @@ fn giraffe() -> Result<Character> {
         "builtin:giraffe".into(),
         (mesh, has),
         Skeleton::single("giraffe"),
+        Vec::new(),
+        false,
+        Vec::new(),
+    )
+}
+
+/// A vertical capsule (radius 0.08 m, 0.36 m tall): the simplest closed control target.
+fn capsule() -> Result<Character> {
+    let caps = [Capsule {
+        a: Vec3::new(0.0, 0.08, 0.0),
+        b: Vec3::new(0.0, 0.28, 0.0),
+        r: 0.08,
+    }];
+    let (mut mesh, has) = shape(&caps, WALKER_STEP);
+    let n = mesh.vertices();
+    mesh.joints = vec![[0; MAX_INFLUENCES]; n];
+    mesh.weights = vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; n];
+    super::assemble(
+        "builtin:capsule".into(),
+        (mesh, has),
+        Skeleton::single("capsule"),
         Vec::new(),
         false,
         Vec::new(),

@@ -366,7 +366,12 @@ impl ControlForce {
 
     /// Record a copy of the control densities into `dst` (a host-visible buffer; the
     /// caller orders it after the steps and before the host reads).
-    pub fn record_copy_densities(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: &Buffer) -> Result<()> {
+    pub fn record_copy_densities(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        dst: &Buffer,
+    ) -> Result<()> {
         match &*self.gpu.borrow() {
             Some(g) => {
                 ctx.copy(cmd, &g.crho, 0, dst, 0, self.m as u64 * 4);

@@ -23,6 +23,8 @@ pub struct ControlRow {
     pub iou: f64,
     pub density_error_mean: f64,
     pub density_error_max: f64,
+    /// Largest rho / rho_0 (compression).
+    pub density_ratio_max: f64,
     pub control_particles: u32,
 }
 
@@ -37,7 +39,8 @@ pub struct ControlStats {
     /// Means over every frame.
     pub mean_inside_fraction: f64,
     pub mean_coverage: f64,
-    /// Frames whose largest density error left the kernels' valid band (|rho/rho0 - 1| > 0.5).
+    /// Frames where the fluid was compressed beyond the kernels' valid band
+    /// (rho / rho_0 > 1.5 somewhere): control forces too strong for the spacing.
     pub frames_out_of_band: u64,
 }
 
@@ -60,7 +63,12 @@ pub struct ControlMetrics {
 impl ControlMetrics {
     pub fn new(ctx: &Context, n: u32, m: u32, slots: usize) -> Result<Self> {
         let host = |name: &str, bytes: u64| {
-            ctx.create_buffer(name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
+            ctx.create_buffer(
+                name,
+                bytes,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )
         };
         let mut out = crate::gpu::Guard::new(ctx, Vec::new());
         for _ in 0..slots {
@@ -91,7 +99,14 @@ impl ControlMetrics {
     }
 
     /// Record the copies of the frame's last state into `slot`.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState, force: &ControlForce, slot: usize) -> Result<()> {
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        st: &SphState,
+        force: &ControlForce,
+        slot: usize,
+    ) -> Result<()> {
         let s = &self.slots[slot];
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
         ctx.copy(cmd, st.pos(), 0, &s.pos, 0, self.n as u64 * 16);
@@ -151,7 +166,10 @@ impl ControlMetrics {
         }
         let inter = fluid.intersection(&target).count();
         let union = fluid.union(&target).count().max(1);
-        let errs: Vec<f64> = rho.iter().map(|r| (r[0] as f64 / rest_density as f64 - 1.0).abs()).collect();
+        let errs: Vec<f64> = rho
+            .iter()
+            .map(|r| (r[0] as f64 / rest_density as f64 - 1.0).abs())
+            .collect();
         let row = ControlRow {
             frame,
             time,
@@ -160,13 +178,17 @@ impl ControlMetrics {
             iou: inter as f64 / union as f64,
             density_error_mean: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
             density_error_max: errs.iter().cloned().fold(0.0, f64::max),
+            density_ratio_max: rho
+                .iter()
+                .map(|r| r[0] as f64 / rest_density as f64)
+                .fold(0.0, f64::max),
             control_particles: self.m,
         };
         let st = &mut self.stats;
         if st.time_to_90.is_none() && row.coverage >= 0.9 {
             st.time_to_90 = Some(time);
         }
-        if row.density_error_max > 0.5 {
+        if row.density_ratio_max > 1.5 {
             st.frames_out_of_band += 1;
         }
         let k = self.rows.len() as f64;

@@ -54,6 +54,21 @@ pub struct ControlDesc {
     pub group: Option<u32>,
 }
 
+impl Default for ControlDesc {
+    fn default() -> Self {
+        Self {
+            placement: random(),
+            spacing: None,
+            bone_weights: eq8(),
+            pressure: DEFAULT_PRESSURE,
+            radius: None,
+            adaptive: off(),
+            velocity: 0.0,
+            group: None,
+        }
+    }
+}
+
 impl ControlDesc {
     /// This target with the control switches applied.
     pub fn with_switches(&self, sw: &Switches) -> Self {

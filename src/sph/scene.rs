@@ -142,7 +142,14 @@ impl Particles {
     }
 }
 
-pub const BUILT_IN: &[&str] = &["demo", "dam-break", "drop", "resting-block", "walker"];
+pub const BUILT_IN: &[&str] = &[
+    "demo",
+    "dam-break",
+    "drop",
+    "resting-block",
+    "walker",
+    "character",
+];
 
 /// Kelager's water with a Tait equation of state stiff enough for < 1% compression in
 /// a metre of water (c = 40 m/s), dt = 4e-4 s (CFL 0.35), 10 steps per frame.
@@ -273,6 +280,55 @@ impl Scene {
                 look: Look::default(),
                 character: None,
                 control: None,
+            },
+            // A liquid character: a pool rises into the built-in walker (control particles,
+            // adaptive pressure) and follows its walk at half speed.
+            "character" => Scene {
+                name: name.into(),
+                domain: Domain {
+                    min: [-0.45, 0.0, -0.3],
+                    max: [0.45, 1.2, 0.3],
+                },
+                fluid: FluidParams {
+                    sound_speed: 20.0,
+                    dt: 9e-4,
+                    substeps: 12,
+                    ..stiff_water()
+                },
+                blocks: vec![Block {
+                    min: [-0.45, 0.0, -0.3],
+                    max: [0.45, 0.1, 0.3],
+                    group: 0,
+                    color: blue,
+                    velocity: [0.0; 3],
+                }],
+                balls: vec![],
+                colliders: vec![],
+                camera: Some(CameraDesc {
+                    eye: [0.0, 0.75, 2.3],
+                    target: [0.0, 0.5, 0.0],
+                    fov: 40.0,
+                }),
+                frames: 150,
+                look: Look {
+                    material: Some(crate::config::Material::Tinted),
+                    size: Some([240, 240]),
+                    tank: Some(false),
+                },
+                character: Some(crate::scene::character::CharacterDesc {
+                    file: "builtin:walker".into(),
+                    animation: None,
+                    looping: true,
+                    height: Some(1.0),
+                    scale: None,
+                    position: [0.0; 3],
+                    rotation: [0.0; 3],
+                    speed: 0.5,
+                }),
+                control: Some(crate::control::target::ControlDesc {
+                    adaptive: crate::config::Adaptive::On,
+                    ..crate::control::target::ControlDesc::default()
+                }),
             },
             // The built-in character alone, walking in place: two cycles at 30 fps.
             "walker" => Scene {
