@@ -162,7 +162,7 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
     for (args, needle) in [
         (
             vec!["run", "--frames", "1", "--out", d, "--placement", "random"],
-            "--placement is not implemented yet",
+            "--placement does not apply to SPH scenes drawn as metaballs: it is used by scenes with a [control] target",
         ),
         (
             vec![
