@@ -143,6 +143,21 @@ enum BenchWhat {
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
         vertices: Option<u32>,
     },
+    /// How fast a control target fills per --adaptive mode (all three when unset): the
+    /// built-in giraffe (or --scene) for --frames frames (the cap); time to 90% coverage
+    Control {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        control: fluidform::config::ControlArgs,
+        #[command(flatten)]
+        character: CharacterArgs,
+        #[command(flatten)]
+        fluid_args: FluidArgs,
+        /// Scene with a [control] target (built-in name or TOML file; default giraffe)
+        #[arg(long)]
+        scene: Option<String>,
+    },
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
         #[command(flatten)]
@@ -202,6 +217,22 @@ impl BenchWhat {
                     file,
                     vertices,
                 )
+            }
+            BenchWhat::Control {
+                common,
+                control,
+                character,
+                fluid_args,
+                scene,
+            } => {
+                let sw = Switches {
+                    common,
+                    control,
+                    character,
+                    fluid_args,
+                    ..d()
+                };
+                return ("control", sw, scene, None);
             }
             BenchWhat::Scan { common } => ("scan", Switches { common, ..d() }),
             BenchWhat::Sort { common, sorting } => (

@@ -282,3 +282,41 @@ fn read_ply(p: &Path) -> Vec<(u32, [f32; 3])> {
         })
         .collect()
 }
+
+#[test]
+fn bench_control_reports_every_adaptive_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_fluidform"))
+        .args([
+            "bench",
+            "control",
+            "--frames",
+            "3",
+            "--quiet",
+            "--validation",
+            "--scene",
+            "character",
+        ])
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let t = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{t}");
+    let md = std::fs::read_to_string(dir.path().join("sweep.md")).unwrap();
+    for v in [
+        "adaptive-off",
+        "adaptive-on",
+        "adaptive-smooth",
+        "time to 90% s",
+        "final coverage",
+    ] {
+        assert!(md.contains(v), "{v} missing from {md}");
+    }
+    // Three frames never reach 90%: reported, not invented.
+    assert!(md.contains("not in"), "{md}");
+}

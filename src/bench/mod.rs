@@ -1,6 +1,7 @@
 //! `fluidform bench <what>`: warm-up, timed repetitions, per-pass GPU ms in the output
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
+pub mod control;
 pub mod plot;
 pub mod primitives;
 pub mod render;
@@ -25,7 +26,8 @@ pub struct BenchOptions {
     /// (at least 3), and the table reports how many each had.
     pub budget_s: f64,
     pub switches: Switches,
-    /// bench skin: the character file (default builtin:walker).
+    /// bench skin: the character file (default builtin:walker); bench control: the scene
+    /// (default giraffe).
     pub character: Option<String>,
     /// bench skin: vertices of the generated mesh (default 1M).
     pub vertices: Option<u32>,
@@ -57,6 +59,7 @@ pub const WHATS: &[&str] = &[
     "stability",
     "render",
     "skin",
+    "control",
 ];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
@@ -122,6 +125,13 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         "skin" => {
             sw.reject_unused("bench skin", &[Group::Character])?;
             skin::skin(&ctx, opts)?
+        }
+        "control" => {
+            sw.reject_unused(
+                "bench control",
+                &[Group::Control, Group::Character, Group::Fluid],
+            )?;
+            control::control(opts)?
         }
         other => {
             return Err(Error::Param(format!(

@@ -149,6 +149,7 @@ pub const BUILT_IN: &[&str] = &[
     "resting-block",
     "walker",
     "character",
+    "giraffe",
 ];
 
 /// Kelager's water with a Tait equation of state stiff enough for < 1% compression in
@@ -162,6 +163,19 @@ fn stiff_water() -> FluidParams {
         substeps: 10,
         restitution: 0.1,
         friction: 0.05,
+        ..FluidParams::default()
+    }
+}
+
+/// Water for pools under control targets: Tait with c = 20 m/s, 12 steps of 0.9 ms a
+/// frame, the default walls (no friction, so the pool slides freely to the target).
+fn pool_water() -> FluidParams {
+    FluidParams {
+        eos: Eos::Tait,
+        sound_speed: 20.0,
+        clamp_negative_pressure: true,
+        dt: 9e-4,
+        substeps: 12,
         ..FluidParams::default()
     }
 }
@@ -289,12 +303,7 @@ impl Scene {
                     min: [-0.45, 0.0, -0.3],
                     max: [0.45, 1.2, 0.3],
                 },
-                fluid: FluidParams {
-                    sound_speed: 20.0,
-                    dt: 9e-4,
-                    substeps: 12,
-                    ..stiff_water()
-                },
+                fluid: pool_water(),
                 blocks: vec![Block {
                     min: [-0.45, 0.0, -0.3],
                     max: [0.45, 0.1, 0.3],
@@ -324,6 +333,50 @@ impl Scene {
                     position: [0.0; 3],
                     rotation: [0.0; 3],
                     speed: 0.5,
+                }),
+                control: Some(crate::control::target::ControlDesc {
+                    adaptive: crate::config::Adaptive::On,
+                    ..crate::control::target::ControlDesc::default()
+                }),
+            },
+            // The built-in long-necked shape (neck 2.5 rest spacings thick) filled from a
+            // pool: the adaptive-pressure test (compare --adaptive off|on|smooth).
+            "giraffe" => Scene {
+                name: name.into(),
+                domain: Domain {
+                    min: [-0.4, 0.0, -0.25],
+                    max: [0.6, 1.2, 0.25],
+                },
+                fluid: pool_water(),
+                blocks: vec![Block {
+                    min: [-0.4, 0.0, -0.25],
+                    max: [0.6, 0.08, 0.25],
+                    group: 0,
+                    color: blue,
+                    velocity: [0.0; 3],
+                }],
+                balls: vec![],
+                colliders: vec![],
+                camera: Some(CameraDesc {
+                    eye: [0.1, 0.7, 2.4],
+                    target: [0.1, 0.5, 0.0],
+                    fov: 40.0,
+                }),
+                frames: 600,
+                look: Look {
+                    size: Some([240, 240]),
+                    tank: Some(false),
+                    ..Look::default()
+                },
+                character: Some(crate::scene::character::CharacterDesc {
+                    file: "builtin:giraffe".into(),
+                    animation: None,
+                    looping: true,
+                    height: None,
+                    scale: None,
+                    position: [0.0; 3],
+                    rotation: [0.0; 3],
+                    speed: 1.0,
                 }),
                 control: Some(crate::control::target::ControlDesc {
                     adaptive: crate::config::Adaptive::On,
