@@ -1,22 +1,11 @@
 //! Characters on ../shared/assets: loading, mesh checks, clip sampling, the CPU skinning
 //! reference against hand-computed values, built-in shapes, and bad input.
+mod common;
+use common::asset;
 use fluidform::character::anim::{clip_time, slerp};
 use fluidform::character::{self, Channel, Character, Clip, Interp, Property};
 use fluidform::config::Skinning;
 use glam::{Mat4, Quat, Vec3, Vec4};
-use std::path::PathBuf;
-
-pub fn asset(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets")
-        .join(name);
-    assert!(
-        p.exists(),
-        "test asset {} is missing (CI has ../shared/assets)",
-        p.display()
-    );
-    p.display().to_string()
-}
 
 fn load(name: &str) -> Character {
     character::load(&asset(name)).unwrap_or_else(|e| panic!("{name}: {e}"))

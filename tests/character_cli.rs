@@ -1,5 +1,7 @@
 //! Characters from the command line: inspect, a character alone, a character with fluid
 //! (both views), --show-mesh and --skinning, and one-line errors for bad scenes.
+mod common;
+use common::asset;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -16,18 +18,6 @@ fn text(o: &Output) -> String {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     )
-}
-
-fn asset(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets")
-        .join(name);
-    assert!(
-        p.exists(),
-        "test asset {} is missing (CI has ../shared/assets)",
-        p.display()
-    );
-    p.display().to_string()
 }
 
 fn scene(name: &str) -> String {

@@ -1,5 +1,7 @@
 //! Control particles: inside tests against the generalized winding number, placement
 //! uniformity against the lattice, binding weights (eq. 8, eq. 9, skin), bad input.
+mod common;
+use common::asset;
 use fluidform::character::{self, Character};
 use fluidform::config::{BoneWeights, Placement};
 use fluidform::control::binding::{self, pair_weights};
@@ -7,19 +9,6 @@ use fluidform::control::inside::{winding_number, InsideTest};
 use fluidform::control::placement;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use std::path::PathBuf;
-
-fn asset(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets")
-        .join(name);
-    assert!(
-        p.exists(),
-        "test asset {} is missing (CI has ../shared/assets)",
-        p.display()
-    );
-    p.display().to_string()
-}
 
 fn load(name: &str) -> Character {
     character::load(&asset(name)).unwrap()

@@ -122,28 +122,24 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
     let (h, hc, m) = (f.h as f64, settings.radius as f64, f.mass as f64);
     let group = |a: &[f32; 4]| a[3].to_bits();
     let controlled = |a: &[f32; 4]| settings.group == ALL_GROUPS || group(a) == settings.group;
-    // Control densities (as a multiset: the GPU holds them in control-grid order).
-    let mut want: Vec<f64> = mesh
+    let fluid: Vec<glam::DVec3> = d1
+        .pos
+        .iter()
+        .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+        .collect();
+    // Control densities in f64 (the GPU holds them in control-grid order: compared as a
+    // multiset).
+    let rho_ref: Vec<f64> = mesh
         .positions
         .iter()
         .map(|c| {
-            let c = c.as_dvec3();
-            (0..d1.pos.len())
+            (0..fluid.len())
                 .filter(|&i| controlled(&d1.attr[i]))
-                .map(|i| {
-                    m * poly6(
-                        (glam::DVec3::new(
-                            d1.pos[i][0] as f64,
-                            d1.pos[i][1] as f64,
-                            d1.pos[i][2] as f64,
-                        ) - c)
-                            .length_squared(),
-                        h,
-                    )
-                })
+                .map(|i| m * poly6((fluid[i] - c.as_dvec3()).length_squared(), h))
                 .sum()
         })
         .collect();
+    let mut want = rho_ref.clone();
     let mut got: Vec<f64> = crho.iter().map(|&x| x as f64).collect();
     want.sort_by(f64::total_cmp);
     got.sort_by(f64::total_cmp);
@@ -174,31 +170,10 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
     let spiky = -45.0 / (std::f64::consts::PI * hc.powi(6));
     let (mut err, mut scale, mut touched) = (0.0f64, 0.0f64, 0);
     let mut rows = Vec::new();
-    for i in 0..d1.pos.len() {
-        let x = glam::DVec3::new(
-            d1.pos[i][0] as f64,
-            d1.pos[i][1] as f64,
-            d1.pos[i][2] as f64,
-        );
+    for (i, &x) in fluid.iter().enumerate() {
         let mut fsum = glam::DVec3::ZERO;
         if controlled(&d1.attr[i]) {
-            for (c, rho_j) in mesh.positions.iter().zip(mesh.positions.iter().map(|c| {
-                let c = c.as_dvec3();
-                (0..d1.pos.len())
-                    .filter(|&k| controlled(&d1.attr[k]))
-                    .map(|k| {
-                        m * poly6(
-                            (glam::DVec3::new(
-                                d1.pos[k][0] as f64,
-                                d1.pos[k][1] as f64,
-                                d1.pos[k][2] as f64,
-                            ) - c)
-                                .length_squared(),
-                            h,
-                        )
-                    })
-                    .sum::<f64>()
-            })) {
+            for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
                 let d = x - c.as_dvec3();
                 let r = d.length();
                 if r < hc && r > 0.0 {

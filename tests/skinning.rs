@@ -1,25 +1,13 @@
 //! GPU skinning (LBS and DQS) against the CPU reference, on CesiumMan at three times and
 //! on a mesh with eight influences per vertex.
 mod common;
+use common::asset;
 use fluidform::character::skin::Skinner;
 use fluidform::character::{self, Animator, Character};
 use fluidform::config::Skinning;
 use fluidform::gpu::{sync, Context};
 use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};
-use std::path::PathBuf;
-
-fn asset(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets")
-        .join(name);
-    assert!(
-        p.exists(),
-        "test asset {} is missing (CI has ../shared/assets)",
-        p.display()
-    );
-    p.display().to_string()
-}
 
 /// Skin on the GPU; the largest position error relative to the mesh size, and the largest
 /// normal error, against the CPU reference.

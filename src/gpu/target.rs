@@ -164,23 +164,7 @@ impl ColorTarget {
             ),
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
-        let region = vk::BufferImageCopy {
-            buffer_offset: 0,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D {
-                width: self.width(),
-                height: self.height(),
-                depth: 1,
-            },
-        };
+        let region = self.region(vk::ImageAspectFlags::COLOR, 0);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,
@@ -197,6 +181,27 @@ impl ColorTarget {
             .dst_access_mask(A::HOST_READ)];
         let dep = vk::DependencyInfo::default().memory_barriers(&b);
         unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    /// The whole image's `aspect`, tightly packed at byte `offset` of a buffer.
+    fn region(&self, aspect: vk::ImageAspectFlags, offset: u64) -> vk::BufferImageCopy {
+        vk::BufferImageCopy {
+            buffer_offset: offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: aspect,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: self.width(),
+                height: self.height(),
+                depth: 1,
+            },
+        }
     }
 
     /// Copy the colour (RGBA8) to `dst` at byte `color_at` and the depth (f32) at
@@ -234,23 +239,7 @@ impl ColorTarget {
             ),
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
-        let region = |aspect, offset| vk::BufferImageCopy {
-            buffer_offset: offset,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: aspect,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D {
-                width: self.width(),
-                height: self.height(),
-                depth: 1,
-            },
-        };
+        let region = |aspect, offset| self.region(aspect, offset);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,

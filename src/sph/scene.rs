@@ -180,6 +180,58 @@ fn pool_water() -> FluidParams {
     }
 }
 
+/// A pool `depth` deep on the floor of the box [lo, hi] under a built-in shape standing at
+/// the origin, pulled in by control particles with adaptive pressure; seen from the front
+/// (camera x and distance `view`), 240 x 240.
+fn liquid(
+    name: &str,
+    (lo, hi): ([f32; 3], [f32; 3]),
+    depth: f32,
+    shape: &str,
+    speed: f32,
+    view: [f32; 2],
+) -> Scene {
+    Scene {
+        name: name.into(),
+        domain: Domain { min: lo, max: hi },
+        fluid: pool_water(),
+        blocks: vec![Block {
+            min: lo,
+            max: [hi[0], depth, hi[2]],
+            group: 0,
+            color: [0.2, 0.45, 1.0],
+            velocity: [0.0; 3],
+        }],
+        balls: vec![],
+        colliders: vec![],
+        camera: Some(CameraDesc {
+            eye: [view[0], 0.75, view[1]],
+            target: [view[0], 0.5, 0.0],
+            fov: 40.0,
+        }),
+        frames: 150,
+        look: Look {
+            size: Some([240, 240]),
+            tank: Some(false),
+            ..Look::default()
+        },
+        character: Some(crate::scene::character::CharacterDesc {
+            file: shape.into(),
+            animation: None,
+            looping: true,
+            height: None,
+            scale: None,
+            position: [0.0; 3],
+            rotation: [0.0; 3],
+            speed,
+        }),
+        control: Some(crate::control::target::ControlDesc {
+            adaptive: crate::config::Adaptive::On,
+            ..crate::control::target::ControlDesc::default()
+        }),
+    }
+}
+
 /// A water column of size `column` at the origin released in a tank of size `tank`, seen
 /// from the front at height and distance `view`, 600 frames of stiff water.
 fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Scene {
@@ -298,90 +350,32 @@ impl Scene {
             // A liquid character: a pool rises into the built-in walker (control particles,
             // adaptive pressure) and follows its walk at half speed.
             "character" => Scene {
-                name: name.into(),
-                domain: Domain {
-                    min: [-0.45, 0.0, -0.3],
-                    max: [0.45, 1.2, 0.3],
-                },
-                fluid: pool_water(),
-                blocks: vec![Block {
-                    min: [-0.45, 0.0, -0.3],
-                    max: [0.45, 0.1, 0.3],
-                    group: 0,
-                    color: blue,
-                    velocity: [0.0; 3],
-                }],
-                balls: vec![],
-                colliders: vec![],
-                camera: Some(CameraDesc {
-                    eye: [0.0, 0.75, 2.3],
-                    target: [0.0, 0.5, 0.0],
-                    fov: 40.0,
-                }),
                 frames: 150,
                 look: Look {
                     material: Some(crate::config::Material::Tinted),
-                    size: Some([240, 240]),
-                    tank: Some(false),
+                    ..Look::default()
                 },
-                character: Some(crate::scene::character::CharacterDesc {
-                    file: "builtin:walker".into(),
-                    animation: None,
-                    looping: true,
-                    height: Some(1.0),
-                    scale: None,
-                    position: [0.0; 3],
-                    rotation: [0.0; 3],
-                    speed: 0.5,
-                }),
-                control: Some(crate::control::target::ControlDesc {
-                    adaptive: crate::config::Adaptive::On,
-                    ..crate::control::target::ControlDesc::default()
-                }),
+                ..liquid(
+                    name,
+                    ([-0.45, 0.0, -0.3], [0.45, 1.2, 0.3]),
+                    0.1,
+                    "builtin:walker",
+                    0.5,
+                    [0.0, 2.3],
+                )
             },
             // The built-in long-necked shape (neck 2.5 rest spacings thick) filled from a
             // pool: the adaptive-pressure test (compare --adaptive off|on|smooth).
             "giraffe" => Scene {
-                name: name.into(),
-                domain: Domain {
-                    min: [-0.4, 0.0, -0.25],
-                    max: [0.6, 1.2, 0.25],
-                },
-                fluid: pool_water(),
-                blocks: vec![Block {
-                    min: [-0.4, 0.0, -0.25],
-                    max: [0.6, 0.08, 0.25],
-                    group: 0,
-                    color: blue,
-                    velocity: [0.0; 3],
-                }],
-                balls: vec![],
-                colliders: vec![],
-                camera: Some(CameraDesc {
-                    eye: [0.1, 0.7, 2.4],
-                    target: [0.1, 0.5, 0.0],
-                    fov: 40.0,
-                }),
                 frames: 600,
-                look: Look {
-                    size: Some([240, 240]),
-                    tank: Some(false),
-                    ..Look::default()
-                },
-                character: Some(crate::scene::character::CharacterDesc {
-                    file: "builtin:giraffe".into(),
-                    animation: None,
-                    looping: true,
-                    height: None,
-                    scale: None,
-                    position: [0.0; 3],
-                    rotation: [0.0; 3],
-                    speed: 1.0,
-                }),
-                control: Some(crate::control::target::ControlDesc {
-                    adaptive: crate::config::Adaptive::On,
-                    ..crate::control::target::ControlDesc::default()
-                }),
+                ..liquid(
+                    name,
+                    ([-0.4, 0.0, -0.25], [0.6, 1.2, 0.25]),
+                    0.08,
+                    "builtin:giraffe",
+                    1.0,
+                    [0.1, 2.4],
+                )
             },
             // The built-in character alone, walking in place: two cycles at 30 fps.
             "walker" => Scene {

@@ -27,6 +27,19 @@ pub fn finish(ctx: &Context) {
     );
 }
 
+/// A file of ../shared/assets (CI has it; a missing one fails the test, never skips it).
+pub fn asset(name: &str) -> String {
+    let p = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets")
+        .join(name);
+    assert!(
+        p.exists(),
+        "test asset {} is missing (CI has ../shared/assets)",
+        p.display()
+    );
+    p.display().to_string()
+}
+
 /// Seeded pseudo-random u32s.
 pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
     use rand::{Rng, SeedableRng};
