@@ -353,7 +353,8 @@ impl Scene {
                 frames: 150,
                 look: Look {
                     material: Some(crate::config::Material::Tinted),
-                    ..Look::default()
+                    size: Some([240, 240]),
+                    tank: Some(false),
                 },
                 ..liquid(
                     name,
