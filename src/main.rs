@@ -36,7 +36,8 @@ enum Command {
     },
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
-        /// Built-in scene (dam-break, drop, resting-block, orbits) or a TOML scene file
+        /// Built-in scene (character, demo, dam-break, drop, resting-block, walker, giraffe,
+        /// orbits) or a TOML scene file
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: String,
         /// Frames to play (default: the scene's own count)
@@ -341,8 +342,12 @@ fn real_main() -> Result<()> {
                 0 => String::new(),
                 k => format!(", {k} particle files and particles.csv"),
             };
+            let control = match out.join("control.csv").exists() {
+                true => ", control.csv",
+                false => "",
+            };
             println!(
-                "wrote {} frame PNGs{anim}{exports}, timings.csv and summary.json to {}",
+                "wrote {} frame PNGs{anim}{exports}{control}, timings.csv and summary.json to {}",
                 r.pngs.len(),
                 out.display()
             );

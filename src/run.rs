@@ -29,7 +29,7 @@ pub struct RunOptions {
     pub switches: Switches,
 }
 
-pub const DEFAULT_SCENE: &str = "demo";
+pub const DEFAULT_SCENE: &str = "character";
 
 /// `config` of a run's summary.json.
 #[derive(Clone, Debug, Serialize, Deserialize)]
