@@ -342,9 +342,9 @@ fn real_main() -> Result<()> {
                 0 => String::new(),
                 k => format!(", {k} particle files and particles.csv"),
             };
-            let control = match out.join("control.csv").exists() {
-                true => ", control.csv",
-                false => "",
+            let control = match &r.summary.stats {
+                fluidform::run::RunStats::Sph(s) if s.control.is_some() => ", control.csv",
+                _ => "",
             };
             println!(
                 "wrote {} frame PNGs{anim}{exports}{control}, timings.csv and summary.json to {}",
