@@ -161,7 +161,7 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
     let d = dir.path().to_str().unwrap();
     for (args, needle) in [
         (
-            vec!["run", "--frames", "1", "--out", d, "--placement", "random"],
+            vec!["run", "--scene", "demo", "--frames", "1", "--out", d, "--placement", "random"],
             "--placement does not apply to SPH scenes drawn as metaballs: it is used by scenes with a [control] target",
         ),
         (
