@@ -230,6 +230,30 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
             .count(),
         4
     );
+    // --particles scales the scene, the character with it.
+    let big = dir.path().join("big");
+    let o = Command::new(bin)
+        .args([
+            "run",
+            "--scene",
+            "character",
+            "--frames",
+            "1",
+            "--render",
+            "points",
+            "--particles",
+            "6000",
+            "--quiet",
+        ])
+        .arg("--out")
+        .arg(&big)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(big.join("summary.json")).unwrap()).unwrap();
+    let h = s["stats"]["character"]["height"].as_f64().unwrap();
+    assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
     let fails: [(&[&str], &str); 4] = [
         (
             &["--scene", "character", "--placement", "rays"],

@@ -554,6 +554,15 @@ impl Scene {
             c.eye = m(c.eye);
             c.target = m(c.target);
         }
+        // The character grows with the scene (its placement about the origin too).
+        if let Some(c) = &mut out.character {
+            c.position = m(c.position);
+            match (c.height, c.scale) {
+                (Some(h), _) => c.height = Some(h * s),
+                (_, Some(k)) => c.scale = Some(k * s),
+                _ => c.scale = Some(s),
+            }
+        }
         out
     }
 
