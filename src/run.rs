@@ -228,35 +228,15 @@ fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     work.destroy(&ctx);
     let timings = timings?;
-    let animation = work.frames.finish()?;
-    let config = RunConfig {
-        command: "run".into(),
-        scene: opts.scene.clone(),
-        frames: frame_count,
-        save_every: opts.save_every,
-        particles: particles as u64,
-        neighbors: None,
-        sort: None,
-        render: None,
-        fluid: None,
-        switches: sw.clone(),
-    };
-    let report = Report {
-        device: &ctx.info,
-        config,
-        timings: &timings,
-        memory,
-        stats: RunStats::Orbits(OrbitsStats { particles }),
-        validation: sw.common.validation.then(|| ctx.validation_counts()),
-    };
-    let summary = report.write(&opts.out)?;
-    check_validation(&ctx)?;
-    Ok(RunResult {
-        summary,
-        pngs: work.frames.pngs,
-        animation,
-        exports: Vec::new(),
-    })
+    finish_fluidless(
+        &ctx,
+        opts,
+        sw,
+        (&opts.scene, frame_count, particles as u64),
+        (&timings, memory),
+        RunStats::Orbits(OrbitsStats { particles }),
+        work.frames,
+    )
 }
 
 /// An SPH scene: steps per frame and the view.
@@ -673,13 +653,42 @@ fn run_character(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResul
     work.character.destroy(&ctx);
     work.view.destroy(&ctx);
     let timings = timings?;
-    let animation = work.frames.finish()?;
+    let stats = RunStats::Character(Box::new(CharacterRunStats {
+        character: stats?,
+        render,
+    }));
+    finish_fluidless(
+        &ctx,
+        opts,
+        sw,
+        (&scene.name, frame_count, 0),
+        (&timings, memory),
+        stats,
+        work.frames,
+    )
+}
+
+/// The end of a run without fluid (orbits, a character alone): the animation closed,
+/// summary.json written, validation checked.
+fn finish_fluidless(
+    ctx: &Context,
+    opts: &RunOptions,
+    sw: &Switches,
+    (scene, frames, particles): (&str, u64, u64),
+    (timings, memory): (
+        &[crate::gpu::FrameTiming],
+        std::collections::BTreeMap<String, u64>,
+    ),
+    stats: RunStats,
+    mut saved: Frames,
+) -> Result<RunResult> {
+    let animation = saved.finish()?;
     let config = RunConfig {
         command: "run".into(),
-        scene: scene.name.clone(),
-        frames: frame_count,
+        scene: scene.to_string(),
+        frames,
         save_every: opts.save_every,
-        particles: 0,
+        particles,
         neighbors: None,
         sort: None,
         render: None,
@@ -689,19 +698,16 @@ fn run_character(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResul
     let report = Report {
         device: &ctx.info,
         config,
-        timings: &timings,
+        timings,
         memory,
-        stats: RunStats::Character(Box::new(CharacterRunStats {
-            character: stats?,
-            render,
-        })),
+        stats,
         validation: sw.common.validation.then(|| ctx.validation_counts()),
     };
     let summary = report.write(&opts.out)?;
-    check_validation(&ctx)?;
+    check_validation(ctx)?;
     Ok(RunResult {
         summary,
-        pngs: work.frames.pngs,
+        pngs: saved.pngs,
         animation,
         exports: Vec::new(),
     })

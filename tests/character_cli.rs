@@ -1,24 +1,8 @@
 //! Characters from the command line: inspect, a character alone, a character with fluid
 //! (both views), --show-mesh and --skinning, and one-line errors for bad scenes.
 mod common;
-use common::asset;
+use common::{asset, fluidform, summary, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn fluidform(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fluidform"))
-        .args(args)
-        .output()
-        .expect("spawn fluidform")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 fn scene(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -26,15 +10,6 @@ fn scene(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-/// summary.json, also read back typed (the whole schema must parse).
-fn summary(out: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
-    let typed: fluidform::run::RunSummary =
-        serde_json::from_str(&text).unwrap_or_else(|e| panic!("typed summary: {e}\n{text}"));
-    assert_eq!(typed.frames as u64, typed.config.frames);
-    serde_json::from_str(&text).unwrap()
 }
 
 /// Pixels of a PNG that `pred` accepts, as a fraction.

@@ -1,20 +1,6 @@
 //! The command line end to end: devices, run, and clear errors with non-zero exits.
-use std::process::{Command, Output};
-
-fn fluidform(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fluidform"))
-        .args(args)
-        .output()
-        .expect("spawn fluidform")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+mod common;
+use common::{fluidform, summary, text};
 
 #[test]
 fn devices_lists_lavapipe_with_features() {
@@ -263,15 +249,6 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
         assert!(t.contains(needle), "{args:?}: {t}");
         assert!(!t.contains("panicked"), "{args:?}: {t}");
     }
-}
-
-/// The run's summary.json, also read back typed (the whole schema must parse).
-fn summary(dir: &std::path::Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
-    let typed: fluidform::run::RunSummary =
-        serde_json::from_str(&text).unwrap_or_else(|e| panic!("typed summary: {e}\n{text}"));
-    assert_eq!(typed.frames as u64, typed.config.frames);
-    serde_json::from_str(&text).unwrap()
 }
 
 /// `run` with `args`, no frames saved, validation on, into `dir`: must succeed; the summary.

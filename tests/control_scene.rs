@@ -3,7 +3,8 @@
 //! with validation, and bad control input is a clear error.
 use fluidform::run::{run, RunOptions, RunStats};
 use std::path::Path;
-use std::process::Command;
+mod common;
+use common::{fluidform, summary, text};
 
 /// A pool (group 0) under a capsule target, and a second pool (group 1) far to the side
 /// (0.7 m: the first pool's spreading does not reach it in the tests' times).
@@ -191,30 +192,23 @@ fn group_only_control_leaves_the_other_group_alone() {
 fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("c");
-    let bin = env!("CARGO_BIN_EXE_fluidform");
-    let o = Command::new(bin)
-        .args([
-            "run",
-            "--scene",
-            "character",
-            "--frames",
-            "3",
-            "--width",
-            "64",
-            "--height",
-            "64",
-            "--quiet",
-            "--validation",
-        ])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let t = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let out_s = out.to_str().unwrap();
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        "character",
+        "--frames",
+        "3",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--quiet",
+        "--validation",
+        "--out",
+        out_s,
+    ]);
+    let t = text(&o);
     assert!(o.status.success(), "{t}");
     for scope in [
         "sph/control/skin",
@@ -232,26 +226,22 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     );
     // --particles scales the scene, the character with it.
     let big = dir.path().join("big");
-    let o = Command::new(bin)
-        .args([
-            "run",
-            "--scene",
-            "character",
-            "--frames",
-            "1",
-            "--render",
-            "points",
-            "--particles",
-            "6000",
-            "--quiet",
-        ])
-        .arg("--out")
-        .arg(&big)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(big.join("summary.json")).unwrap()).unwrap();
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        "character",
+        "--frames",
+        "1",
+        "--render",
+        "points",
+        "--particles",
+        "6000",
+        "--quiet",
+        "--out",
+        big.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(&big);
     let h = s["stats"]["character"]["height"].as_f64().unwrap();
     assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
     let fails: [(&[&str], &str); 4] = [
@@ -273,14 +263,10 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
         ),
     ];
     for (args, needle) in fails {
-        let o = Command::new(bin)
-            .arg("run")
-            .args(args)
-            .args(["--frames", "1", "--quiet"])
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
+        let mut all = vec!["run"];
+        all.extend_from_slice(args);
+        all.extend(["--frames", "1", "--quiet", "--out", out_s]);
+        let o = fluidform(&all);
         let t = String::from_utf8_lossy(&o.stderr).to_string();
         assert_eq!(o.status.code(), Some(1), "{args:?}: {t}");
         assert!(
@@ -310,26 +296,19 @@ fn read_ply(p: &Path) -> Vec<(u32, [f32; 3])> {
 #[test]
 fn bench_control_reports_every_adaptive_mode() {
     let dir = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_fluidform"))
-        .args([
-            "bench",
-            "control",
-            "--frames",
-            "3",
-            "--quiet",
-            "--validation",
-            "--scene",
-            "character",
-        ])
-        .arg("--out")
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    let t = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let o = fluidform(&[
+        "bench",
+        "control",
+        "--frames",
+        "3",
+        "--quiet",
+        "--validation",
+        "--scene",
+        "character",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let t = text(&o);
     assert!(o.status.success(), "{t}");
     let md = std::fs::read_to_string(dir.path().join("sweep.md")).unwrap();
     for v in [

@@ -381,14 +381,6 @@ impl ControlForce {
         }
     }
 
-    /// Skinned control positions of the last pose (unsorted), after the frame's fence.
-    pub fn positions(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
-        match &*self.gpu.borrow() {
-            Some(g) => ctx.readback(&g.mesh.pos, 0, self.m as usize),
-            None => Err(Error::Param("the control set is destroyed".into())),
-        }
-    }
-
     pub fn destroy(&self, ctx: &Context) {
         if let Some(mut g) = self.gpu.borrow_mut().take() {
             g.destroy(ctx);

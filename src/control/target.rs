@@ -106,8 +106,6 @@ pub struct ControlTarget {
     pub desc: ControlDesc,
     /// Placed rest-pose joint matrices (the bind of the control particles).
     rest_inv: Vec<Mat4>,
-    /// Control particles' rest positions.
-    pub rest: Vec<Vec3>,
 }
 
 impl ControlTarget {
@@ -156,7 +154,7 @@ impl ControlTarget {
         };
         let n = points.len();
         let mesh = Mesh {
-            positions: points.clone(),
+            positions: points,
             normals: vec![Vec3::ZERO; n],
             uvs: Vec::new(),
             indices: Vec::new(),
@@ -193,7 +191,6 @@ impl ControlTarget {
             force,
             desc: desc.clone(),
             rest_inv,
-            rest: points,
         })
     }
 

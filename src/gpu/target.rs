@@ -149,8 +149,8 @@ impl ColorTarget {
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
 
-    /// Copy the colour image into this slot's readback buffer (after rendering).
-    pub fn copy_out(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
+    /// The colour image into `dst` at byte `offset`, after rendering.
+    fn copy_color(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: vk::Buffer, offset: u64) {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
         image_barrier(
             ctx,
@@ -164,16 +164,22 @@ impl ColorTarget {
             ),
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
-        let region = self.region(vk::ImageAspectFlags::COLOR, 0);
+        let region = self.region(vk::ImageAspectFlags::COLOR, offset);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,
                 self.color.raw,
                 L::TRANSFER_SRC_OPTIMAL,
-                self.readbacks[slot].raw,
+                dst,
                 &[region],
             )
         };
+    }
+
+    /// Copy the colour image into this slot's readback buffer (after rendering).
+    pub fn copy_out(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
+        use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
+        self.copy_color(ctx, cmd, self.readbacks[slot].raw, 0);
         let b = [vk::MemoryBarrier2::default()
             .src_stage_mask(S::COPY)
             .src_access_mask(A::TRANSFER_WRITE)
@@ -215,18 +221,7 @@ impl ColorTarget {
         depth_at: u64,
     ) {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
-        image_barrier(
-            ctx,
-            cmd,
-            self.color.raw,
-            vk::ImageAspectFlags::COLOR,
-            (
-                S::COLOR_ATTACHMENT_OUTPUT,
-                A::COLOR_ATTACHMENT_WRITE,
-                L::COLOR_ATTACHMENT_OPTIMAL,
-            ),
-            (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
-        );
+        self.copy_color(ctx, cmd, dst.raw, color_at);
         image_barrier(
             ctx,
             cmd,
@@ -239,21 +234,14 @@ impl ColorTarget {
             ),
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
-        let region = |aspect, offset| self.region(aspect, offset);
+        let region = self.region(vk::ImageAspectFlags::DEPTH, depth_at);
         unsafe {
-            ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                self.color.raw,
-                L::TRANSFER_SRC_OPTIMAL,
-                dst.raw,
-                &[region(vk::ImageAspectFlags::COLOR, color_at)],
-            );
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,
                 self.depth.raw,
                 L::TRANSFER_SRC_OPTIMAL,
                 dst.raw,
-                &[region(vk::ImageAspectFlags::DEPTH, depth_at)],
+                &[region],
             );
         }
     }

@@ -46,6 +46,20 @@ pub struct CharacterDesc {
 }
 
 impl CharacterDesc {
+    /// `file` at its own size at the origin, its first clip looping at its own rate.
+    pub fn new(file: &str) -> Self {
+        Self {
+            file: file.into(),
+            animation: None,
+            looping: true,
+            height: None,
+            scale: None,
+            position: [0.0; 3],
+            rotation: [0.0; 3],
+            speed: 1.0,
+        }
+    }
+
     pub fn validate(&self, scene: &str) -> Result<()> {
         let bad = |m: String| Err(Error::Param(format!("scene {scene}: character {m}")));
         if self.height.is_some() && self.scale.is_some() {

@@ -216,14 +216,8 @@ fn liquid(
             ..Look::default()
         },
         character: Some(crate::scene::character::CharacterDesc {
-            file: shape.into(),
-            animation: None,
-            looping: true,
-            height: None,
-            scale: None,
-            position: [0.0; 3],
-            rotation: [0.0; 3],
             speed,
+            ..crate::scene::character::CharacterDesc::new(shape)
         }),
         control: Some(crate::control::target::ControlDesc {
             adaptive: crate::config::Adaptive::On,
@@ -399,16 +393,9 @@ impl Scene {
                     size: Some([320, 320]),
                     ..Look::default()
                 },
-                character: Some(crate::scene::character::CharacterDesc {
-                    file: "builtin:walker".into(),
-                    animation: None,
-                    looping: true,
-                    height: None,
-                    scale: None,
-                    position: [0.0; 3],
-                    rotation: [0.0; 3],
-                    speed: 1.0,
-                }),
+                character: Some(crate::scene::character::CharacterDesc::new(
+                    "builtin:walker",
+                )),
                 control: None,
             },
             _ => return None,

@@ -40,6 +40,32 @@ pub fn asset(name: &str) -> String {
     p.display().to_string()
 }
 
+/// The fluidform binary run with `args`.
+pub fn fluidform(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_fluidform"))
+        .args(args)
+        .output()
+        .expect("spawn fluidform")
+}
+
+/// A command's stdout and stderr together.
+pub fn text(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The run's summary.json, also read back typed (the whole schema must parse).
+pub fn summary(dir: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let typed: fluidform::run::RunSummary =
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("typed summary: {e}\n{text}"));
+    assert_eq!(typed.frames as u64, typed.config.frames);
+    serde_json::from_str(&text).unwrap()
+}
+
 /// Seeded pseudo-random u32s.
 pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
     use rand::{Rng, SeedableRng};
