@@ -122,40 +122,35 @@ impl SkinnedMesh {
                 ws.push([w[0], w[1], w[2], w[3]]);
             }
         }
-        let mut g = Guard::new(ctx, Vec::new());
-        let mut make = |name: &str, size: u64| -> Result<usize> {
-            g.push(ctx.storage_buffer(name, size)?);
-            Ok(g.len() - 1)
-        };
+        // Each buffer guarded: a failure halfway releases the ones made before it.
+        let buf =
+            |name: &str, size: u64| ctx.storage_buffer(name, size).map(|b| Guard::new(ctx, b));
         let vb = n as u64 * 16;
-        let k_joints = make(
+        let joints = buf(
             "skin joints",
             (joint_count * std::mem::size_of::<GpuJoint>()) as u64,
         )?;
-        let k_rest = make("skin rest positions", vb)?;
-        let k_nrm = make("skin rest normals", vb)?;
-        let k_ids = make("skin joint ids", (n * sets * 8) as u64)?;
-        let k_w = make("skin weights", (n * sets * 16) as u64)?;
-        make("skinned positions", vb)?;
-        make("skinned normals", vb)?;
-        make("mesh indices", mesh.indices.len() as u64 * 4)?;
-        ctx.upload(&mut g[k_rest], 0, &pos)?;
-        ctx.upload(&mut g[k_nrm], 0, &nrm)?;
-        ctx.upload(&mut g[k_ids], 0, &ids)?;
-        ctx.upload(&mut g[k_w], 0, &ws)?;
-        ctx.upload(&mut g[7], 0, &mesh.indices)?;
-        let _ = k_joints;
-        let mut it = g.take().into_iter();
-        let mut next = || it.next().unwrap();
+        let mut rest_pos = buf("skin rest positions", vb)?;
+        let mut rest_nrm = buf("skin rest normals", vb)?;
+        let mut joint_ids = buf("skin joint ids", (n * sets * 8) as u64)?;
+        let mut weights = buf("skin weights", (n * sets * 16) as u64)?;
+        let out_pos = buf("skinned positions", vb)?;
+        let out_nrm = buf("skinned normals", vb)?;
+        let mut indices = buf("mesh indices", mesh.indices.len() as u64 * 4)?;
+        ctx.upload(&mut rest_pos, 0, &pos)?;
+        ctx.upload(&mut rest_nrm, 0, &nrm)?;
+        ctx.upload(&mut joint_ids, 0, &ids)?;
+        ctx.upload(&mut weights, 0, &ws)?;
+        ctx.upload(&mut indices, 0, &mesh.indices)?;
         Ok(Self {
-            joints: next(),
-            rest_pos: next(),
-            rest_nrm: next(),
-            joint_ids: next(),
-            weights: next(),
-            pos: next(),
-            nrm: next(),
-            indices: next(),
+            joints: joints.take(),
+            rest_pos: rest_pos.take(),
+            rest_nrm: rest_nrm.take(),
+            joint_ids: joint_ids.take(),
+            weights: weights.take(),
+            pos: out_pos.take(),
+            nrm: out_nrm.take(),
+            indices: indices.take(),
             vertices: n as u32,
             triangles: mesh.triangles() as u32,
             joint_count,
