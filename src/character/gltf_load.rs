@@ -86,6 +86,16 @@ fn check_primitive(path: &Path, what: &str, prim: &gltf::Primitive) -> Result<()
     Ok(())
 }
 
+fn check_joint_count(path: &Path, n: usize) -> Result<()> {
+    match n > MAX_JOINTS {
+        true => Err(err(
+            path,
+            format!("has {n} joints; at most {MAX_JOINTS} are supported"),
+        )),
+        false => Ok(()),
+    }
+}
+
 /// One primitive's vertices before merging.
 struct Part {
     positions: Vec<Vec3>,
@@ -223,15 +233,8 @@ pub fn load(path: &Path) -> Result<Character> {
                                 inverse_bind: ibm[j],
                             });
                         }
-                        if joints.len() > MAX_JOINTS {
-                            return Err(err(
-                                path,
-                                format!(
-                                    "has {} joints; at most {MAX_JOINTS} are supported",
-                                    joints.len()
-                                ),
-                            ));
-                        }
+                        // Before the skin's primitives are read, so the count is the error.
+                        check_joint_count(path, joints.len())?;
                         skin_offset.insert(skin.index(), o);
                         o
                     }
@@ -344,15 +347,8 @@ pub fn load(path: &Path) -> Result<Character> {
     if parts.is_empty() {
         return Err(err(path, "has no mesh in its scene"));
     }
-    if joints.len() > MAX_JOINTS {
-        return Err(err(
-            path,
-            format!(
-                "has {} joints; at most {MAX_JOINTS} are supported",
-                joints.len()
-            ),
-        ));
-    }
+    // Rigid mesh nodes add a joint each.
+    check_joint_count(path, joints.len())?;
     let clips = read_clips(path, doc, &buffers, &mut warnings)?;
     let skeleton = Skeleton {
         nodes,
