@@ -247,11 +247,7 @@ struct SphWork<'a> {
     view: Box<dyn crate::viewer::View>,
     frames: Frames<'a>,
     export: Option<crate::export::ParticleExport>,
-    character: Option<SceneCharacter>,
-    control: Option<crate::control::target::ControlTarget>,
-    metrics: Option<crate::control::metrics::ControlMetrics>,
-    /// Per slot: the target's placed joint matrices and the scene time of its frame.
-    poses: Vec<Option<(Vec<glam::Mat4>, f64)>>,
+    targets: crate::scene::targets::SceneTargets,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -263,24 +259,14 @@ impl FrameWork for SphWork<'_> {
         frame: u64,
         slot: usize,
     ) -> Result<()> {
-        if let (Some(c), Some(ch)) = (&self.control, &self.character) {
-            let time = self.stepper.sim_time;
-            let mats = ch
-                .anim
-                .joint_matrices(&ch.ch, (time * ch.speed as f64) as f32);
-            c.set_pose(&ch.ch, &mats, self.stepper.frame_time as f32)?;
-            self.poses[slot] = Some((mats, time));
-        }
+        let frame_dt = self.stepper.frame_time as f32;
+        self.targets
+            .record_poses(frame, self.stepper.sim_time, frame_dt, slot)?;
         self.stepper
             .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
-        if let (Some(m), Some(c)) = (&self.metrics, &self.control) {
-            prof.begin(ctx, cmd, "control-metrics");
-            m.record(ctx, cmd, &self.st, &c.force, slot)?;
-            prof.end(ctx, cmd);
-        }
-        if let Some(c) = &self.character {
-            c.record(ctx, cmd, prof, self.stepper.sim_time)?;
-        }
+        let t = self.stepper.sim_time;
+        self.targets
+            .record_after(ctx, cmd, prof, &self.st, t, slot)?;
         // The step's positions -> the view's copies and shaders.
         ctx.barrier(
             cmd,
@@ -292,7 +278,7 @@ impl FrameWork for SphWork<'_> {
         }
         let save = self.frames.save(frame);
         let st = &self.st;
-        let mesh = self.character.as_ref().and_then(|c| c.draw());
+        let mesh = self.targets.draw();
         self.view.record(
             ctx,
             cmd,
@@ -308,26 +294,7 @@ impl FrameWork for SphWork<'_> {
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         self.stepper.retire_slot(slot, frame)?;
-        if let (Some(m), Some(c), Some(ch), Some((mats, time))) = (
-            &mut self.metrics,
-            &self.control,
-            &self.character,
-            self.poses[slot].take(),
-        ) {
-            let (mesh, _) = ch.ch.skinned_at(&mats, ch.method)?;
-            let f = &self.st.fluid;
-            let group = c.force.settings.group;
-            let spacing = c.desc.spacing.unwrap_or(f.spacing());
-            m.retire(
-                slot,
-                frame,
-                time,
-                (&mesh, &ch.ch.mesh.indices),
-                group,
-                f.rest_density,
-                spacing,
-            )?;
-        }
+        self.targets.retire(slot, frame, &self.st.fluid)?;
         if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
             e.retire(frame, slot)?;
         }
@@ -344,12 +311,7 @@ impl SphWork<'_> {
             e.destroy(ctx);
         }
         self.view.destroy(ctx);
-        if let Some(m) = &mut self.metrics {
-            m.destroy(ctx);
-        }
-        if let Some(c) = &mut self.character {
-            c.destroy(ctx);
-        }
+        self.targets.destroy(ctx);
         self.st.destroy(ctx);
         self.solver.destroy(ctx);
     }
@@ -360,7 +322,11 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     use crate::sph::SphSolver;
     use crate::viewer::{MetaballViewer, PointsViewer, View};
     let sw = &opts.switches;
-    let render = sw.view.render.unwrap_or(RenderKind::Metaballs);
+    let render = sw
+        .view
+        .render
+        .or(scene.look.render)
+        .unwrap_or(RenderKind::Metaballs);
     use crate::config::Group;
     let mut uses = vec![
         Group::Sort,
@@ -376,7 +342,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     if scene.character.is_some() {
         uses.push(Group::Character);
     }
-    if scene.control.is_some() {
+    if !scene.control_targets().is_empty() {
         uses.push(Group::Control);
     }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
@@ -421,27 +387,11 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         }
     };
     let cam = camera_with_switches(cam, sw);
-    let character = scene_character(&ctx, &scene, sw)?;
-    let character = Guard::new(&ctx, character);
     let mut solver = solver;
-    let control = match (&scene.control, character.as_ref()) {
-        (Some(desc), Some(c)) => Some(crate::control::target::ControlTarget::new(
-            &ctx,
-            &mut solver,
-            &c.ch,
-            &c.anim,
-            &desc.with_switches(sw),
-            &scene.fluid,
-            (scene.domain.min, scene.domain.max),
-            sw.common.seed,
-        )?),
-        _ => None,
-    };
-    let metrics = control
-        .as_ref()
-        .map(|c| crate::control::metrics::ControlMetrics::new(&ctx, st.n, c.count(), SLOTS))
-        .transpose()?;
-    let show = character.as_ref().map(|c| c.show).unwrap_or(ShowMesh::Off);
+    let targets =
+        crate::scene::targets::SceneTargets::new(&ctx, &scene, sw, &mut solver, &st, SLOTS)?;
+    let targets = Guard::new(&ctx, targets);
+    let show = targets.show();
     let view: Box<dyn View> = match render {
         RenderKind::Metaballs => {
             let tank = scene
@@ -476,10 +426,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         view: view.take(),
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
-        character: character.take(),
-        metrics,
-        control,
-        poses: vec![None; SLOTS],
+        targets: targets.take(),
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -489,16 +436,8 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
     let render_stats = work.view.stats();
-    let character_stats = work.character.as_ref().map(|c| c.stats()).transpose();
-    let control_stats = match (&work.metrics, &work.control) {
-        (Some(m), Some(c)) => {
-            m.write_csv(&opts.out.join("control.csv"))?;
-            let mut s = m.stats.clone();
-            s.settings = Some(c.force.settings.clone());
-            Some(s)
-        }
-        _ => None,
-    };
+    let character_stats = work.targets.character_stats();
+    let control_stats = work.targets.control_summary(&opts.out);
     let sort = work.solver.search.sort;
     let exports = work
         .export
@@ -514,7 +453,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         simulated_seconds,
         render: render_stats,
         character: character_stats?,
-        control: control_stats,
+        control: control_stats?,
     };
     let config = RunConfig {
         command: "run".into(),

@@ -39,6 +39,8 @@ fn scene() -> Scene {
         look: Default::default(),
         character: None,
         control: None,
+        targets: vec![],
+        timeline: vec![],
     }
 }
 
@@ -86,6 +88,7 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             1,
             settings.clone(),
             (sc.domain.min, sc.domain.max),
+            None,
         )
         .unwrap(),
     );

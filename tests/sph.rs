@@ -43,6 +43,8 @@ fn block_scene(fluid: FluidParams) -> Scene {
         look: Default::default(),
         character: None,
         control: None,
+        targets: vec![],
+        timeline: vec![],
     }
 }
 

@@ -30,7 +30,7 @@ struct ControlParams {
     float down;
     float inv_frame;  // 1 / frame time: control velocity from two poses
     uint group;       // controlled group, or 0xFFFFFFFF: all
-    uint pad;
+    uint live;        // control particles this step (rays: the GPU's count)
 };
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
 layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz

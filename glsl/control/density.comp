@@ -4,6 +4,8 @@
 void main() {
     uint j = global_id();
     if (j >= C.dims.w) return;
+    // Parked slots (rays) sort after the live ones: no density there.
+    if (j >= C.live) { crho[j] = 0.0; return; }
     vec3 xj = cpos[j].xyz;
     float h2 = P.h * P.h;
     float sum = 0.0;

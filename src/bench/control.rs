@@ -36,7 +36,7 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
                 "bench control: scene {scene} has no fluid"
             )));
         };
-        let Some(c) = &stats.control else {
+        let Some(c) = stats.control.as_ref().and_then(|c| c.targets.first()) else {
             return Err(Error::Param(format!(
                 "bench control: scene {scene} has no [control] target"
             )));

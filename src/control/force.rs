@@ -17,7 +17,7 @@ use crate::sph::solver::SphState;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 crate::gpu_interface! {
@@ -46,9 +46,12 @@ pub struct ControlGpuParams {
     pub down: f32,
     pub inv_frame: f32,
     pub group: u32,
-    pub pad: u32,
+    /// Control particles this step: m for bound sets, the GPU's count for rays.
+    pub live: u32,
 }
 const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 80);
+/// Byte offset of `live` (the rays placement copies its count there).
+pub const LIVE_OFFSET: u64 = std::mem::offset_of!(ControlGpuParams, live) as u64;
 
 /// Every group is controlled.
 pub const ALL_GROUPS: u32 = u32::MAX;
@@ -139,6 +142,8 @@ struct ControlGpu {
     sorted_prev: Buffer,
     crho: Buffer,
     params: Buffer,
+    /// `--placement rays`: re-placed from the skinned mesh (`mesh`) every frame.
+    rays: Option<super::rays::RaysPlacer>,
 }
 
 crate::impl_destroy!(ControlGpu);
@@ -151,6 +156,9 @@ impl ControlGpu {
         self.search.destroy(ctx);
         self.nb.destroy(ctx);
         self.gather.destroy(ctx);
+        if let Some(r) = &mut self.rays {
+            r.destroy(ctx);
+        }
         for b in [
             &mut self.prev,
             &mut self.sorted_pos,
@@ -169,6 +177,9 @@ pub struct ControlForce {
     pending: RefCell<Option<Pose>>,
     /// No pose recorded yet: the first one is also the previous (zero velocity).
     first: RefCell<bool>,
+    /// Attached (the hook records nothing while released) and the factor on c_cp.
+    attached: Cell<bool>,
+    strength: Cell<f32>,
     pub settings: ControlSettings,
     /// Control particles.
     pub m: u32,
@@ -177,7 +188,8 @@ pub struct ControlForce {
 impl ControlForce {
     /// For control particles at rest positions `mesh.positions`, bound by its joints and
     /// weights (normals unused), skinned by `joints` joints, for fluid searched by
-    /// `solver`, in the domain [lo, hi].
+    /// `solver`, in the domain [lo, hi]. With `rays` (spacing, capacity), `mesh` is the
+    /// target's surface, skinned and re-placed by rays every frame.
     pub fn new(
         ctx: &Context,
         solver: &crate::sph::SphSolver,
@@ -185,11 +197,20 @@ impl ControlForce {
         joints: usize,
         settings: ControlSettings,
         domain: ([f32; 3], [f32; 3]),
+        rays: Option<(f32, u32)>,
     ) -> Result<Self> {
         settings.validate()?;
-        let m = mesh.vertices();
+        let m = match rays {
+            Some((_, capacity)) => capacity as usize,
+            None => mesh.vertices(),
+        };
         if m == 0 {
             return Err(Error::Param("no control particles".into()));
+        }
+        if rays.is_some() && settings.velocity > 0.0 {
+            return Err(Error::Param(
+                "--control-velocity needs control particles that persist between frames: --placement rays re-places them every frame (use vertices or random)".into(),
+            ));
         }
         // The control grid: the grid strategy with the counting sort (cell counts).
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
@@ -209,7 +230,30 @@ impl ControlForce {
         };
         let density = pipeline("control-density", "control/density.comp")?;
         let force = pipeline("control-force", "control/force.comp")?;
-        let grid = GridSpec::covering(domain.0, domain.1, settings.radius)?;
+        // Rays: three more layers above the domain in z, the last one parking the unused
+        // slots two cells away from any fluid particle's.
+        let r = settings.radius;
+        let top = [domain.1[0], domain.1[1], domain.1[2] + 3.0 * r];
+        let grid = match rays {
+            Some(_) => GridSpec::covering(domain.0, top, r)?,
+            None => GridSpec::covering(domain.0, domain.1, r)?,
+        };
+        let rays = match rays {
+            Some((spacing, capacity)) => {
+                let g = super::rays::RaysGrid::new(domain.0, domain.1, spacing)?;
+                let far = domain
+                    .0
+                    .iter()
+                    .chain(&domain.1)
+                    .fold(0f32, |a, v| a.max(v.abs()));
+                let park = far + 3.0 * r + 1.0;
+                Some(Guard::new(
+                    ctx,
+                    super::rays::RaysPlacer::new(ctx, g, capacity, park)?,
+                ))
+            }
+            None => None,
+        };
         let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
         let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
         let skin = SkinPass::new(ctx, crate::config::Skinning::Lbs, mesh.influence_sets)?;
@@ -242,9 +286,12 @@ impl ControlForce {
                 sorted_prev: sorted_prev.take(),
                 crho: crho.take(),
                 params: params.take(),
+                rays: rays.map(|r| r.take()),
             })),
             pending: RefCell::new(None),
             first: RefCell::new(true),
+            attached: Cell::new(true),
+            strength: Cell::new(1.0),
             settings,
             m: m as u32,
         })
@@ -253,6 +300,23 @@ impl ControlForce {
     /// The pose the next step uses (once per frame).
     pub fn set_pose(&self, pose: Pose) {
         *self.pending.borrow_mut() = Some(pose);
+    }
+
+    /// Attach or release (a released set records no passes; when attached again its
+    /// first pose has zero velocity) at `strength` times c_cp, from the next pose on.
+    pub fn set_attached(&self, attached: bool, strength: f32) {
+        if attached && !self.attached.get() {
+            *self.first.borrow_mut() = true;
+        }
+        if !attached {
+            self.pending.borrow_mut().take();
+        }
+        self.attached.set(attached);
+        self.strength.set(strength);
+    }
+
+    pub fn attached(&self) -> bool {
+        self.attached.get()
     }
 
     fn gpu_params(&self, g: &ControlGpu, frame_dt: f32) -> ControlGpuParams {
@@ -266,7 +330,7 @@ impl ControlForce {
                 g.grid.cell,
             ],
             dims: [g.grid.dims[0], g.grid.dims[1], g.grid.dims[2], self.m],
-            pressure: s.pressure,
+            pressure: s.pressure * self.strength.get(),
             radius: h,
             spiky_grad: -45.0 / (std::f32::consts::PI * h.powi(6)),
             velocity: s.velocity,
@@ -277,7 +341,7 @@ impl ControlForce {
             down: s.down,
             inv_frame: if frame_dt > 0.0 { 1.0 / frame_dt } else { 0.0 },
             group: s.group,
-            pad: 0,
+            live: self.m,
         }
     }
 
@@ -310,6 +374,40 @@ impl ControlForce {
             sync::COMPUTE_READ | sync::COMPUTE_WRITE,
         );
         g.skin.record(ctx, cmd, &g.mesh)?;
+        if let Some(r) = &g.rays {
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ); // surface -> raster
+            scopes.end(ctx, cmd);
+            r.record(
+                ctx,
+                cmd,
+                scopes,
+                &g.mesh.pos,
+                &g.mesh.indices,
+                g.mesh.triangles,
+            )?;
+            ctx.copy(
+                cmd,
+                &r.stats,
+                super::rays::STATS_PARTICLES,
+                &g.params,
+                LIVE_OFFSET,
+                4,
+            );
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+            scopes.begin(ctx, cmd, "control-grid");
+            // Re-placed particles have no previous pose: both are the new set.
+            let pos = &r.out;
+            g.search
+                .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
+            ctx.compute_barrier(cmd); // permutation -> gathers
+            g.gather
+                .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
+            g.gather
+                .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_prev, self.m);
+            ctx.compute_barrier(cmd); // sorted control set -> density and force
+            scopes.end(ctx, cmd);
+            return Ok(());
+        }
         if first {
             ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
             ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
@@ -364,21 +462,44 @@ impl ControlForce {
         }
     }
 
-    /// Record a copy of the control densities into `dst` (a host-visible buffer; the
-    /// caller orders it after the steps and before the host reads).
-    pub fn record_copy_densities(
+    /// Record copies of the control densities into `crho` and of the counts into
+    /// `counts` (16 bytes: live control particles, then the rays placement's fragments and
+    /// particles) (host-visible buffers; the caller orders them after the steps and before
+    /// the host reads).
+    pub fn record_copy_readback(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        dst: &Buffer,
+        crho: &Buffer,
+        counts: &Buffer,
     ) -> Result<()> {
         match &*self.gpu.borrow() {
             Some(g) => {
-                ctx.copy(cmd, &g.crho, 0, dst, 0, self.m as u64 * 4);
+                ctx.copy(cmd, &g.crho, 0, crho, 0, self.m as u64 * 4);
+                ctx.copy(cmd, &g.params, LIVE_OFFSET, counts, 0, 4);
+                if let Some(r) = &g.rays {
+                    ctx.copy(cmd, &r.stats, 0, counts, 4, 8);
+                }
                 Ok(())
             }
             None => Err(Error::Param("the control set is destroyed".into())),
         }
+    }
+
+    /// The live control particles of a frame's counts (see `record_copy_readback`), or
+    /// the rays placement's overflow.
+    pub fn check_counts(&self, counts: [u32; 4]) -> Result<u32> {
+        if let Some(r) = &*self.gpu.borrow() {
+            if let Some(r) = &r.rays {
+                r.check(counts[1], counts[2])?;
+            }
+        }
+        Ok(counts[0].min(self.m))
+    }
+
+    /// Re-placed every frame (`--placement rays`).
+    pub fn replaced(&self) -> bool {
+        matches!(&*self.gpu.borrow(), Some(g) if g.rays.is_some())
     }
 
     pub fn destroy(&self, ctx: &Context) {
@@ -404,6 +525,9 @@ impl SphHook for ControlHook {
         st: &SphState,
     ) -> Result<()> {
         let c = &self.0;
+        if !c.attached.get() {
+            return Ok(());
+        }
         let gpu = c.gpu.borrow();
         let g = gpu
             .as_ref()

@@ -18,6 +18,7 @@ use std::collections::HashSet;
 pub struct ControlRow {
     pub frame: u64,
     pub time: f64,
+    pub target: String,
     pub inside_fraction: f64,
     pub coverage: f64,
     pub iou: f64,
@@ -31,6 +32,8 @@ pub struct ControlRow {
 /// `stats.control` of summary.json.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ControlStats {
+    pub target: String,
+    pub placement: Option<crate::config::Placement>,
     pub control_particles: u32,
     pub settings: Option<super::force::ControlSettings>,
     /// First scene time at which coverage reached 0.9 (None: never).
@@ -50,6 +53,7 @@ struct Slot {
     rho: Buffer,
     attr: Buffer,
     crho: Buffer,
+    counts: Buffer,
 }
 
 pub struct ControlMetrics {
@@ -61,7 +65,7 @@ pub struct ControlMetrics {
 }
 
 impl ControlMetrics {
-    pub fn new(ctx: &Context, n: u32, m: u32, slots: usize) -> Result<Self> {
+    pub fn new(ctx: &Context, n: u32, m: u32, target: &str, slots: usize) -> Result<Self> {
         let host = |name: &str, bytes: u64| {
             ctx.create_buffer(
                 name,
@@ -76,6 +80,7 @@ impl ControlMetrics {
             out.push(host("metrics densities", n as u64 * 8)?);
             out.push(host("metrics attributes", n as u64 * 16)?);
             out.push(host("metrics control densities", m as u64 * 4)?);
+            out.push(host("metrics control counts", 16)?);
         }
         let mut it = out.take().into_iter();
         let slots = (0..slots)
@@ -84,6 +89,7 @@ impl ControlMetrics {
                 rho: it.next().unwrap(),
                 attr: it.next().unwrap(),
                 crho: it.next().unwrap(),
+                counts: it.next().unwrap(),
             })
             .collect();
         Ok(Self {
@@ -92,6 +98,7 @@ impl ControlMetrics {
             m,
             rows: Vec::new(),
             stats: ControlStats {
+                target: target.into(),
                 control_particles: m,
                 ..Default::default()
             },
@@ -112,7 +119,7 @@ impl ControlMetrics {
         ctx.copy(cmd, st.pos(), 0, &s.pos, 0, self.n as u64 * 16);
         ctx.copy(cmd, st.rho_p(), 0, &s.rho, 0, self.n as u64 * 8);
         ctx.copy(cmd, st.attr(), 0, &s.attr, 0, self.n as u64 * 16);
-        force.record_copy_densities(ctx, cmd, &s.crho)?;
+        force.record_copy_readback(ctx, cmd, &s.crho, &s.counts)?;
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ);
         Ok(())
     }
@@ -126,6 +133,7 @@ impl ControlMetrics {
         frame: u64,
         time: f64,
         mesh: (&[Vec3], &[u32]),
+        force: &ControlForce,
         group: u32,
         rest_density: f32,
         spacing: f32,
@@ -138,7 +146,11 @@ impl ControlMetrics {
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&read(&s.pos)?[..self.n as usize * 16]);
         let rho: &[[f32; 2]] = bytemuck::cast_slice(&read(&s.rho)?[..self.n as usize * 8]);
         let attr: &[[f32; 4]] = bytemuck::cast_slice(&read(&s.attr)?[..self.n as usize * 16]);
-        let crho: &[f32] = bytemuck::cast_slice(&read(&s.crho)?[..self.m as usize * 4]);
+        let counts: &[u32] = bytemuck::cast_slice(&read(&s.counts)?[..16]);
+        let live = force
+            .check_counts([counts[0], counts[1], counts[2], counts[3]])?
+            .min(self.m);
+        let crho: &[f32] = bytemuck::cast_slice(&read(&s.crho)?[..live as usize * 4]);
         let inside = InsideTest::new(mesh.0, mesh.1);
         let controlled: Vec<Vec3> = pos
             .iter()
@@ -173,8 +185,9 @@ impl ControlMetrics {
         let row = ControlRow {
             frame,
             time,
+            target: self.stats.target.clone(),
             inside_fraction: inside_count as f64 / controlled.len().max(1) as f64,
-            coverage: covered as f64 / self.m.max(1) as f64,
+            coverage: covered as f64 / live.max(1) as f64,
             iou: inter as f64 / union as f64,
             density_error_mean: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
             density_error_max: errs.iter().cloned().fold(0.0, f64::max),
@@ -182,9 +195,10 @@ impl ControlMetrics {
                 .iter()
                 .map(|r| r[0] as f64 / rest_density as f64)
                 .fold(0.0, f64::max),
-            control_particles: self.m,
+            control_particles: live,
         };
         let st = &mut self.stats;
+        st.control_particles = live;
         if st.time_to_90.is_none() && row.coverage >= 0.9 {
             st.time_to_90 = Some(time);
         }
@@ -199,25 +213,31 @@ impl ControlMetrics {
         Ok(self.rows.last().unwrap())
     }
 
-    /// control.csv: one row per frame.
-    pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
-        let io = |e: std::io::Error| Error::Io {
-            path: path.display().to_string(),
-            source: e,
-        };
-        let mut w = csv::Writer::from_path(path).map_err(|e| io(e.into()))?;
-        for r in &self.rows {
-            w.serialize(r).map_err(|e| io(e.into()))?;
-        }
-        w.flush().map_err(io)
-    }
-
     pub fn destroy(&mut self, ctx: &Context) {
         for s in &mut self.slots {
-            for b in [&mut s.pos, &mut s.rho, &mut s.attr, &mut s.crho] {
+            for b in [
+                &mut s.pos,
+                &mut s.rho,
+                &mut s.attr,
+                &mut s.crho,
+                &mut s.counts,
+            ] {
                 ctx.destroy_buffer(b);
             }
         }
     }
 }
 crate::impl_destroy!(ControlMetrics);
+
+/// control.csv: one row per target and frame.
+pub fn write_csv(path: &std::path::Path, rows: &[ControlRow]) -> Result<()> {
+    let io = |e: std::io::Error| Error::Io {
+        path: path.display().to_string(),
+        source: e,
+    };
+    let mut w = csv::Writer::from_path(path).map_err(|e| io(e.into()))?;
+    for r in rows {
+        w.serialize(r).map_err(|e| io(e.into()))?;
+    }
+    w.flush().map_err(io)
+}

@@ -5,4 +5,6 @@ pub mod force;
 pub mod inside;
 pub mod metrics;
 pub mod placement;
+pub mod rays;
 pub mod target;
+pub mod timeline;

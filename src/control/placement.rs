@@ -132,8 +132,8 @@ pub fn place(
             random(mesh, spacing, seed)
         }
         Placement::Rays => {
-            return Err(Error::Unsupported(
-                "--placement rays (GPU depth-peeled rays) is not implemented yet".into(),
+            return Err(Error::Param(
+                "--placement rays places on the GPU every frame (control::rays), not here".into(),
             ))
         }
     };

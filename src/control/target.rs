@@ -100,6 +100,17 @@ impl ControlDesc {
     }
 }
 
+/// A named control target beside the scene's `[character]` (TOML `[[targets]]`): a
+/// character or closed mesh, where it stands and how it plays, and its control settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetDesc {
+    pub name: String,
+    pub character: crate::scene::character::CharacterDesc,
+    #[serde(default)]
+    pub control: ControlDesc,
+}
+
 /// Control particles of a placed character, driving the fluid through the solver's hook.
 pub struct ControlTarget {
     pub force: Rc<ControlForce>,
@@ -129,6 +140,9 @@ impl ControlTarget {
             .collect();
         let (rest_mesh, _) = ch.skinned_at(&placed_rest, Skinning::Lbs)?;
         let spacing = desc.spacing.unwrap_or(fluid.spacing());
+        if desc.placement == Placement::Rays {
+            return Self::rays(ctx, solver, ch, &rest_mesh, desc, fluid, domain, spacing);
+        }
         let points = placement::place(ch, &rest_mesh, desc.placement, spacing, seed)?;
         let (lo, hi) = (Vec3::from(domain.0), Vec3::from(domain.1));
         if let Some(p) = points
@@ -185,6 +199,7 @@ impl ControlTarget {
             ch.skeleton.joints.len(),
             settings,
             domain,
+            None,
         )?);
         solver.add_force(Box::new(ControlHook(force.clone())));
         Ok(Self {
@@ -194,9 +209,69 @@ impl ControlTarget {
         })
     }
 
+    /// `--placement rays`: the character's own surface, skinned by its own weights and
+    /// re-placed on the GPU every frame; room for three times the rest pose's lattice.
+    #[allow(clippy::too_many_arguments)]
+    fn rays(
+        ctx: &Context,
+        solver: &mut crate::sph::SphSolver,
+        ch: &Character,
+        rest_mesh: &[Vec3],
+        desc: &ControlDesc,
+        fluid: &crate::sph::FluidParams,
+        domain: ([f32; 3], [f32; 3]),
+        spacing: f32,
+    ) -> Result<Self> {
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return Err(Error::Param(format!(
+                "--control-spacing must be positive, got {spacing}"
+            )));
+        }
+        ch.require_closed("--placement rays")?;
+        let rest = placement::lattice((rest_mesh, &ch.mesh.indices), spacing).len();
+        if rest == 0 {
+            return Err(Error::Model {
+                path: ch.source.clone(),
+                message: format!(
+                    "gives no control particles at spacing {spacing} (the mesh is smaller than the spacing)"
+                ),
+            });
+        }
+        let (lo, hi) = crate::character::check::bounds(rest_mesh);
+        let (dlo, dhi) = (Vec3::from(domain.0), Vec3::from(domain.1));
+        if lo.cmplt(dlo).any() || hi.cmpgt(dhi).any() {
+            return Err(Error::Param(format!(
+                "the control target {} reaches outside the domain {dlo}..{dhi} (its rest pose spans {lo}..{hi})",
+                ch.source
+            )));
+        }
+        let capacity = (3 * rest + 1024).min(u32::MAX as usize / 16) as u32;
+        let force = Rc::new(ControlForce::new(
+            ctx,
+            solver,
+            &ch.mesh,
+            ch.skeleton.joints.len(),
+            desc.settings(fluid.h),
+            domain,
+            Some((spacing, capacity)),
+        )?);
+        solver.add_force(Box::new(ControlHook(force.clone())));
+        Ok(Self {
+            force,
+            desc: desc.clone(),
+            rest_inv: Vec::new(),
+        })
+    }
+
     /// Set the pose of scene time `t` (the animator's joint matrices, placed) for the next
     /// frame's steps, `frame_dt` seconds after the previous pose.
     pub fn set_pose(&self, ch: &Character, mats: &[Mat4], frame_dt: f32) -> Result<()> {
+        if self.desc.placement == Placement::Rays {
+            // The surface itself is skinned (its bind pose is the file's).
+            let joints = pose::gpu_joints(mats, Skinning::Lbs, &|j| ch.joint_name(j))?;
+            self.force.set_pose(Pose { joints, frame_dt });
+            return Ok(());
+        }
         let rel: Vec<Mat4> = mats
             .iter()
             .zip(&self.rest_inv)

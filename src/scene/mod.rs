@@ -1,3 +1,4 @@
 //! Scene parts beside the SPH scenes: the `orbits` test scene and characters.
 pub mod character;
 pub mod orbits;
+pub mod targets;

@@ -113,7 +113,7 @@ pub struct SphRunStats {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub character: Option<crate::scene::character::CharacterStats>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub control: Option<crate::control::metrics::ControlStats>,
+    pub control: Option<crate::scene::targets::ControlSummary>,
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

@@ -1,6 +1,7 @@
 //! SPH scenes: a domain box, fluid parameters, fluid blocks and spheres (filled on a
 //! lattice at the rest spacing), colliders and a camera. Built in or read from TOML.
 use super::params::{Collider, Eos, FluidParams, MAX_COLLIDERS};
+use crate::control::timeline::{Action, Event};
 use crate::error::{Error, Result};
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -58,6 +59,9 @@ fn default_fov() -> f32 {
     45.0
 }
 
+/// The control target of `[character]` and `[control]` on the timeline.
+pub const MAIN_TARGET: &str = "character";
+
 fn default_frames() -> u64 {
     240
 }
@@ -84,9 +88,17 @@ pub struct Scene {
     /// An animated character (a scene may have it alone, with no fluid).
     #[serde(default)]
     pub character: Option<crate::scene::character::CharacterDesc>,
-    /// Control particles pulling the fluid into the character (needs `character`).
+    /// Control particles pulling the fluid into the character (needs `character`): the
+    /// control target named "character".
     #[serde(default)]
     pub control: Option<crate::control::target::ControlDesc>,
+    /// More control targets, by name.
+    #[serde(default)]
+    pub targets: Vec<crate::control::target::TargetDesc>,
+    /// When targets attach, switch, unite, release and change strength (default: every
+    /// target attached from the start).
+    #[serde(default)]
+    pub timeline: Vec<crate::control::timeline::Event>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -98,6 +110,8 @@ pub struct Look {
     pub size: Option<[u32; 2]>,
     /// Draw the domain as a glass tank (default on).
     pub tank: Option<bool>,
+    /// Metaballs (default) or points (coloured by particle, as groups need).
+    pub render: Option<crate::config::RenderKind>,
 }
 
 impl Look {
@@ -150,6 +164,9 @@ pub const BUILT_IN: &[&str] = &[
     "walker",
     "character",
     "giraffe",
+    "union",
+    "morph",
+    "two-groups",
 ];
 
 /// Kelager's water with a Tait equation of state stiff enough for < 1% compression in
@@ -223,6 +240,35 @@ fn liquid(
             adaptive: crate::config::Adaptive::On,
             ..crate::control::target::ControlDesc::default()
         }),
+        targets: vec![],
+        timeline: vec![],
+    }
+}
+
+/// The built-in capsule, `height` tall, standing at `at`.
+fn capsule(height: f32, at: [f32; 3]) -> crate::scene::character::CharacterDesc {
+    crate::scene::character::CharacterDesc {
+        height: Some(height),
+        position: at,
+        ..crate::scene::character::CharacterDesc::new("builtin:capsule")
+    }
+}
+
+/// A control target with the liquid scenes' settings (adaptive pressure), controlling
+/// `group` (None: all).
+fn target(
+    name: &str,
+    character: crate::scene::character::CharacterDesc,
+    group: Option<u32>,
+) -> crate::control::target::TargetDesc {
+    crate::control::target::TargetDesc {
+        name: name.into(),
+        character,
+        control: crate::control::target::ControlDesc {
+            adaptive: crate::config::Adaptive::On,
+            group,
+            ..crate::control::target::ControlDesc::default()
+        },
     }
 }
 
@@ -254,6 +300,8 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         look: Look::default(),
         character: None,
         control: None,
+        targets: vec![],
+        timeline: vec![],
     }
 }
 
@@ -276,6 +324,7 @@ impl Scene {
                     material: Some(crate::config::Material::Tinted),
                     size: Some([300, 200]),
                     tank: None,
+                    render: None,
                 },
                 ..dam_break(name, [1.5, 0.9, 0.5], [0.5, 0.63, 0.5], [0.95, 2.3])
             },
@@ -313,6 +362,8 @@ impl Scene {
                 look: Look::default(),
                 character: None,
                 control: None,
+                targets: vec![],
+                timeline: vec![],
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -340,15 +391,22 @@ impl Scene {
                 look: Look::default(),
                 character: None,
                 control: None,
+                targets: vec![],
+                timeline: vec![],
             },
             // A liquid character: a pool rises into the built-in walker (control particles,
-            // adaptive pressure) and follows its walk at half speed.
+            // adaptive pressure), follows its walk at half speed, and is released at 1.5 s.
             "character" => Scene {
-                frames: 150,
+                frames: 200,
+                timeline: vec![
+                    Event::new(0.0, Action::Attach, Some(MAIN_TARGET)),
+                    Event::new(1.5, Action::Release, None),
+                ],
                 look: Look {
                     material: Some(crate::config::Material::Tinted),
                     size: Some([240, 240]),
                     tank: Some(false),
+                    render: None,
                 },
                 ..liquid(
                     name,
@@ -372,6 +430,85 @@ impl Scene {
                     [0.1, 2.4],
                 )
             },
+            // A capsule of water that morphs into the walker at 1 s.
+            "morph" => Scene {
+                frames: 220,
+                targets: vec![target("capsule", capsule(0.6, [0.0, 0.0, 0.0]), None)],
+                timeline: vec![
+                    Event::new(0.0, Action::Attach, Some("capsule")),
+                    Event::new(1.0, Action::Switch, Some(MAIN_TARGET)),
+                ],
+                ..liquid(
+                    name,
+                    ([-0.45, 0.0, -0.3], [0.45, 1.2, 0.3]),
+                    0.1,
+                    "builtin:walker",
+                    0.5,
+                    [0.0, 2.3],
+                )
+            },
+            // The walker fills; at 0.8 s a capsule beside it is added to the target.
+            "union" => {
+                let mut s = liquid(
+                    name,
+                    ([-0.6, 0.0, -0.3], [0.6, 1.2, 0.3]),
+                    0.1,
+                    "builtin:walker",
+                    0.5,
+                    [0.0, 2.8],
+                );
+                if let Some(c) = &mut s.character {
+                    c.position = [-0.2, 0.0, 0.0];
+                }
+                s.look.size = Some([320, 240]);
+                s.frames = 200;
+                s.targets = vec![target("capsule", capsule(0.6, [0.3, 0.0, 0.0]), None)];
+                s.timeline = vec![
+                    Event::new(0.0, Action::Attach, Some(MAIN_TARGET)),
+                    Event::new(0.8, Action::Union, Some("capsule")),
+                ];
+                s
+            }
+            // A pool of blue (group 0) and orange (group 1) stripes: the walker pulls the
+            // blue out, a capsule beside it the orange (each target reaches the fluid
+            // within h_c of its control particles); released at 1.5 s, they mix.
+            "two-groups" => {
+                let mut s = liquid(
+                    name,
+                    ([-0.6, 0.0, -0.3], [0.6, 1.2, 0.3]),
+                    0.1,
+                    "builtin:walker",
+                    0.5,
+                    [0.0, 2.8],
+                );
+                // Stripes 0.1 m wide along x.
+                s.blocks = (0..12)
+                    .map(|k| Block {
+                        min: [-0.6 + 0.1 * k as f32, 0.0, -0.3],
+                        max: [-0.5 + 0.1 * k as f32, 0.1, 0.3],
+                        group: k % 2,
+                        color: [blue, [1.0, 0.55, 0.15]][k as usize % 2],
+                        velocity: [0.0; 3],
+                    })
+                    .collect();
+                if let Some(c) = &mut s.character {
+                    c.position = [-0.2, 0.0, 0.0];
+                }
+                // Points show the groups' colours (metaballs have one material).
+                s.look.render = Some(crate::config::RenderKind::Points);
+                if let Some(c) = &mut s.control {
+                    c.group = Some(0);
+                }
+                s.look.size = Some([320, 240]);
+                s.frames = 220;
+                s.targets = vec![target("capsule", capsule(0.6, [0.3, 0.0, 0.0]), Some(1))];
+                s.timeline = vec![
+                    Event::new(0.0, Action::Attach, Some(MAIN_TARGET)),
+                    Event::new(0.0, Action::Union, Some("capsule")),
+                    Event::new(1.5, Action::Release, None),
+                ];
+                s
+            }
             // The built-in character alone, walking in place: two cycles at 30 fps.
             "walker" => Scene {
                 name: name.into(),
@@ -397,6 +534,8 @@ impl Scene {
                     "builtin:walker",
                 )),
                 control: None,
+                targets: vec![],
+                timeline: vec![],
             },
             _ => return None,
         })
@@ -421,10 +560,11 @@ impl Scene {
         let mut s: Scene = toml::from_str(&text)
             .map_err(|e| Error::Param(format!("scene file {name_or_path}: {e}")))?;
         // A character file is named relative to the scene file.
-        if let Some(c) = &mut s.character {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let chars = s.character.iter_mut();
+        for c in chars.chain(s.targets.iter_mut().map(|t| &mut t.character)) {
             let f = Path::new(&c.file);
             if !c.file.starts_with("builtin:") && f.is_relative() {
-                let dir = path.parent().unwrap_or(Path::new("."));
                 c.file = dir.join(f).display().to_string();
             }
         }
@@ -505,6 +645,23 @@ impl Scene {
                 self.name
             )));
         }
+        if !self.targets.is_empty() && !self.has_fluid() {
+            return Err(Error::Param(format!(
+                "scene {}: [[targets]] need fluid",
+                self.name
+            )));
+        }
+        let names = self.control_targets();
+        for (i, t) in self.targets.iter().enumerate() {
+            t.character.validate(&self.name)?;
+            if names[..names.len() - self.targets.len() + i].contains(&t.name) {
+                return Err(Error::Param(format!(
+                    "scene {}: two control targets named '{}'",
+                    self.name, t.name
+                )));
+            }
+        }
+        crate::control::timeline::Timeline::new(&self.name, &self.timeline, &names)?;
         if !self.has_fluid() && self.character.is_none() {
             return Err(Error::Param(format!(
                 "scene {}: no fluid (blocks or balls) and no character",
@@ -512,6 +669,15 @@ impl Scene {
             )));
         }
         Ok(())
+    }
+
+    /// The names of the control targets: "character" for `[character]` with `[control]`,
+    /// then `[[targets]]` in order.
+    pub fn control_targets(&self) -> Vec<String> {
+        let main = self.control.is_some().then(|| MAIN_TARGET.to_string());
+        main.into_iter()
+            .chain(self.targets.iter().map(|t| t.name.clone()))
+            .collect()
     }
 
     /// Blocks or balls of fluid (a scene may hold a character alone).
@@ -541,8 +707,9 @@ impl Scene {
             c.eye = m(c.eye);
             c.target = m(c.target);
         }
-        // The character grows with the scene (its placement about the origin too).
-        if let Some(c) = &mut out.character {
+        // The characters grow with the scene (their placement about the origin too).
+        let chars = out.character.iter_mut();
+        for c in chars.chain(out.targets.iter_mut().map(|t| &mut t.character)) {
             c.position = m(c.position);
             match (c.height, c.scale) {
                 (Some(h), _) => c.height = Some(h * s),

@@ -1,0 +1,267 @@
+//! A scene's characters and control targets as it plays: the `[character]` (with its
+//! `[control]`, the target "character") and the `[[targets]]`, attached, switched, united
+//! and released by the timeline; each attached target's pose set before the frame's
+//! steps, its metrics read after them; the first shown mesh drawn by the view.
+use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
+use crate::config::{ShowMesh, Skinning, Switches};
+use crate::control::metrics::{ControlMetrics, ControlStats};
+use crate::control::target::{ControlDesc, ControlTarget};
+use crate::control::timeline::{FiredEvent, Timeline};
+use crate::error::Result;
+use crate::gpu::{Context, Guard, Profiler};
+use crate::render::mesh::MeshDraw;
+use crate::sph::scene::MAIN_TARGET;
+use crate::sph::{Scene, SphSolver, SphState};
+use ash::vk;
+use glam::Mat4;
+use serde::{Deserialize, Serialize};
+
+/// `stats.control` of summary.json: each control target's metrics and the fired events.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ControlSummary {
+    pub targets: Vec<ControlStats>,
+    pub events: Vec<FiredEvent>,
+}
+
+struct Live {
+    name: String,
+    character: SceneCharacter,
+    control: Option<(ControlTarget, ControlMetrics)>,
+    /// Per slot: the placed joint matrices and scene time of the frame, when attached.
+    poses: Vec<Option<(Vec<Mat4>, f64)>>,
+}
+
+pub struct SceneTargets {
+    live: Vec<Live>,
+    /// Index into `live` of each control target (timeline order of names).
+    controlled: Vec<usize>,
+    timeline: Timeline,
+    pub fired: Vec<FiredEvent>,
+    quiet: bool,
+}
+
+impl SceneTargets {
+    /// Load, place and bind every character and target of `scene` (errors before the
+    /// first frame), hooking each control target into `solver`.
+    pub fn new(
+        ctx: &Context,
+        scene: &Scene,
+        sw: &Switches,
+        solver: &mut SphSolver,
+        st: &SphState,
+        slots: usize,
+    ) -> Result<Self> {
+        let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
+        let mut descs: Vec<(String, &CharacterDesc, Option<&ControlDesc>)> = Vec::new();
+        if let Some(c) = &scene.character {
+            descs.push((MAIN_TARGET.into(), c, scene.control.as_ref()));
+        }
+        for t in &scene.targets {
+            descs.push((t.name.clone(), &t.character, Some(&t.control)));
+        }
+        let mut out = Guard::new(
+            ctx,
+            Self {
+                live: Vec::new(),
+                controlled: Vec::new(),
+                timeline: Timeline::default(),
+                fired: Vec::new(),
+                quiet: sw.common.quiet,
+            },
+        );
+        for (name, cdesc, control) in descs {
+            // A liquid character hides its mesh unless asked.
+            let show = sw.character.show_mesh.unwrap_or(match control {
+                Some(_) => ShowMesh::Off,
+                None => ShowMesh::Shaded,
+            });
+            let character = Guard::new(ctx, SceneCharacter::new(ctx, cdesc, method, show)?);
+            let control = match control {
+                Some(d) => {
+                    let t = ControlTarget::new(
+                        ctx,
+                        solver,
+                        &character.ch,
+                        &character.anim,
+                        &d.with_switches(sw),
+                        &scene.fluid,
+                        (scene.domain.min, scene.domain.max),
+                        sw.common.seed,
+                    )?;
+                    let m = ControlMetrics::new(ctx, st.n, t.count(), &name, slots)?;
+                    let i = out.live.len();
+                    out.controlled.push(i);
+                    Some((t, m))
+                }
+                None => None,
+            };
+            out.live.push(Live {
+                name,
+                character: character.take(),
+                control,
+                poses: vec![None; slots],
+            });
+        }
+        let names = scene.control_targets();
+        out.timeline = match scene.timeline.is_empty() {
+            true => Timeline::all_attached(&names),
+            false => Timeline::new(&scene.name, &scene.timeline, &names)?,
+        };
+        let t = out.take();
+        for (k, &i) in t.controlled.iter().enumerate() {
+            let (c, _) = t.live[i].control.as_ref().expect("a control target");
+            c.force
+                .set_attached(t.timeline.attached(k), t.timeline.strength(k));
+        }
+        Ok(t)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.live.is_empty()
+    }
+
+    /// Before the frame's steps: fire the events due at scene time `t` and set every
+    /// attached target's pose (`frame_dt` after the previous one).
+    pub fn record_poses(&mut self, frame: u64, t: f64, frame_dt: f32, slot: usize) -> Result<()> {
+        for (event, changes) in self.timeline.due(t) {
+            if !self.quiet {
+                eprintln!("t = {t:.3} s (frame {frame}): {}", event.describe());
+            }
+            for (k, attached, strength) in changes {
+                let (c, _) = self.live[self.controlled[k]]
+                    .control
+                    .as_ref()
+                    .expect("control");
+                c.force.set_attached(attached, strength);
+            }
+            self.fired.push(FiredEvent {
+                frame,
+                time: t,
+                event,
+            });
+        }
+        for l in &mut self.live {
+            l.poses[slot] = None;
+            let Some((c, _)) = l.control.as_ref().filter(|(c, _)| c.force.attached()) else {
+                continue;
+            };
+            let ch = &l.character;
+            let mats = ch.anim.joint_matrices(&ch.ch, (t * ch.speed as f64) as f32);
+            c.set_pose(&ch.ch, &mats, frame_dt)?;
+            l.poses[slot] = Some((mats, t));
+        }
+        Ok(())
+    }
+
+    /// After the frame's steps: the attached targets' metric copies, and the shown
+    /// characters skinned to scene time `t` for the view.
+    pub fn record_after(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        st: &SphState,
+        t: f64,
+        slot: usize,
+    ) -> Result<()> {
+        for l in &self.live {
+            if let (Some((c, m)), Some(_)) = (&l.control, &l.poses[slot]) {
+                prof.begin(ctx, cmd, "control-metrics");
+                m.record(ctx, cmd, st, &c.force, slot)?;
+                prof.end(ctx, cmd);
+            }
+            if l.character.show != ShowMesh::Off {
+                l.character.record(ctx, cmd, prof, t)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The mesh the view draws: the first shown character (attached, if a target).
+    pub fn draw(&self) -> Option<MeshDraw<'_>> {
+        self.live
+            .iter()
+            .filter(|l| l.control.as_ref().is_none_or(|(c, _)| c.force.attached()))
+            .find_map(|l| l.character.draw())
+    }
+
+    pub fn show(&self) -> ShowMesh {
+        self.live
+            .iter()
+            .map(|l| l.character.show)
+            .find(|s| *s != ShowMesh::Off)
+            .unwrap_or(ShowMesh::Off)
+    }
+
+    /// After the slot's fence: the metrics of frame `frame` for every target it posed.
+    pub fn retire(
+        &mut self,
+        slot: usize,
+        frame: u64,
+        fluid: &crate::sph::FluidParams,
+    ) -> Result<()> {
+        for l in &mut self.live {
+            let (Some((c, m)), Some((mats, time))) = (&mut l.control, l.poses[slot].take()) else {
+                continue;
+            };
+            let ch = &l.character;
+            let (mesh, _) = ch.ch.skinned_at(&mats, ch.method)?;
+            let spacing = c.desc.spacing.unwrap_or(fluid.spacing());
+            m.retire(
+                slot,
+                frame,
+                time,
+                (&mesh, &ch.ch.mesh.indices),
+                &c.force,
+                c.force.settings.group,
+                fluid.rest_density,
+                spacing,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// `stats.character`: the first character's.
+    pub fn character_stats(&self) -> Result<Option<CharacterStats>> {
+        self.live.first().map(|l| l.character.stats()).transpose()
+    }
+
+    /// `stats.control` (None without control targets), and control.csv in `out`: every
+    /// target's rows, by frame.
+    pub fn control_summary(&self, out: &std::path::Path) -> Result<Option<ControlSummary>> {
+        if self.controlled.is_empty() {
+            return Ok(None);
+        }
+        let mut rows: Vec<_> = Vec::new();
+        let mut targets = Vec::new();
+        for &i in &self.controlled {
+            let l = &self.live[i];
+            let (c, m) = l.control.as_ref().expect("control");
+            rows.extend(m.rows.iter().cloned());
+            let mut s = m.stats.clone();
+            s.settings = Some(c.force.settings.clone());
+            s.placement = Some(c.desc.placement);
+            targets.push(s);
+        }
+        rows.sort_by_key(|r| r.frame);
+        crate::control::metrics::write_csv(&out.join("control.csv"), &rows)?;
+        Ok(Some(ControlSummary {
+            targets,
+            events: self.fired.clone(),
+        }))
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for l in &mut self.live {
+            if let Some((_, m)) = &mut l.control {
+                m.destroy(ctx);
+            }
+            l.character.destroy(ctx);
+        }
+    }
+
+    pub fn name(&self, i: usize) -> &str {
+        &self.live[i].name
+    }
+}
+crate::impl_destroy!(SceneTargets);
