@@ -92,6 +92,15 @@ pub fn variants() -> Vec<Variant> {
             }
         }
     }
+    use crate::control::rays::RaysIo;
+    for f in ["control/rays_count.comp", "control/rays_emit.comp"] {
+        v.push(with::<RaysIo>(f, &[]));
+    }
+    for pass in 0..2 {
+        let d = [kv("PASS", pass)];
+        v.push(with::<RaysIo>("control/rays.vert", &d));
+        v.push(with::<RaysIo>("control/rays.frag", &d));
+    }
     use crate::render::metaball::renderer::MetaballIo;
     for list in [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer] {
         for material in [

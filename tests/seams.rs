@@ -347,7 +347,13 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "ControlParams",
             fields!(fluidform::control::force::ControlGpuParams;
             grid, dims, pressure, radius, spiky_grad, velocity, adaptive, low, high, up, down,
-            inv_frame, group, pad),
+            inv_frame, group, live),
+        ),
+        (
+            "control/rays_emit.comp",
+            "Push",
+            fields!(fluidform::control::rays::RaysGpuPush;
+            lo, dims, capacity, triangles, pixels, pad),
         ),
         (
             "character/skin.comp",
