@@ -19,8 +19,12 @@ fn gpu_rays(
     capacity: u32,
 ) -> (Vec<Vec3>, u32, u32) {
     let v4: Vec<[f32; 4]> = pos.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
-    let mut vb = ctx.storage_buffer("test verts", v4.len() as u64 * 16).unwrap();
-    let mut ib = ctx.storage_buffer("test indices", idx.len() as u64 * 4).unwrap();
+    let mut vb = ctx
+        .storage_buffer("test verts", v4.len() as u64 * 16)
+        .unwrap();
+    let mut ib = ctx
+        .storage_buffer("test indices", idx.len() as u64 * 4)
+        .unwrap();
     ctx.upload(&mut vb, 0, &v4).unwrap();
     ctx.upload(&mut ib, 0, idx).unwrap();
     let mut r = RaysPlacer::new(ctx, grid, capacity, 1e3).unwrap();
@@ -69,14 +73,20 @@ fn rays_placement_matches_the_winding_number() {
         let spacing = (hi - lo).max_element() / 50.0;
         let grid = RaysGrid::new((lo - pad).into(), (hi + pad).into(), spacing).unwrap();
         let (pts, frags, n) = gpu_rays(&ctx, pos, idx, grid, 200_000);
-        assert!(frags > 0 && n as usize == pts.len(), "{name}: {n} particles");
+        assert!(
+            frags > 0 && n as usize == pts.len(),
+            "{name}: {n} particles"
+        );
         let got: HashSet<[i64; 3]> = pts.iter().map(|p| key(&grid, *p)).collect();
         assert_eq!(got.len(), pts.len(), "{name}: a lattice point placed twice");
         // Every placed point is a lattice point.
         for p in &pts {
             let k = key(&grid, *p);
             let q = grid.point(k[0] as u32, k[1] as u32, k[2] as u32);
-            assert!(q.distance(*p) < 1e-4 * spacing, "{name}: {p} off the lattice");
+            assert!(
+                q.distance(*p) < 1e-4 * spacing,
+                "{name}: {p} off the lattice"
+            );
         }
         // The reference: the CPU inside test (signed crossings, itself checked against the
         // winding number); where it and the GPU differ, the winding number decides, and
@@ -194,7 +204,11 @@ fn overlapping_parts_give_their_union_and_overflow_is_reported() {
     assert!(frags as usize > 2 * 36, "{frags} fragments");
     // Too small a capacity: the count says so and the placer reports it.
     let (_, frags, n) = gpu_rays(&ctx, &pos, &idx, grid, 100);
-    assert_eq!(n as usize, want.len(), "the full count even when it overflows");
+    assert_eq!(
+        n as usize,
+        want.len(),
+        "the full count even when it overflows"
+    );
     let r = RaysPlacer::new(&ctx, grid, 100, 1e3).unwrap();
     let e = r.check(frags, n).unwrap_err().to_string();
     assert!(e.contains("overflow the capacity 100"), "{e}");

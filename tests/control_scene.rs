@@ -76,8 +76,123 @@ fn play(path: &str, out: &Path, frames: u64, extra: &[&str]) -> fluidform::run::
 
 fn control_of(r: &fluidform::run::RunResult) -> fluidform::control::metrics::ControlStats {
     match &r.summary.stats {
-        RunStats::Sph(s) => s.control.clone().expect("stats.control"),
+        RunStats::Sph(s) => s.control.clone().expect("stats.control").targets[0].clone(),
         _ => panic!("not an SPH run"),
+    }
+}
+
+/// A ball of water high inside a capsule target, released at 0.2 s: until then the control
+/// slows its fall; after it, its centre of mass falls freely.
+#[test]
+fn release_returns_the_fluid_to_free_fall() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+name = "release"
+[domain]
+min = [-0.3, 0.0, -0.3]
+max = [0.3, 1.2, 0.3]
+[fluid]
+eos = "tait"
+sound_speed = 20.0
+clamp_negative_pressure = true
+dt = 0.0009
+substeps = 12
+[[balls]]
+center = [0.0, 0.78, 0.0]
+radius = 0.07
+[character]
+file = "builtin:capsule"
+position = [0.0, 0.6, 0.0]
+[control]
+adaptive = "on"
+[[timeline]]
+time = 0.0
+action = "attach"
+target = "character"
+[[timeline]]
+time = 0.2
+action = "release"
+"#;
+    let path = dir.path().join("release.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let r = play(
+        path.to_str().unwrap(),
+        &out,
+        28,
+        &["--export", "ply", "--export-every", "1"],
+    );
+    let RunStats::Sph(st) = &r.summary.stats else {
+        panic!("not an SPH run")
+    };
+    let c = st.control.clone().unwrap();
+    assert_eq!(c.events.len(), 2, "{:?}", c.events);
+    let released = c.events[1].frame as usize;
+    let frame_time = st.simulated_seconds / 28.0;
+    assert!(
+        (c.events[1].time - 0.2).abs() <= frame_time,
+        "released at {}",
+        c.events[1].time
+    );
+    let com = |f: usize| {
+        let ps = read_ply(&r.exports[f]);
+        ps.iter().map(|(_, p)| p[1] as f64).sum::<f64>() / ps.len() as f64
+    };
+    // Attached: the control slows the fall (the ball, a quarter of the capsule's volume,
+    // spreads into its lower part), far short of the free fall's 0.2 m by 0.2 s.
+    let t0 = (released - 1) as f64 * frame_time + frame_time;
+    let fell = 0.78 - com(released - 1);
+    assert!(
+        fell < 0.75 * 0.5 * 9.81 * t0 * t0,
+        "fell {fell} m in {t0} s while attached"
+    );
+    let rows: Vec<Vec<String>> = std::fs::read_to_string(out.join("control.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    let inside: f64 = rows.last().unwrap()[3].parse().unwrap();
+    assert!(inside > 0.9, "inside fraction {inside} when released");
+    // Released: y'' = -g (second differences 3 frames apart, before the first drops
+    // thrown out while attached reach the floor).
+    let (a, b, d) = (com(released + 1), com(released + 4), com(released + 7));
+    let dt = 3.0 * frame_time;
+    let acc = (d - 2.0 * b + a) / (dt * dt);
+    assert!(
+        (acc + 9.81).abs() < 0.05 * 9.81,
+        "centre of mass acceleration {acc} m/s^2 after release"
+    );
+    // The control records no passes once released: its metric rows stop.
+    let csv = std::fs::read_to_string(out.join("control.csv")).unwrap();
+    assert_eq!(csv.lines().count() - 1, released, "{csv}");
+}
+
+/// Timelines that cannot play are refused when the scene loads, with the event named.
+#[test]
+fn bad_timelines_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = scene(dir.path(), "tl", "[control]", 9e-4, 12);
+    let base = std::fs::read_to_string(base).unwrap();
+    let cases = [
+        ("time = -1.0\naction = \"attach\"\ntarget = \"character\"", "time must be at least 0"),
+        ("time = 0.0\naction = \"attach\"\ntarget = \"nobody\"", "no control target named 'nobody'"),
+        ("time = 0.0\naction = \"union\"\ntarget = \"character\"", "use attach"),
+        ("time = 0.0\naction = \"release\"", "release with no target attached"),
+        ("time = 0.0\naction = \"attach\"\ntarget = \"character\"\n[[timeline]]\ntime = 1.0\naction = \"attach\"\ntarget = \"character\"", "already attached"),
+        ("time = 0.0\naction = \"fly\"", "unknown variant"),
+    ];
+    for (i, (event, needle)) in cases.iter().enumerate() {
+        let p = dir.path().join(format!("bad{i}.toml"));
+        std::fs::write(&p, format!("{base}\n[[timeline]]\n{event}\n")).unwrap();
+        let e = fluidform::sph::Scene::load(p.to_str().unwrap())
+            .err()
+            .unwrap_or_else(|| panic!("case {i} loaded"))
+            .to_string();
+        assert!(
+            e.contains(needle) && e.lines().count() == 1,
+            "case {i}: {e}"
+        );
     }
 }
 
@@ -217,6 +332,30 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     ] {
         assert!(t.contains(scope), "{scope} missing: {t}");
     }
+    // Rays re-place every frame in their own scope.
+    let rays = dir.path().join("rays");
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        "character",
+        "--frames",
+        "3",
+        "--render",
+        "points",
+        "--placement",
+        "rays",
+        "--quiet",
+        "--validation",
+        "--out",
+        rays.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert!(o.status.success() && t.contains("sph/control/place"), "{t}");
+    let s = summary(&rays);
+    let n = s["stats"]["control"]["targets"][0]["control_particles"]
+        .as_u64()
+        .unwrap();
+    assert!(n > 500, "{n} control particles placed by rays");
     assert_eq!(
         std::fs::read_to_string(out.join("control.csv"))
             .unwrap()
@@ -246,8 +385,15 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
     let fails: [(&[&str], &str); 4] = [
         (
-            &["--scene", "character", "--placement", "rays"],
-            "not implemented yet",
+            &[
+                "--scene",
+                "character",
+                "--placement",
+                "rays",
+                "--control-velocity",
+                "1",
+            ],
+            "persist between frames",
         ),
         (
             &["--scene", "character", "--control-pressure=-1"],

@@ -557,8 +557,20 @@ impl Scene {
             path: name_or_path.into(),
             source: e,
         })?;
-        let mut s: Scene = toml::from_str(&text)
-            .map_err(|e| Error::Param(format!("scene file {name_or_path}: {e}")))?;
+        let mut s: Scene = toml::from_str(&text).map_err(|e| {
+            // One line: where, then what (the parser's own text draws the line).
+            let at = e.span().map(|r| {
+                let before = &text[..r.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                format!(" line {line} column {col}:")
+            });
+            Error::Param(format!(
+                "scene file {name_or_path}:{} {}",
+                at.unwrap_or_default(),
+                e.message().trim().replace('\n', " ")
+            ))
+        })?;
         // A character file is named relative to the scene file.
         let dir = path.parent().unwrap_or(Path::new("."));
         let chars = s.character.iter_mut();
