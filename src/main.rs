@@ -37,7 +37,7 @@ enum Command {
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
         /// Built-in scene (character, demo, dam-break, drop, resting-block, walker, giraffe,
-        /// orbits) or a TOML scene file
+        /// union, morph, two-groups, orbits) or a TOML scene file
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: String,
         /// Frames to play (default: the scene's own count)
@@ -158,6 +158,10 @@ enum BenchWhat {
         /// Scene with a [control] target (built-in name or TOML file; default giraffe)
         #[arg(long)]
         scene: Option<String>,
+        /// Velocity-term gains K to sweep beside the adaptive modes (default: 0, or
+        /// --control-velocity)
+        #[arg(long, value_delimiter = ',', value_name = "K,...")]
+        velocities: Vec<f32>,
     },
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
@@ -199,7 +203,15 @@ impl SphBench {
 
 impl BenchWhat {
     /// The benchmark's name and its switches (groups it does not take at their defaults).
-    fn into_parts(self) -> (&'static str, Switches, Option<String>, Option<u32>) {
+    fn into_parts(
+        self,
+    ) -> (
+        &'static str,
+        Switches,
+        Option<String>,
+        Option<u32>,
+        Vec<f32>,
+    ) {
         let d = Switches::default;
         let (what, sw) = match self {
             BenchWhat::Skin {
@@ -217,6 +229,7 @@ impl BenchWhat {
                     },
                     file,
                     vertices,
+                    Vec::new(),
                 )
             }
             BenchWhat::Control {
@@ -225,6 +238,7 @@ impl BenchWhat {
                 character,
                 fluid_args,
                 scene,
+                velocities,
             } => {
                 let sw = Switches {
                     common,
@@ -233,7 +247,7 @@ impl BenchWhat {
                     fluid_args,
                     ..d()
                 };
-                return ("control", sw, scene, None);
+                return ("control", sw, scene, None, velocities);
             }
             BenchWhat::Scan { common } => ("scan", Switches { common, ..d() }),
             BenchWhat::Sort { common, sorting } => (
@@ -275,7 +289,7 @@ impl BenchWhat {
                 },
             ),
         };
-        (what, sw, None, None)
+        (what, sw, None, None, Vec::new())
     }
 }
 
@@ -360,7 +374,7 @@ fn real_main() -> Result<()> {
             warmup,
             budget_s,
         } => {
-            let (what, switches, character, vertices) = what.into_parts();
+            let (what, switches, character, vertices, velocities) = what.into_parts();
             let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
                 what: what.to_string(),
                 out: out.clone(),
@@ -370,6 +384,7 @@ fn real_main() -> Result<()> {
                 switches,
                 character,
                 vertices,
+                velocities,
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{} configurations; wrote {}", rows.len(), out.display());

@@ -31,6 +31,8 @@ pub struct BenchOptions {
     pub character: Option<String>,
     /// bench skin: vertices of the generated mesh (default 1M).
     pub vertices: Option<u32>,
+    /// bench control: velocity-term gains to sweep (empty: --control-velocity or 0).
+    pub velocities: Vec<f32>,
 }
 
 /// `config` of one benchmark configuration's summary.json.

@@ -222,3 +222,54 @@ pub fn sweep_dated(
     }
     root.present().map_err(|e| err(path, e))
 }
+
+/// Coverage over scene time, one line per variant (`series`: name, (time, coverage)).
+pub fn coverage(
+    path: &Path,
+    title: &str,
+    device: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    font()?;
+    let caption = format!("{title}: {device}, {}", today());
+    let tmax = series
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| q.0))
+        .fold(0.0f64, f64::max)
+        .max(1e-3);
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..tmax, 0.0..1.0)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("scene time (s)")
+        .y_desc("coverage (control particles with rho >= 0.5 rho0)")
+        .draw()
+        .map_err(|e| err(path, e))?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        chart
+            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+            .map_err(|e| err(path, e))?
+            .label(name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
+    }
+    let gray = RGBColor(150, 150, 150);
+    chart
+        .draw_series(LineSeries::new(vec![(0.0, 0.9), (tmax, 0.9)], gray))
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    root.present().map_err(|e| err(path, e))
+}

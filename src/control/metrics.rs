@@ -38,6 +38,13 @@ pub struct ControlStats {
     pub settings: Option<super::force::ControlSettings>,
     /// First scene time at which coverage reached 0.9 (None: never).
     pub time_to_90: Option<f64>,
+    /// ... and 0.8 (a filled shape's coverage plateaus near 0.85: control particles
+    /// within a kernel radius of the surface see a free surface's partial density).
+    pub time_to_80: Option<f64>,
+    /// The target's animation cycle in scene seconds (clip duration / speed), and the
+    /// mean inside fraction over the run's last cycle (None: no clip, or a shorter run).
+    pub cycle_s: Option<f64>,
+    pub mean_inside_last_cycle: Option<f64>,
     pub last: Option<ControlRow>,
     /// Means over every frame.
     pub mean_inside_fraction: f64,
@@ -202,6 +209,9 @@ impl ControlMetrics {
         if st.time_to_90.is_none() && row.coverage >= 0.9 {
             st.time_to_90 = Some(time);
         }
+        if st.time_to_80.is_none() && row.coverage >= 0.8 {
+            st.time_to_80 = Some(time);
+        }
         if row.density_ratio_max > 1.5 {
             st.frames_out_of_band += 1;
         }
@@ -211,6 +221,25 @@ impl ControlMetrics {
         st.last = Some(row.clone());
         self.rows.push(row);
         Ok(self.rows.last().unwrap())
+    }
+
+    /// `cycle_s` and `mean_inside_last_cycle` for a target animated with period `cycle`.
+    pub fn finish_cycle(&mut self, cycle: Option<f64>) {
+        let st = &mut self.stats;
+        st.cycle_s = cycle;
+        st.mean_inside_last_cycle = match (cycle, self.rows.first(), self.rows.last()) {
+            (Some(c), Some(a), Some(b)) if b.time - a.time >= c => {
+                let from = b.time - c;
+                let tail: Vec<f64> = self
+                    .rows
+                    .iter()
+                    .filter(|r| r.time >= from)
+                    .map(|r| r.inside_fraction)
+                    .collect();
+                Some(tail.iter().sum::<f64>() / tail.len() as f64)
+            }
+            _ => None,
+        };
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

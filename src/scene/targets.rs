@@ -228,7 +228,19 @@ impl SceneTargets {
 
     /// `stats.control` (None without control targets), and control.csv in `out`: every
     /// target's rows, by frame.
-    pub fn control_summary(&self, out: &std::path::Path) -> Result<Option<ControlSummary>> {
+    pub fn control_summary(&mut self, out: &std::path::Path) -> Result<Option<ControlSummary>> {
+        for l in &mut self.live {
+            let ch = &l.character;
+            let cycle = ch
+                .anim
+                .clip
+                .map(|c| ch.ch.clips[c].duration as f64)
+                .filter(|d| *d > 0.0 && ch.speed > 0.0)
+                .map(|d| d / ch.speed as f64);
+            if let Some((_, m)) = &mut l.control {
+                m.finish_cycle(cycle);
+            }
+        }
         if self.controlled.is_empty() {
             return Ok(None);
         }
