@@ -2,12 +2,13 @@
 # Regenerate results/<device-slug>/control.md and its plots:
 # 1. the built-in giraffe (neck 2.5 rest spacings thick) and giraffe.obj filled from a
 #    pool with --adaptive off, on and smooth: times to 80% and 90% coverage;
-# 2. CesiumMan walking (tests/scenes/cesium_man_liquid.toml): every --adaptive mode with
-#    --control-velocity 0 and 5, the inside fraction over the last walk cycle;
+# 2. CesiumMan walking (tests/scenes/cesium_man_walk.toml: his own volume of water): every
+#    --adaptive mode with --control-velocity 0 and 5, the inside fraction over the last cycle;
 # 3. --placement rays re-placing about 3000 control particles every frame in the built-in
 #    character: its share of the GPU frame.
-# Usage: scripts/bench_control.sh [--device N|NAME] [--frames N] (the giraffes' cap,
-# default 900 frames, 9.7 s; CesiumMan plays 600, rays 60)
+# Usage: [PARTS="giraffe giraffe-obj cesium rays"] scripts/bench_control.sh [--device N|NAME]
+# [--frames N] (the built-in giraffe's cap, default 900 frames, 9.7 s; giraffe.obj plays
+# 600, CesiumMan 400, rays 60)
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,10 +29,12 @@ run() { # out-name, then bench arguments
   cp "out/bench/$name/sweep.csv" "$dir/$name.csv"
   cp "out/bench/$name/coverage.png" "$dir/$name.png"
 }
-run control-giraffe "${args[@]}"
-run control-giraffe-obj --scene tests/scenes/giraffe_liquid.toml "${args[@]}"
-run control-cesium --scene tests/scenes/cesium_man_liquid.toml --velocities 0,5 --frames 600 "${rest[@]}"
-run control-rays --scene character --placement rays --control-spacing 0.0185 --adaptive on --frames 60 "${rest[@]}"
+# PARTS picks what to (re)measure; the page is made from every part's CSV in the folder.
+parts=" ${PARTS:-giraffe giraffe-obj cesium rays} "
+[[ $parts == *" giraffe "* ]] && run control-giraffe "${args[@]}"
+[[ $parts == *" giraffe-obj "* ]] && run control-giraffe-obj --scene tests/scenes/giraffe_liquid.toml --frames 600 "${rest[@]}"
+[[ $parts == *" cesium "* ]] && run control-cesium --scene tests/scenes/cesium_man_walk.toml --velocities 0,5 --frames 400 "${rest[@]}"
+[[ $parts == *" rays "* ]] && run control-rays --scene character --placement rays --control-spacing 0.0185 --adaptive on --frames 60 "${rest[@]}"
 md=$dir/control.md
 table() { # the sweep's table without the per-pass columns
   python3 - "$1" <<'PY'
@@ -64,7 +67,7 @@ PY
   echo
   table "$dir/control-giraffe.csv"
   echo
-  echo "giraffe.obj ([plot](control-giraffe-obj.png)):"
+  echo "giraffe.obj, 600 frames ([plot](control-giraffe-obj.png)):"
   echo
   table "$dir/control-giraffe-obj.csv"
   echo

@@ -339,7 +339,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     if render == RenderKind::Metaballs {
         uses.push(Group::Metaball);
     }
-    if scene.character.is_some() {
+    if scene.character.is_some() || !scene.targets.is_empty() {
         uses.push(Group::Character);
     }
     if !scene.control_targets().is_empty() {

@@ -182,3 +182,52 @@ fn bone_weights_by_eq8_eq9_and_skin() {
     let (j, w) = binding::bind(&ch, &bones, &[p], BoneWeights::Skin, &rest);
     assert_eq!((j[0], w[0]), (ch.mesh.joints[100], ch.mesh.weights[100]));
 }
+
+#[test]
+fn the_timeline_attaches_switches_unites_releases_and_scales() {
+    use fluidform::control::timeline::{Action, Event, Timeline};
+    let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+    let ev = |t: f32, a: Action, who: Option<&str>, k: f32| Event {
+        strength: k,
+        ..Event::new(t, a, who)
+    };
+    // Given out of order: fired by time (file order at equal times).
+    let events = [
+        ev(0.5, Action::Union, Some("b"), 2.0),
+        ev(0.0, Action::Attach, Some("a"), 1.0),
+        ev(0.2, Action::Strength, None, 0.5),
+        ev(1.0, Action::Switch, Some("c"), 1.0),
+        ev(2.0, Action::Release, None, 1.0),
+    ];
+    let mut t = Timeline::new("s", &events, &names).unwrap();
+    let state = |t: &Timeline| -> Vec<(bool, f32)> {
+        (0..3).map(|i| (t.attached(i), t.strength(i))).collect()
+    };
+    assert!(t.due(-0.1).is_empty());
+    assert_eq!(t.due(0.0).len(), 1);
+    assert_eq!(state(&t), [(true, 1.0), (false, 1.0), (false, 1.0)]);
+    // Two events due by 0.6: strength of the attached ones, then the union.
+    let fired: Vec<Action> = t.due(0.6).iter().map(|(e, _)| e.action).collect();
+    assert_eq!(fired, [Action::Strength, Action::Union]);
+    assert_eq!(state(&t), [(true, 0.5), (true, 2.0), (false, 1.0)]);
+    let (_, changes) = &t.due(1.0)[0];
+    assert_eq!(changes.len(), 3, "switch releases a and b, attaches c");
+    assert_eq!(state(&t), [(false, 0.5), (false, 2.0), (true, 1.0)]);
+    t.due(5.0);
+    assert!(state(&t).iter().all(|s| !s.0));
+    // Every target attached from the start without a timeline.
+    let all = Timeline::all_attached(&names);
+    assert!((0..3).all(|i| all.attached(i)));
+    // A strength below zero and a release of a target that is not attached are refused.
+    let bad = [ev(0.0, Action::Attach, Some("a"), -1.0)];
+    assert!(Timeline::new("s", &bad, &names)
+        .unwrap_err()
+        .to_string()
+        .contains("strength must be at least 0"));
+    let bad = [
+        ev(0.0, Action::Attach, Some("a"), 1.0),
+        ev(0.1, Action::Release, Some("b"), 1.0),
+    ];
+    let e = Timeline::new("s", &bad, &names).unwrap_err().to_string();
+    assert!(e.contains("event 2") && e.contains("not attached"), "{e}");
+}
