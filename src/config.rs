@@ -222,6 +222,12 @@ pub struct ControlArgs {
     /// smooth (ours: fades from x2 to 0 between 80% and 120%)
     #[arg(long, value_enum)]
     pub adaptive: Option<Adaptive>,
+    /// Adaptive thresholds as fractions of rho_0 (default 0.8,1.2)
+    #[arg(long, value_delimiter = ',', value_name = "LOW,HIGH")]
+    pub adaptive_thresholds: Option<Vec<f32>>,
+    /// Adaptive factors below LOW and above HIGH (default 2,0.5)
+    #[arg(long, value_delimiter = ',', value_name = "UP,DOWN")]
+    pub adaptive_factors: Option<Vec<f32>>,
     /// K of a velocity term pulling the fluid to the control particles' velocity (0: off)
     #[arg(long)]
     pub control_velocity: Option<f32>,

@@ -383,7 +383,15 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     let s = summary(&big);
     let h = s["stats"]["character"]["height"].as_f64().unwrap();
     assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
-    let fails: [(&[&str], &str); 4] = [
+    let fails: [(&[&str], &str); 6] = [
+        (
+            &["--scene", "character", "--adaptive-thresholds", "1.3,1.2"],
+            "0 < low < high",
+        ),
+        (
+            &["--scene", "character", "--adaptive-factors", "2"],
+            "--adaptive-factors takes two numbers",
+        ),
         (
             &[
                 "--scene",

@@ -21,6 +21,12 @@ fn eq8() -> BoneWeights {
 fn off() -> Adaptive {
     Adaptive::Off
 }
+fn thresholds() -> [f32; 2] {
+    [0.8, 1.2]
+}
+fn factors() -> [f32; 2] {
+    [2.0, 0.5]
+}
 fn default_pressure() -> f32 {
     DEFAULT_PRESSURE
 }
@@ -47,6 +53,11 @@ pub struct ControlDesc {
     pub radius: Option<f32>,
     #[serde(default = "off")]
     pub adaptive: Adaptive,
+    /// Adaptive thresholds (fractions of rho_0) and factors below and above them.
+    #[serde(default = "thresholds")]
+    pub thresholds: [f32; 2],
+    #[serde(default = "factors")]
+    pub factors: [f32; 2],
     #[serde(default)]
     pub velocity: f32,
     /// The controlled group (default: all).
@@ -63,26 +74,44 @@ impl Default for ControlDesc {
             pressure: DEFAULT_PRESSURE,
             radius: None,
             adaptive: off(),
+            thresholds: thresholds(),
+            factors: factors(),
             velocity: 0.0,
             group: None,
         }
     }
 }
 
+/// The two values of switch `name`, if given.
+fn pair(name: &str, v: &Option<Vec<f32>>) -> Result<Option<[f32; 2]>> {
+    match v.as_deref() {
+        None => Ok(None),
+        Some([a, b]) => Ok(Some([*a, *b])),
+        Some(v) => Err(Error::Param(format!(
+            "{name} takes two numbers separated by a comma, got {}",
+            v.len()
+        ))),
+    }
+}
+
 impl ControlDesc {
     /// This target with the control switches applied.
-    pub fn with_switches(&self, sw: &Switches) -> Self {
+    pub fn with_switches(&self, sw: &Switches) -> Result<Self> {
         let c = &sw.control;
-        Self {
+        let thresholds = pair("--adaptive-thresholds", &c.adaptive_thresholds)?;
+        let factors = pair("--adaptive-factors", &c.adaptive_factors)?;
+        Ok(Self {
             placement: c.placement.unwrap_or(self.placement),
             spacing: c.control_spacing.or(self.spacing),
             bone_weights: c.bone_weights.unwrap_or(self.bone_weights),
             pressure: c.control_pressure.unwrap_or(self.pressure),
             radius: c.control_radius.or(self.radius),
             adaptive: c.adaptive.unwrap_or(self.adaptive),
+            thresholds: thresholds.unwrap_or(self.thresholds),
+            factors: factors.unwrap_or(self.factors),
             velocity: c.control_velocity.unwrap_or(self.velocity),
             group: self.group,
-        }
+        })
     }
 
     pub fn settings(&self, h: f32) -> ControlSettings {
@@ -90,10 +119,10 @@ impl ControlDesc {
             pressure: self.pressure,
             radius: self.radius.unwrap_or(2.0 * h),
             adaptive: self.adaptive,
-            low: 0.8,
-            high: 1.2,
-            up: 2.0,
-            down: 0.5,
+            low: self.thresholds[0],
+            high: self.thresholds[1],
+            up: self.factors[0],
+            down: self.factors[1],
             velocity: self.velocity,
             group: self.group.unwrap_or(ALL_GROUPS),
         }

@@ -83,7 +83,7 @@ impl SceneTargets {
                         solver,
                         &character.ch,
                         &character.anim,
-                        &d.with_switches(sw),
+                        &d.with_switches(sw)?,
                         &scene.fluid,
                         (scene.domain.min, scene.domain.max),
                         sw.common.seed,
