@@ -228,6 +228,7 @@ fn liquid(
         }),
         frames: 150,
         look: Look {
+            material: Some(crate::config::Material::Tinted),
             size: Some([240, 240]),
             tank: Some(false),
             ..Look::default()
