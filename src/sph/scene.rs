@@ -246,6 +246,23 @@ fn liquid(
     }
 }
 
+/// `liquid` in a 1.2 m wide box (room for a second target), the walker at `x`, 320 x 240.
+fn wide(name: &str, x: f32) -> Scene {
+    let mut s = liquid(
+        name,
+        ([-0.6, 0.0, -0.3], [0.6, 1.2, 0.3]),
+        0.1,
+        "builtin:walker",
+        0.5,
+        [0.0, 2.8],
+    );
+    if let Some(c) = &mut s.character {
+        c.position = [x, 0.0, 0.0];
+    }
+    s.look.size = Some([320, 240]);
+    s
+}
+
 /// The built-in capsule, `height` tall, standing at `at`.
 fn capsule(height: f32, at: [f32; 3]) -> crate::scene::character::CharacterDesc {
     crate::scene::character::CharacterDesc {
@@ -450,18 +467,7 @@ impl Scene {
             },
             // The walker fills; at 0.8 s a capsule beside it is added to the target.
             "union" => {
-                let mut s = liquid(
-                    name,
-                    ([-0.6, 0.0, -0.3], [0.6, 1.2, 0.3]),
-                    0.1,
-                    "builtin:walker",
-                    0.5,
-                    [0.0, 2.8],
-                );
-                if let Some(c) = &mut s.character {
-                    c.position = [-0.2, 0.0, 0.0];
-                }
-                s.look.size = Some([320, 240]);
+                let mut s = wide(name, -0.2);
                 s.frames = 200;
                 s.targets = vec![target("capsule", capsule(0.6, [0.3, 0.0, 0.0]), None)];
                 s.timeline = vec![
@@ -474,14 +480,7 @@ impl Scene {
             // blue out, a capsule beside it the orange (each target reaches the fluid
             // within h_c of its control particles); released at 1.5 s, they mix.
             "two-groups" => {
-                let mut s = liquid(
-                    name,
-                    ([-0.6, 0.0, -0.3], [0.6, 1.2, 0.3]),
-                    0.1,
-                    "builtin:walker",
-                    0.5,
-                    [0.0, 2.8],
-                );
+                let mut s = wide(name, -0.2);
                 // Stripes 0.1 m wide along x.
                 s.blocks = (0..12)
                     .map(|k| Block {
@@ -492,15 +491,11 @@ impl Scene {
                         velocity: [0.0; 3],
                     })
                     .collect();
-                if let Some(c) = &mut s.character {
-                    c.position = [-0.2, 0.0, 0.0];
-                }
                 // Points show the groups' colours (metaballs have one material).
                 s.look.render = Some(crate::config::RenderKind::Points);
                 if let Some(c) = &mut s.control {
                     c.group = Some(0);
                 }
-                s.look.size = Some([320, 240]);
                 s.frames = 220;
                 s.targets = vec![target("capsule", capsule(0.6, [0.3, 0.0, 0.0]), Some(1))];
                 s.timeline = vec![
