@@ -168,6 +168,28 @@ action = "release"
     assert_eq!(csv.lines().count() - 1, released, "{csv}");
 }
 
+/// Rays re-place the capsule's particles every frame (its surface has fewer vertices
+/// than the particles' capacity: nothing copies by the vertex count).
+#[test]
+fn rays_fill_the_capsule_frame_after_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    // (c_cp scaled by the spacing cubed: eq. 7 sums over every control particle.)
+    let control = "[control]\nplacement = \"rays\"\nspacing = 0.015\npressure = 1e-4";
+    let path = scene(dir.path(), "rays", control, 9e-4, 12);
+    let r = play(&path, &dir.path().join("out"), 30, &[]);
+    let c = control_of(&r);
+    assert_eq!(c.placement, Some(fluidform::config::Placement::Rays));
+    // The capsule's lattice: about its volume (0.0061 m^3) over spacing^3, 1800.
+    let n = c.control_particles;
+    assert!((1500..2100).contains(&n), "{n} control particles");
+    let last = c.last.unwrap();
+    assert!(
+        last.coverage > 0.2,
+        "coverage {} after 30 frames",
+        last.coverage
+    );
+}
+
 /// Timelines that cannot play are refused when the scene loads, with the event named.
 #[test]
 fn bad_timelines_fail_clearly() {

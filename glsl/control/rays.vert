@@ -3,6 +3,8 @@
 // the pixel grid (no depth test, no culling); each vertex carries its triangle's sign
 // (+1 where the outward normal faces -z: a ray going +z enters there) and its world z.
 #include "rays.glsl"
+// The count and fill passes must rasterise the same fragments.
+invariant gl_Position;
 layout(location = 0) out float v_z;
 layout(location = 1) flat out float v_sign;
 void main() {

@@ -20,7 +20,7 @@ void main() {
     float wind = 0.0;
     for (uint i = s; i < e; ++i) {
         vec2 f = frags[i];
-        if (wind > 0.5 && i > s) n += uint(max(first_step(f.x) - first_step(frags[i - 1u].x), 0));
+        if (abs(wind) > 0.5 && i > s) n += uint(max(first_step(f.x) - first_step(frags[i - 1u].x), 0));
         wind += f.y;
     }
     emit[p] = n;

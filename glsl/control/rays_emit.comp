@@ -12,7 +12,7 @@ void main() {
     float wind = 0.0;
     for (uint i = s; i < e; ++i) {
         vec2 f = frags[i];
-        if (wind > 0.5 && i > s) {
+        if (abs(wind) > 0.5 && i > s) {
             int k1 = first_step(f.x);
             for (int k = first_step(frags[i - 1u].x); k < k1; ++k) {
                 if (o < pc.capacity) outp[o] = vec4(xy, pc.lo.z + (float(k) + 0.5) * pc.lo.w, 0.0);

@@ -107,7 +107,7 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
                         "final inside".into(),
                         format!("{:.3}", last.inside_fraction),
                     ),
-                    ("inside, last cycle".into(), cycle),
+                    ("inside last cycle".into(), cycle),
                     ("mean coverage".into(), format!("{:.3}", c.mean_coverage)),
                     ("place share".into(), place),
                     (

@@ -233,7 +233,9 @@ impl ControlForce {
         // Rays: three more layers above the domain in z, the last one parking the unused
         // slots two cells away from any fluid particle's.
         let r = settings.radius;
-        let top = [domain.1[0], domain.1[1], domain.1[2] + 3.0 * r];
+        let spacing = rays.map_or(0.0, |(s, _)| s);
+        // (Lattice steps reach half a spacing past the domain's top.)
+        let top = [domain.1[0], domain.1[1], domain.1[2] + spacing + 3.0 * r];
         let grid = match rays {
             Some(_) => GridSpec::covering(domain.0, top, r)?,
             None => GridSpec::covering(domain.0, domain.1, r)?,
@@ -246,7 +248,7 @@ impl ControlForce {
                     .iter()
                     .chain(&domain.1)
                     .fold(0f32, |a, v| a.max(v.abs()));
-                let park = far + 3.0 * r + 1.0;
+                let park = far + spacing + 3.0 * r + 1.0;
                 Some(Guard::new(
                     ctx,
                     super::rays::RaysPlacer::new(ctx, g, capacity, park)?,
@@ -363,7 +365,8 @@ impl ControlForce {
             sync::COMPUTE_READ | sync::COMPUTE_WRITE,
             sync::TRANSFER_READ | sync::TRANSFER_WRITE,
         );
-        if !first {
+        // (Rays: the surface is skinned, not the particles; they have no previous pose.)
+        if !first && g.rays.is_none() {
             ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
         }
         ctx.update(cmd, &g.params, 0, &[self.gpu_params(g, pose.frame_dt)]);
