@@ -191,6 +191,7 @@ fn the_timeline_attaches_switches_unites_releases_and_scales() {
         strength: k,
         ..Event::new(t, a, who)
     };
+    assert_eq!(Event::new(0.0, Action::Release, None).fade(), 0.2);
     // Given out of order: fired by time (file order at equal times).
     let events = [
         ev(0.5, Action::Union, Some("b"), 2.0),

@@ -112,6 +112,7 @@ target = "character"
 [[timeline]]
 time = 0.2
 action = "release"
+fade = 0.0
 "#;
     let path = dir.path().join("release.toml");
     std::fs::write(&path, text).unwrap();

@@ -48,7 +48,15 @@ pub struct Event {
     /// Factor on the target's c_cp (attach, switch, union, strength).
     #[serde(default = "one")]
     pub strength: f32,
+    /// Seconds over which a released target's pull fades to nothing (release, and the
+    /// targets a switch lets go; default FADE). A held shape is compressed a little, and
+    /// letting go at once turns that pressure into an explosion.
+    #[serde(default)]
+    pub fade: Option<f32>,
 }
+
+/// Default fade of a release (seconds).
+pub const FADE: f32 = 0.2;
 
 impl Event {
     pub fn new(time: f32, action: Action, target: Option<&str>) -> Self {
@@ -57,13 +65,18 @@ impl Event {
             action,
             target: target.map(String::from),
             strength: 1.0,
+            fade: None,
         }
+    }
+
+    pub fn fade(&self) -> f32 {
+        self.fade.unwrap_or(FADE)
     }
 
     pub fn describe(&self) -> String {
         let who = self.target.as_deref().unwrap_or("every attached target");
         match self.action {
-            Action::Release => format!("release {who}"),
+            Action::Release => format!("release {who} over {} s", self.fade()),
             Action::Strength => format!("strength {} for {who}", self.strength),
             a if self.strength != 1.0 => {
                 format!("{} {who} at strength {}", a.as_str(), self.strength)
@@ -108,6 +121,9 @@ impl Timeline {
                     i,
                     format!("strength must be at least 0, got {}", e.strength),
                 );
+            }
+            if !(e.fade().is_finite() && e.fade() >= 0.0) {
+                return bad(i, format!("fade must be at least 0 s, got {}", e.fade()));
             }
             if let Some(t) = &e.target {
                 if !names.contains(t) {

@@ -37,6 +37,8 @@ pub struct SceneTargets {
     controlled: Vec<usize>,
     timeline: Timeline,
     pub fired: Vec<FiredEvent>,
+    /// Per control target being let go: (start time, strength then, fade seconds).
+    fading: Vec<Option<(f64, f32, f32)>>,
     quiet: bool,
 }
 
@@ -66,6 +68,7 @@ impl SceneTargets {
                 controlled: Vec::new(),
                 timeline: Timeline::default(),
                 fired: Vec::new(),
+                fading: Vec::new(),
                 quiet: sw.common.quiet,
             },
         );
@@ -107,7 +110,8 @@ impl SceneTargets {
             true => Timeline::all_attached(&names),
             false => Timeline::new(&scene.name, &scene.timeline, &names)?,
         };
-        let t = out.take();
+        let mut t = out.take();
+        t.fading = vec![None; t.controlled.len()];
         for (k, &i) in t.controlled.iter().enumerate() {
             let (c, _) = t.live[i].control.as_ref().expect("a control target");
             c.force
@@ -132,13 +136,40 @@ impl SceneTargets {
                     .control
                     .as_ref()
                     .expect("control");
-                c.force.set_attached(attached, strength);
+                match attached {
+                    true => {
+                        self.fading[k] = None;
+                        c.force.set_attached(true, strength);
+                    }
+                    // Let go over the fade (at once when it is 0).
+                    false if c.force.attached() => {
+                        self.fading[k] = Some((t, strength, event.fade()));
+                    }
+                    false => {}
+                }
             }
             self.fired.push(FiredEvent {
                 frame,
                 time: t,
                 event,
             });
+        }
+        for (k, f) in self.fading.iter_mut().enumerate() {
+            let Some((t0, s0, d)) = *f else { continue };
+            let (c, _) = self.live[self.controlled[k]]
+                .control
+                .as_ref()
+                .expect("control");
+            let left = match d > 0.0 {
+                true => 1.0 - (t - t0) as f32 / d,
+                false => 0.0,
+            };
+            if left <= 0.0 {
+                c.force.set_attached(false, s0);
+                *f = None;
+            } else {
+                c.force.set_attached(true, s0 * left);
+            }
         }
         for l in &mut self.live {
             l.poses[slot] = None;
