@@ -5,6 +5,7 @@ pub mod bench;
 pub mod character;
 pub mod config;
 pub mod control;
+pub mod emission;
 pub mod error;
 pub mod export;
 pub mod gpu;

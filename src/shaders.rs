@@ -92,6 +92,15 @@ pub fn variants() -> Vec<Variant> {
             }
         }
     }
+    use crate::emission::uv::UvIo;
+    for f in [
+        "emission/uv.vert",
+        "emission/uv.frag",
+        "emission/uv_flags.comp",
+        "emission/uv_compact.comp",
+    ] {
+        v.push(with::<UvIo>(f, &[]));
+    }
     use crate::control::rays::RaysIo;
     for f in ["control/rays_count.comp", "control/rays_emit.comp"] {
         v.push(with::<RaysIo>(f, &[]));

@@ -350,6 +350,11 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             inv_frame, group, live),
         ),
         (
+            "emission/uv_compact.comp",
+            "Push",
+            fields!(fluidform::emission::uv::UvPush; atlas, size),
+        ),
+        (
             "control/rays_emit.comp",
             "Push",
             fields!(fluidform::control::rays::RaysGpuPush;

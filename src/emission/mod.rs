@@ -1,0 +1,3 @@
+//! Motion-trail emission (seed 002): SPH particles shed from a moving character's surface,
+//! picked through a UV-space position buffer (RenderToUV).
+pub mod uv;

@@ -1,0 +1,243 @@
+//! RenderToUV (seed 002, scope `uv`): the skinned mesh rasterised into its UV layout at
+//! `size` texels, each covered texel holding the world position of its surface point; the
+//! positions of the current and the previous frame are kept (the emitter interpolates
+//! between them). Coverage depends on the UV layout only, so the covered texels are listed
+//! once, at creation: mask -> exclusive scan -> compaction, and every random pick from the
+//! list lands on the surface.
+use crate::character::Mesh;
+use crate::error::{Error, Result};
+use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::{
+    sync, Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
+    Labels, Scopes,
+};
+use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch, ScanVariant};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+
+/// glsl/emission/uv.glsl `Push`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct UvPush {
+    pub atlas: [f32; 4],
+    pub size: [u32; 4],
+}
+const _: () = assert!(std::mem::size_of::<UvPush>() == 32);
+
+crate::gpu_interface! {
+    /// glsl/emission/uv.glsl
+    pub UvIo / UvBufs: "UV", push UvPush {
+        verts = 0, uvs = 1, indices = 2, pos = 3, flags = 4, valid = 5,
+    }
+}
+
+/// Largest texture side (graphics viewports).
+pub const MAX_SIZE: u32 = 8192;
+
+pub struct UvSurface {
+    raster: GraphicsPipeline<UvIo>,
+    flags_pass: ComputePipeline<UvIo>,
+    compact: ComputePipeline<UvIo>,
+    scan: ScanPass,
+    scratch: ScanScratch,
+    uvs: Buffer,
+    flags: Buffer,
+    /// World positions per texel: `pos[current()]` this frame's, the other the last.
+    pub pos: [Buffer; 2],
+    /// Covered texel indices, `valid_count` of them.
+    pub valid: Buffer,
+    pub valid_count: u32,
+    pub size: [u32; 2],
+    current: usize,
+    push: UvPush,
+}
+
+impl UvSurface {
+    pub const NAME: &'static str = "uv";
+
+    /// For `mesh` (its UVs and triangles) at `size` texels; lists the covered texels.
+    pub fn new(ctx: &Context, mesh: &Mesh, size: [u32; 2]) -> Result<Self> {
+        if mesh.uvs.len() != mesh.positions.len() || mesh.uvs.is_empty() {
+            return Err(Error::Param(
+                "the emitting mesh has no UVs (texture coordinates): the UV emitter needs them (use --emitter vertices)".into(),
+            ));
+        }
+        if size.iter().any(|s| *s == 0 || *s > MAX_SIZE) {
+            return Err(Error::Param(format!(
+                "UV texture size {}x{} is outside 1..={MAX_SIZE}",
+                size[0], size[1]
+            )));
+        }
+        let texels = size[0] as u64 * size[1] as u64;
+        let desc = GraphicsDesc {
+            name: "uv",
+            vertex: "emission/uv.vert",
+            fragment: "emission/uv.frag",
+            defines: &[],
+            color_format: None,
+            depth_format: None,
+            blend: false,
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+        };
+        let raster = Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?);
+        let compute = |name, shader| -> Result<Guard<ComputePipeline<UvIo>>> {
+            let d = ComputeDesc::plain(name, shader, &[], 64);
+            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &d)?))
+        };
+        let flags_pass = compute("uv flags", "emission/uv_flags.comp")?;
+        let compact = compute("uv compact", "emission/uv_compact.comp")?;
+        let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
+        let scratch = Guard::new(ctx, scan.scratch(ctx, texels + 1)?);
+        let buf =
+            |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let mut uvs = buf("uv coordinates", mesh.uvs.len() as u64 * 8)?;
+        let uv: Vec<[f32; 2]> = mesh.uvs.iter().map(|u| [u.x, u.y]).collect();
+        ctx.upload(&mut uvs, 0, &uv)?;
+        let flags = buf("uv flags", (texels + 1) * 4)?;
+        let pos0 = buf("uv positions 0", texels * 16)?;
+        let pos1 = buf("uv positions 1", texels * 16)?;
+        let valid = buf("uv valid texels", texels * 4)?;
+        let mut s = Guard::new(
+            ctx,
+            Self {
+                raster: raster.take(),
+                flags_pass: flags_pass.take(),
+                compact: compact.take(),
+                scan: scan.take(),
+                scratch: scratch.take(),
+                uvs: uvs.take(),
+                flags: flags.take(),
+                pos: [pos0.take(), pos1.take()],
+                valid: valid.take(),
+                valid_count: 0,
+                size,
+                current: 0,
+                push: UvPush {
+                    atlas: [1.0, 1.0, 0.0, 0.0],
+                    size: [size[0], size[1], texels as u32, 0],
+                },
+            },
+        );
+        // The rest pose's positions: coverage is the UV layout's, whatever the pose.
+        let v4: Vec<[f32; 4]> = mesh
+            .positions
+            .iter()
+            .map(|p| [p.x, p.y, p.z, 1.0])
+            .collect();
+        let mut verts = Guard::new(ctx, ctx.storage_buffer("uv rest", v4.len() as u64 * 16)?);
+        let mut idx = Guard::new(
+            ctx,
+            ctx.storage_buffer("uv indices", mesh.indices.len().max(1) as u64 * 4)?,
+        );
+        ctx.upload(&mut verts, 0, &v4)?;
+        ctx.upload(&mut idx, 0, &mesh.indices)?;
+        let tris = (mesh.indices.len() / 3) as u32;
+        ctx.one_shot(|cmd| -> Result<()> {
+            s.record(ctx, cmd, &mut Labels, &verts, &idx, tris)?;
+            s.record_compact(ctx, cmd)
+        })??;
+        let count: Vec<u32> = ctx.readback(&s.flags, texels * 4, 1)?;
+        s.valid_count = count[0];
+        if s.valid_count == 0 {
+            return Err(Error::Param(format!(
+                "the mesh's UV layout covers no texel centre at {}x{}",
+                size[0], size[1]
+            )));
+        }
+        Ok(s.take())
+    }
+
+    /// Index into `pos` of the latest frame's positions.
+    pub fn current(&self) -> usize {
+        self.current
+    }
+
+    fn bufs<'a>(&'a self, verts: &'a Buffer, indices: &'a Buffer, pos: &'a Buffer) -> UvBufs<'a> {
+        UvBufs {
+            verts,
+            uvs: &self.uvs,
+            indices,
+            pos,
+            flags: &self.flags,
+            valid: &self.valid,
+        }
+    }
+
+    /// Rasterise the skinned mesh (`verts`, written and made visible to vertex shaders by
+    /// the caller; `indices` of `triangles` triangles) into the next position buffer,
+    /// which becomes the current one.
+    pub fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        verts: &Buffer,
+        indices: &Buffer,
+        triangles: u32,
+    ) -> Result<()> {
+        let next = 1 - self.current;
+        scopes.begin(ctx, cmd, Self::NAME);
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_READ | sync::GRAPHICS_READ | sync::TRANSFER_READ,
+            sync::TRANSFER_WRITE,
+        );
+        ctx.fill(cmd, &self.pos[next], 0);
+        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::GRAPHICS_READ);
+        begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
+        let bufs = self.bufs(verts, indices, &self.pos[next]);
+        self.raster.bind(ctx, cmd, &bufs, &self.push);
+        ctx.draw(cmd, 3 * triangles, 1);
+        ctx.end_rendering(cmd);
+        // Positions -> the emitter (and copies).
+        ctx.barrier(
+            cmd,
+            sync::FRAGMENT_WRITE,
+            sync::COMPUTE_READ | sync::TRANSFER_READ,
+        );
+        scopes.end(ctx, cmd);
+        self.current = next;
+        Ok(())
+    }
+
+    /// List the covered texels of the current positions (flags, scan, compaction).
+    fn record_compact(&self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
+        let texels = self.push.size[2] as u64;
+        let (v, i) = (&self.pos[self.current], &self.uvs);
+        // (Neither vertex buffer is read by the compute passes.)
+        let bufs = self.bufs(i, i, v);
+        self.flags_pass
+            .dispatch(ctx, cmd, &bufs, &self.push, texels + 1);
+        ctx.compute_barrier(cmd);
+        self.scan.record(
+            ctx,
+            cmd,
+            &self.flags,
+            &self.flags,
+            texels + 1,
+            ScanKind::Exclusive,
+            &self.scratch,
+        )?;
+        ctx.compute_barrier(cmd);
+        self.compact.dispatch(ctx, cmd, &bufs, &self.push, texels);
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::COMPUTE_READ | sync::TRANSFER_READ | sync::HOST_READ,
+        );
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.raster.destroy(ctx);
+        self.flags_pass.destroy(ctx);
+        self.compact.destroy(ctx);
+        self.scan.destroy(ctx);
+        self.scratch.destroy(ctx);
+        let [p0, p1] = &mut self.pos;
+        for b in [&mut self.uvs, &mut self.flags, p0, p1, &mut self.valid] {
+            ctx.destroy_buffer(b);
+        }
+    }
+}
+crate::impl_destroy!(UvSurface);
