@@ -92,6 +92,10 @@ pub fn variants() -> Vec<Variant> {
             }
         }
     }
+    v.push(with::<crate::emission::emit::EmitIo>(
+        "emission/emit.comp",
+        &[],
+    ));
     use crate::emission::uv::UvIo;
     for f in [
         "emission/uv.vert",

@@ -350,6 +350,12 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             inv_frame, group, live),
         ),
         (
+            "emission/emit.comp",
+            "EmitParams",
+            fields!(fluidform::emission::emit::EmitGpuParams;
+            n, valid_count, budget, seed, limit, dt, dtau, k),
+        ),
+        (
             "emission/uv_compact.comp",
             "Push",
             fields!(fluidform::emission::uv::UvPush; atlas, size),

@@ -1,3 +1,4 @@
 //! Motion-trail emission (seed 002): SPH particles shed from a moving character's surface,
 //! picked through a UV-space position buffer (RenderToUV).
+pub mod emit;
 pub mod uv;
