@@ -494,12 +494,8 @@ fn scene_character(
     sw: &Switches,
 ) -> Result<Option<SceneCharacter>> {
     let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
-    // A liquid character hides its mesh unless asked.
-    let hidden = scene.control.is_some();
-    let show = sw.character.show_mesh.unwrap_or(match hidden {
-        true => ShowMesh::Off,
-        false => ShowMesh::Shaded,
-    });
+    // (Scenes with fluid, and so any control target, play through SceneTargets.)
+    let show = sw.character.show_mesh.unwrap_or(ShowMesh::Shaded);
     scene
         .character
         .as_ref()

@@ -265,7 +265,8 @@ impl ControlForce {
         let buf =
             |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
         let v4 = m as u64 * 16;
-        let prev = buf("control previous", v4)?;
+        // (Rays keep no previous pose.)
+        let prev = buf("control previous", if rays.is_some() { 16 } else { v4 })?;
         let sorted_pos = buf("control sorted positions", v4)?;
         let sorted_prev = buf("control sorted previous", v4)?;
         let crho = buf("control densities", m as u64 * 4)?;
@@ -377,55 +378,50 @@ impl ControlForce {
             sync::COMPUTE_READ | sync::COMPUTE_WRITE,
         );
         g.skin.record(ctx, cmd, &g.mesh)?;
-        if let Some(r) = &g.rays {
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ); // surface -> raster
-            scopes.end(ctx, cmd);
-            r.record(
-                ctx,
-                cmd,
-                scopes,
-                &g.mesh.pos,
-                &g.mesh.indices,
-                g.mesh.triangles,
-            )?;
-            ctx.copy(
-                cmd,
-                &r.stats,
-                super::rays::STATS_PARTICLES,
-                &g.params,
-                LIVE_OFFSET,
-                4,
-            );
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
-            scopes.begin(ctx, cmd, "control-grid");
-            // Re-placed particles have no previous pose: both are the new set.
-            let pos = &r.out;
-            g.search
-                .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
-            ctx.compute_barrier(cmd); // permutation -> gathers
-            g.gather
-                .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
-            g.gather
-                .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_prev, self.m);
-            ctx.compute_barrier(cmd); // sorted control set -> density and force
-            scopes.end(ctx, cmd);
-            return Ok(());
-        }
-        if first {
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
-            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
-        }
-        ctx.compute_barrier(cmd); // skinned positions -> the control grid
-        scopes.end(ctx, cmd);
+        // The control set and its previous pose: the skinned particles, or the rays
+        // placement's (re-placed particles have no previous pose: both are the new set).
+        let (pos, prev) = match &g.rays {
+            Some(r) => {
+                ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ); // surface -> raster
+                scopes.end(ctx, cmd);
+                r.record(
+                    ctx,
+                    cmd,
+                    scopes,
+                    &g.mesh.pos,
+                    &g.mesh.indices,
+                    g.mesh.triangles,
+                )?;
+                ctx.copy(
+                    cmd,
+                    &r.stats,
+                    super::rays::STATS_PARTICLES,
+                    &g.params,
+                    LIVE_OFFSET,
+                    4,
+                );
+                ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+                (&r.out, &r.out)
+            }
+            None => {
+                if first {
+                    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
+                    ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+                    ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+                }
+                ctx.compute_barrier(cmd); // skinned positions -> the control grid
+                scopes.end(ctx, cmd);
+                (&g.mesh.pos, &g.prev)
+            }
+        };
         scopes.begin(ctx, cmd, "control-grid");
         g.search
-            .record_build(ctx, cmd, scopes, &g.nb, &g.mesh.pos, self.m, &g.grid)?;
+            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
         ctx.compute_barrier(cmd); // permutation -> gathers
         g.gather
-            .record(ctx, cmd, &g.nb.perm, &g.mesh.pos, &g.sorted_pos, self.m);
+            .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
         g.gather
-            .record(ctx, cmd, &g.nb.perm, &g.prev, &g.sorted_prev, self.m);
+            .record(ctx, cmd, &g.nb.perm, prev, &g.sorted_prev, self.m);
         ctx.compute_barrier(cmd); // sorted control set -> density and force
         scopes.end(ctx, cmd);
         Ok(())

@@ -131,10 +131,11 @@ pub fn place(
             ch.require_closed("--placement random")?;
             random(mesh, spacing, seed)
         }
+        // Placed on the GPU every frame (control::rays); here the rest pose's lattice,
+        // which sizes its buffers.
         Placement::Rays => {
-            return Err(Error::Param(
-                "--placement rays places on the GPU every frame (control::rays), not here".into(),
-            ))
+            ch.require_closed("--placement rays")?;
+            lattice(mesh, spacing)
         }
     };
     if pts.is_empty() {

@@ -4,7 +4,7 @@
 use super::binding;
 use super::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
-use crate::character::{pose, Animator, Character, Mesh, MAX_INFLUENCES};
+use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
 use crate::config::{Adaptive, BoneWeights, Placement, Skinning, Switches};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -169,19 +169,21 @@ impl ControlTarget {
             .collect();
         let (rest_mesh, _) = ch.skinned_at(&placed_rest, Skinning::Lbs)?;
         let spacing = desc.spacing.unwrap_or(fluid.spacing());
-        if desc.placement == Placement::Rays {
-            return Self::rays(ctx, solver, ch, &rest_mesh, desc, fluid, domain, spacing);
-        }
         let points = placement::place(ch, &rest_mesh, desc.placement, spacing, seed)?;
-        let (lo, hi) = (Vec3::from(domain.0), Vec3::from(domain.1));
-        if let Some(p) = points
-            .iter()
-            .find(|p| p.cmplt(lo).any() || p.cmpgt(hi).any())
-        {
+        // Rays place inside the moving surface itself: all of it must fit.
+        let (what, span) = match desc.placement {
+            Placement::Rays => ("surface", check::bounds(&rest_mesh)),
+            _ => ("control particles", check::bounds(&points)),
+        };
+        let (dlo, dhi) = (Vec3::from(domain.0), Vec3::from(domain.1));
+        if span.0.cmplt(dlo).any() || span.1.cmpgt(dhi).any() {
             return Err(Error::Param(format!(
-                "the control target {} reaches outside the domain {lo}..{hi} (a control particle at {p})",
-                ch.source
+                "the control target {} reaches outside the domain {dlo}..{dhi} (its {what} span {}..{})",
+                ch.source, span.0, span.1
             )));
+        }
+        if desc.placement == Placement::Rays {
+            return Self::rays(ctx, solver, ch, desc, fluid, domain, spacing, points.len());
         }
         let globals: Vec<Mat4> = ch
             .skeleton
@@ -239,41 +241,19 @@ impl ControlTarget {
     }
 
     /// `--placement rays`: the character's own surface, skinned by its own weights and
-    /// re-placed on the GPU every frame; room for three times the rest pose's lattice.
+    /// re-placed on the GPU every frame; room for three times the rest pose's lattice
+    /// (`rest` points).
     #[allow(clippy::too_many_arguments)]
     fn rays(
         ctx: &Context,
         solver: &mut crate::sph::SphSolver,
         ch: &Character,
-        rest_mesh: &[Vec3],
         desc: &ControlDesc,
         fluid: &crate::sph::FluidParams,
         domain: ([f32; 3], [f32; 3]),
         spacing: f32,
+        rest: usize,
     ) -> Result<Self> {
-        if !(spacing.is_finite() && spacing > 0.0) {
-            return Err(Error::Param(format!(
-                "--control-spacing must be positive, got {spacing}"
-            )));
-        }
-        ch.require_closed("--placement rays")?;
-        let rest = placement::lattice((rest_mesh, &ch.mesh.indices), spacing).len();
-        if rest == 0 {
-            return Err(Error::Model {
-                path: ch.source.clone(),
-                message: format!(
-                    "gives no control particles at spacing {spacing} (the mesh is smaller than the spacing)"
-                ),
-            });
-        }
-        let (lo, hi) = crate::character::check::bounds(rest_mesh);
-        let (dlo, dhi) = (Vec3::from(domain.0), Vec3::from(domain.1));
-        if lo.cmplt(dlo).any() || hi.cmpgt(dhi).any() {
-            return Err(Error::Param(format!(
-                "the control target {} reaches outside the domain {dlo}..{dhi} (its rest pose spans {lo}..{hi})",
-                ch.source
-            )));
-        }
         let capacity = (3 * rest + 1024).min(u32::MAX as usize / 16) as u32;
         let force = Rc::new(ControlForce::new(
             ctx,

@@ -258,6 +258,18 @@ fn liquid(
     }
 }
 
+/// `liquid`: the walker at half speed over a 0.9 x 0.6 m pool 0.1 m deep.
+fn walker_pool(name: &str) -> Scene {
+    liquid(
+        name,
+        ([-0.45, 0.0, -0.3], [0.45, 1.2, 0.3]),
+        0.1,
+        "builtin:walker",
+        0.5,
+        [0.0, 2.3],
+    )
+}
+
 /// `liquid` in a 1.2 m wide box (room for a second target), the walker at `x`, 320 x 240.
 fn wide(name: &str, x: f32) -> Scene {
     let mut s = liquid(
@@ -439,14 +451,7 @@ impl Scene {
                     tank: Some(false),
                     render: None,
                 },
-                ..liquid(
-                    name,
-                    ([-0.45, 0.0, -0.3], [0.45, 1.2, 0.3]),
-                    0.1,
-                    "builtin:walker",
-                    0.5,
-                    [0.0, 2.3],
-                )
+                ..walker_pool(name)
             },
             // The built-in long-necked shape (neck 2.5 rest spacings thick) filled from a
             // pool: the adaptive-pressure test (compare --adaptive off|on|smooth).
@@ -469,14 +474,7 @@ impl Scene {
                     Event::new(0.0, Action::Attach, Some("capsule")),
                     Event::new(1.0, Action::Switch, Some(MAIN_TARGET)),
                 ],
-                ..liquid(
-                    name,
-                    ([-0.45, 0.0, -0.3], [0.45, 1.2, 0.3]),
-                    0.1,
-                    "builtin:walker",
-                    0.5,
-                    [0.0, 2.3],
-                )
+                ..walker_pool(name)
             },
             // The walker fills; at 0.8 s a capsule beside it is added to the target.
             "union" => {
