@@ -45,6 +45,7 @@ switch_enum!(Material {
     Copper,
     Aluminium
 });
+switch_enum!(EmitterKind { Uv, Vertices });
 switch_enum!(Placement {
     Vertices,
     Random,
@@ -205,8 +206,9 @@ pub struct CharacterArgs {
 /// Control particles (scenes with a `[control]` target).
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ControlArgs {
-    /// Control-particle placement: one per welded vertex, or Poisson-disk points inside
-    /// (closed meshes); rays (GPU) is not built yet
+    /// Control-particle placement: one per welded vertex, Poisson-disk points inside
+    /// (closed meshes), or rays: parallel rays through the skinned mesh, re-placed every
+    /// frame on the GPU
     #[arg(long, value_enum)]
     pub placement: Option<Placement>,
     /// Control-particle spacing in metres (default: the fluid's rest spacing)
@@ -236,6 +238,44 @@ pub struct ControlArgs {
     /// skin weights)
     #[arg(long, value_enum)]
     pub bone_weights: Option<BoneWeights>,
+}
+
+/// Motion-trail emission (scenes with `[emission]`).
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct EmissionArgs {
+    /// Where particles are born: uv (random covered texels of the skinned mesh rendered
+    /// into its UV atlas, seed 002) or vertices (random vertices: the baseline)
+    #[arg(long, value_enum)]
+    pub emitter: Option<EmitterKind>,
+    /// Births per second at most (default: every due slot is born, as Algorithm 1)
+    #[arg(long)]
+    pub emission_rate: Option<f32>,
+    /// Life limit in seconds (a birth draws an age in (0, limit/2))
+    #[arg(long)]
+    pub life_limit: Option<f32>,
+    /// Energy transfer rate k of eq. 7, in units of the surface's velocity (1: particles
+    /// leave with the surface's own velocity)
+    #[arg(long)]
+    pub transfer: Option<f32>,
+    /// UV atlas size in texels, WxH or N (N x N)
+    #[arg(long, value_parser = parse_size)]
+    pub uv_size: Option<[u32; 2]>,
+}
+
+fn parse_size(s: &str) -> std::result::Result<[u32; 2], String> {
+    let parse = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{s}' is not WxH or N (positive integers)"))
+    };
+    let v = match s.split_once(['x', 'X']) {
+        Some((w, h)) => [parse(w)?, parse(h)?],
+        None => [parse(s)?; 2],
+    };
+    if v.iter().any(|x| *x == 0) {
+        return Err(format!("'{s}': sizes must be positive"));
+    }
+    Ok(v)
 }
 
 /// Every switch of DESIGN.md's command line, grouped per subsystem. `run` takes all of
@@ -278,6 +318,9 @@ pub struct Switches {
     #[command(flatten)]
     #[serde(flatten)]
     pub control: ControlArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub emission: EmissionArgs,
 }
 
 impl Default for CommonArgs {
@@ -327,6 +370,7 @@ pub enum Group {
     Export,
     Character,
     Control,
+    Emission,
 }
 
 /// The switches of `g` that differ from the group's defaults, as written on the command
@@ -350,7 +394,7 @@ impl Switches {
     /// applies, and for every control switch (not built yet), naming what brings it: a
     /// switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
-        let groups: [(Group, Vec<String>, &str); 9] = [
+        let groups: [(Group, Vec<String>, &str); 10] = [
             (
                 Group::Sort,
                 set_in(&self.sorting),
@@ -387,6 +431,11 @@ impl Switches {
                 Group::Control,
                 set_in(&self.control),
                 "scenes with a [control] target (control particles)",
+            ),
+            (
+                Group::Emission,
+                set_in(&self.emission),
+                "scenes with [emission] (motion-trail emission) and bench emission",
             ),
         ];
         for (g, set, owner) in groups {

@@ -52,7 +52,6 @@ pub struct ParticleExport {
     every: u64,
     out: PathBuf,
     mass: f32,
-    n: u32,
     slots: Vec<Copies>,
     /// Simulated time of the frame recorded into each slot.
     times: Vec<f64>,
@@ -111,7 +110,6 @@ impl ParticleExport {
             every: every.max(1),
             out: out.to_path_buf(),
             mass: st.fluid.mass,
-            n: st.n,
             times: vec![0.0; slots],
             slots: copies.take(),
             csv,
@@ -150,11 +148,32 @@ impl ParticleExport {
         fn cast(b: &Buffer) -> &[u8] {
             b.mapped().expect("host-visible export buffer")
         }
-        let snap = Snapshot {
+        let all = Snapshot {
             pos: bytemuck::cast_slice(cast(&c.pos)),
             vel: bytemuck::cast_slice(cast(&c.vel)),
             rho_p: bytemuck::cast_slice(cast(&c.rho_p)),
             attr: bytemuck::cast_slice(cast(&c.attr)),
+        };
+        // Live particles only: an emitter's dead slots (pos.w < 0) are left out.
+        let keep: Vec<bool> = all.pos.iter().map(|p| p[3] >= 0.0).collect();
+        fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
+            v.iter()
+                .zip(keep)
+                .filter(|(_, k)| **k)
+                .map(|(x, _)| *x)
+                .collect()
+        }
+        let (pos, vel, rho_p, attr) = (
+            pick(all.pos, &keep),
+            pick(all.vel, &keep),
+            pick(all.rho_p, &keep),
+            pick(all.attr, &keep),
+        );
+        let snap = Snapshot {
+            pos: &pos,
+            vel: &vel,
+            rho_p: &rho_p,
+            attr: &attr,
         };
         let (name, bytes) = match self.format {
             ExportFormat::Ply => (format!("particles_{frame:04}.ply"), ply(&snap)),
@@ -168,7 +187,7 @@ impl ParticleExport {
         writeln!(
             self.csv,
             "{frame},{time:.6},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6e}",
-            self.n,
+            snap.pos.len(),
             row.com[0],
             row.com[1],
             row.com[2],

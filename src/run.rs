@@ -262,11 +262,15 @@ impl FrameWork for SphWork<'_> {
         let frame_dt = self.stepper.frame_time as f32;
         self.targets
             .record_poses(frame, self.stepper.sim_time, frame_dt, slot)?;
+        let (steps, _) = self.stepper.plan(&self.st);
+        let t0 = self.stepper.sim_time;
+        self.targets
+            .record_before(ctx, cmd, prof, &mut self.st, t0, frame_dt, steps)?;
         self.stepper
             .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
         let t = self.stepper.sim_time;
         self.targets
-            .record_after(ctx, cmd, prof, &self.st, t, slot)?;
+            .record_after(ctx, cmd, prof, &self.st, t, (frame, slot))?;
         // The step's positions -> the view's copies and shaders.
         ctx.barrier(
             cmd,
@@ -345,6 +349,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     if !scene.control_targets().is_empty() {
         uses.push(Group::Control);
     }
+    if scene.emission.is_some() {
+        uses.push(Group::Emission);
+    }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
     let mut scene = scene;
@@ -368,7 +375,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
     let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
     let parts = scene.particles(sw.common.seed);
-    let st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
+    let mut st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
     let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
@@ -388,8 +395,15 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let cam = camera_with_switches(cam, sw);
     let mut solver = solver;
-    let targets =
-        crate::scene::targets::SceneTargets::new(&ctx, &scene, sw, &mut solver, &st, SLOTS)?;
+    let targets = crate::scene::targets::SceneTargets::new(
+        &ctx,
+        &scene,
+        sw,
+        &mut solver,
+        &mut st,
+        &parts.pos,
+        SLOTS,
+    )?;
     let targets = Guard::new(&ctx, targets);
     let show = targets.show();
     let view: Box<dyn View> = match render {
@@ -438,6 +452,12 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let render_stats = work.view.stats();
     let character_stats = work.targets.character_stats();
     let control_stats = work.targets.control_summary(&opts.out);
+    let emission_stats = match &timings {
+        Ok(_) => work
+            .targets
+            .emission_summary(&ctx, simulated_seconds, &opts.out),
+        Err(_) => Ok(None),
+    };
     let sort = work.solver.search.sort;
     let exports = work
         .export
@@ -454,6 +474,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         render: render_stats,
         character: character_stats?,
         control: control_stats?,
+        emission: emission_stats?,
     };
     let config = RunConfig {
         command: "run".into(),

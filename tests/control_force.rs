@@ -41,6 +41,7 @@ fn scene() -> Scene {
         control: None,
         targets: vec![],
         timeline: vec![],
+        emission: None,
     }
 }
 

@@ -319,7 +319,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "SphParams",
             fields!(SphGpuParams;
             gravity, domain_min, domain_max, h, mass, rest_density, stiffness, viscosity,
-            tension, tension_threshold, gamma, eos, clamp_negative, colliders, pad, poly6,
+            tension, tension_threshold, gamma, eos, clamp_negative, colliders, live, poly6,
             poly6_grad, spiky_grad, visc_lap),
         ),
         (

@@ -45,6 +45,7 @@ fn block_scene(fluid: FluidParams) -> Scene {
         control: None,
         targets: vec![],
         timeline: vec![],
+        emission: None,
     }
 }
 

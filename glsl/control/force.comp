@@ -6,7 +6,7 @@
 #include "common.glsl"
 void main() {
     uint i = global_id();
-    if (i >= pc.n || !controlled(i)) return;
+    if (i >= sph_live() || !controlled(i)) return;
     vec3 xi = pos[i].xyz;
     float hc = C.radius, hc2 = hc * hc;
     ivec3 c0 = clamp(ivec3(floor((xi - C.grid.xyz) / C.grid.w)), ivec3(0), ivec3(C.dims.xyz) - 1);

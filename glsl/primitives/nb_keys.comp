@@ -1,5 +1,7 @@
 #version 450
 // Neighbour search, step 1 for grid and hash: each particle's cell key; value = index.
+// A dead slot (pos.w < 0, e.g. an emitter's unborn particle) gets the key one past the
+// last cell, so every sort puts it after the live particles and no query visits it.
 #include "common/index.glsl"
 #include "nb_common.glsl"
 #define NB_CELL_ONLY
@@ -10,11 +12,11 @@ layout(std430, binding = NBK_B_VALS) writeonly buffer Vals { uint vals[]; };  //
 void main() {
     uint i = global_id();
     if (i >= pc.n) return;
-    vec3 p = pos[i].xyz;
+    vec4 p = pos[i];
 #if NB_STRATEGY == NB_GRID
-    keys[i] = nb_grid_id(nb_grid_cell(p));
+    keys[i] = p.w < 0.0 ? NB_DIMS.x * NB_DIMS.y * NB_DIMS.z : nb_grid_id(nb_grid_cell(p.xyz));
 #else
-    keys[i] = nb_hash(nb_cell_of(p));
+    keys[i] = p.w < 0.0 ? NB_TABLE : nb_hash(nb_cell_of(p.xyz));
 #endif
     vals[i] = i;
 }

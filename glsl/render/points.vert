@@ -14,6 +14,10 @@ const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
 void main() {
     vec4 p = pos[gl_InstanceIndex];
     vec2 c = corners[gl_VertexIndex];
+    if (p.w < 0.0) {  // a dead slot (emission): degenerate, culled
+        gl_Position = vec4(2.0, 2.0, 0.5, 1.0);
+        return;
+    }
     float r = (p.w > 0.0 ? p.w : 1.0) * pc.right.w;  // w: per-particle radius, or 0
     vec3 world = p.xyz + (c.x * pc.right.xyz + c.y * pc.up.xyz) * r;
     gl_Position = pc.view_proj * vec4(world, 1.0);

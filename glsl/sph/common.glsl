@@ -27,7 +27,7 @@ struct SphParams {
     uint eos;          // EOS_IDEAL: p = k (rho - rho0), EOS_TAIT
     uint clamp_negative;
     uint colliders;
-    uint pad;
+    uint live;         // slots at and past it are dead (emission); see sph_live()
     float poly6;       // 315 / (64 pi h^9)
     float poly6_grad;  // -945 / (32 pi h^9)
     float spiky_grad;  // -45 / (pi h^6)
@@ -45,6 +45,9 @@ layout(std430, binding = SPH_B_RHO_P) buffer RhoP { vec2 rho_p[]; };     // dens
 layout(std430, binding = SPH_B_ACC) buffer Acc { vec4 acc[]; };          // acceleration
 layout(std430, binding = SPH_B_VHALF) buffer Vhalf { vec4 vhalf[]; };    // v(t - dt/2)
 layout(std430, binding = SPH_B_COLLIDERS) readonly buffer Colliders { Collider cols[]; };
+
+// Particles the passes cover: live ones come first (the sort puts dead slots last).
+uint sph_live() { return min(pc.n, P.live); }
 
 float pressure_of(float rho) {
     float p = P.eos == EOS_TAIT ? P.stiffness * (pow(rho / P.rest_density, P.gamma) - 1.0)

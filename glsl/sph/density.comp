@@ -3,7 +3,7 @@
 #include "common.glsl"
 void main() {
     uint i = global_id();
-    if (i >= pc.n) return;
+    if (i >= sph_live()) return;
     vec3 xi = pos[i].xyz;
     float h2 = P.h * P.h;
     float sum = 0.0;

@@ -394,9 +394,16 @@ fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
     let any_uv = parts.iter().any(|p| p.uvs.is_some());
     let mut zero = 0;
     let mut over = 0;
-    for p in parts {
+    for (k, p) in parts.into_iter().enumerate() {
         let base = m.positions.len() as u32;
         let n = p.positions.len();
+        if p.uvs.is_some() {
+            m.uv_parts.push(UvPart {
+                name: format!("primitive {k}"),
+                first: (m.indices.len() / 3) as u32,
+                count: (p.indices.len() / 3) as u32,
+            });
+        }
         m.indices.extend(p.indices.iter().map(|i| i + base));
         m.positions.extend(&p.positions);
         has_normal.extend(std::iter::repeat_n(true, n));

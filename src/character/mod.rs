@@ -1,6 +1,7 @@
 //! Characters: glTF 2.0 and OBJ loading, mesh checks, clip sampling, and skinning (a GPU
 //! pass with linear blend or dual quaternions, and its CPU reference).
 pub mod anim;
+pub mod capsules;
 pub mod check;
 pub mod cpu;
 pub mod gltf_load;
@@ -65,6 +66,7 @@ pub(crate) fn assemble(
         check: MeshCheck::default(),
         flipped: false,
         warnings: Vec::new(),
+        capsules: Vec::new(),
     };
     // Normals first (the rest pose skins them too); given ones kept, zero ones replaced.
     let computed = check::area_normals(&mesh.positions, &mesh.indices);

@@ -22,6 +22,17 @@ pub struct Mesh {
     pub weights: Vec<[f32; MAX_INFLUENCES]>,
     /// 1: at most 4 influences per vertex; 2: up to 8.
     pub influence_sets: usize,
+    /// Triangle ranges with UVs of their own (a file's primitives), packed apart in the
+    /// emission atlas; empty: the whole mesh is one UV set.
+    pub uv_parts: Vec<UvPart>,
+}
+
+/// `count` triangles from `first` sharing one UV set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UvPart {
+    pub name: String,
+    pub first: u32,
+    pub count: u32,
 }
 
 impl Mesh {
@@ -199,4 +210,6 @@ pub struct Character {
     /// The mesh faced inward and was flipped.
     pub flipped: bool,
     pub warnings: Vec<String>,
+    /// The built-in characters' capsules (empty for loaded ones: capsules::of fits them).
+    pub capsules: Vec<super::capsules::BoneCapsule>,
 }

@@ -169,6 +169,32 @@ fn bone(name: &str, parent: Option<usize>, a: [f32; 3], b: [f32; 3], r: f32) -> 
     }
 }
 
+/// Each bone's capsule, carried by its joint (joints are the bones, in order).
+fn bone_capsules(bones: &[Bone]) -> Vec<super::capsules::BoneCapsule> {
+    bones
+        .iter()
+        .enumerate()
+        .map(|(joint, b)| super::capsules::BoneCapsule {
+            joint,
+            a: b.cap.a,
+            b: b.cap.b,
+            r: b.cap.r,
+        })
+        .collect()
+}
+
+/// A rigid shape's capsules, all on its one joint.
+fn rigid_capsules(caps: &[Capsule]) -> Vec<super::capsules::BoneCapsule> {
+    caps.iter()
+        .map(|c| super::capsules::BoneCapsule {
+            joint: 0,
+            a: c.a,
+            b: c.b,
+            r: c.r,
+        })
+        .collect()
+}
+
 /// The walker's skeleton (about 1.05 m tall, Y up, facing +Z).
 fn walker_bones() -> Vec<Bone> {
     let mut b = vec![
@@ -350,14 +376,16 @@ fn walker() -> Result<Character> {
     bind(&mut mesh, &bones);
     let skel = skeleton_of(&bones);
     let clip = walk_clip(&bones);
-    super::assemble(
+    let mut ch = super::assemble(
         "builtin:walker".into(),
         (mesh, has),
         skel,
         vec![clip],
         true,
         Vec::new(),
-    )
+    )?;
+    ch.capsules = bone_capsules(&bones);
+    Ok(ch)
 }
 
 /// Neck radius: 1.25 rest spacings of the default fluid (2.5 spacings thick).
@@ -384,14 +412,16 @@ fn giraffe() -> Result<Character> {
     let n = mesh.vertices();
     mesh.joints = vec![[0; MAX_INFLUENCES]; n];
     mesh.weights = vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; n];
-    super::assemble(
+    let mut ch = super::assemble(
         "builtin:giraffe".into(),
         (mesh, has),
         Skeleton::single("giraffe"),
         Vec::new(),
         false,
         Vec::new(),
-    )
+    )?;
+    ch.capsules = rigid_capsules(&caps);
+    Ok(ch)
 }
 
 /// A vertical capsule (radius 0.08 m, 0.36 m tall): the simplest closed control target.
@@ -405,12 +435,14 @@ fn capsule() -> Result<Character> {
     let n = mesh.vertices();
     mesh.joints = vec![[0; MAX_INFLUENCES]; n];
     mesh.weights = vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; n];
-    super::assemble(
+    let mut ch = super::assemble(
         "builtin:capsule".into(),
         (mesh, has),
         Skeleton::single("capsule"),
         Vec::new(),
         false,
         Vec::new(),
-    )
+    )?;
+    ch.capsules = rigid_capsules(&caps);
+    Ok(ch)
 }

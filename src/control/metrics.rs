@@ -162,6 +162,7 @@ impl ControlMetrics {
         let controlled: Vec<Vec3> = pos
             .iter()
             .zip(attr)
+            .filter(|(p, _)| p[3] >= 0.0) // live particles only (emission's dead slots)
             .filter(|(_, a)| group == ALL_GROUPS || a[3].to_bits() == group)
             .map(|(p, _)| Vec3::new(p[0], p[1], p[2]))
             .collect();

@@ -206,6 +206,7 @@ impl ControlTarget {
             joints,
             weights,
             influence_sets: sets.min(MAX_INFLUENCES / 4),
+            uv_parts: Vec::new(),
         };
         let rest_inv = placed_rest
             .iter()

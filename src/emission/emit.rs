@@ -1,11 +1,11 @@
-//! Emit (seed 002, Algorithm 1; scope `emit`): one invocation per particle slot respawns
-//! the slots past their life limit at random covered texels of the UV position buffers,
-//! between the last frame's surface and this frame's, with the surface's velocity times
-//! the transfer rate (eq. 7); the others age. Births per step are capped by a budget
-//! (the emission rate); the counts come back in `counts` (due slots, slots alive).
-use super::uv::UvSurface;
+//! Emit (seed 002, Algorithm 1; scope `emit`): one invocation per particle slot ages the
+//! live slots and gives the due ones (past their life limit, or dead) a birth at a random
+//! source point between the last two frames of the surface, with the surface's velocity
+//! times the transfer rate (eq. 7), while the step's budget lasts; the rest die. Counts per
+//! step (due, alive, birth requests), per frame (births, speeds) and per emitting
+//! primitive (births) stay on the GPU.
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -14,20 +14,25 @@ use bytemuck::{Pod, Zeroable};
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct EmitGpuParams {
     pub n: u32,
-    pub valid_count: u32,
+    pub sources: u32,
     pub budget: u32,
     pub seed: u32,
     pub limit: f32,
     pub dt: f32,
     pub dtau: f32,
     pub k: f32,
+    pub tau_lo: f32,
+    pub tau_hi: f32,
+    pub frame_dt: f32,
+    pub pad: u32,
 }
-const _: () = assert!(std::mem::size_of::<EmitGpuParams>() == 32);
+const _: () = assert!(std::mem::size_of::<EmitGpuParams>() == 48);
 
 crate::gpu_interface! {
     /// glsl/emission/emit.comp
     pub EmitIo / EmitBufs: "EMIT", push () {
-        params = 0, cur = 1, prev = 2, valid = 3, pos = 4, vel = 5, life = 6, counts = 7,
+        params = 0, cur = 1, prev = 2, valid = 3, pos = 4, vel = 5, vhalf = 6, life = 7,
+        counts = 8, stats = 9, hist = 10,
     }
 }
 
@@ -36,12 +41,23 @@ crate::gpu_interface! {
 pub struct EmitSettings {
     /// Life limit in seconds.
     pub limit: f32,
-    /// Births per step at most.
-    pub budget: u32,
+    /// Births per second at most (None: every due slot is born, as in Algorithm 1).
+    pub rate: Option<f32>,
     /// k times the frame time: 1 gives particles the surface's own velocity.
     pub transfer: f32,
     /// Half the finite-difference interval in tau (0 < dtau < 1/2).
     pub dtau: f32,
+}
+
+impl Default for EmitSettings {
+    fn default() -> Self {
+        Self {
+            limit: 2.0,
+            rate: None,
+            transfer: 1.0,
+            dtau: 0.05,
+        }
+    }
 }
 
 impl EmitSettings {
@@ -50,6 +66,11 @@ impl EmitSettings {
             return Err(Error::Param(format!(
                 "--life-limit must be positive, got {}",
                 self.limit
+            )));
+        }
+        if let Some(r) = self.rate.filter(|r| !(r.is_finite() && *r > 0.0)) {
+            return Err(Error::Param(format!(
+                "--emission-rate must be positive, got {r}"
             )));
         }
         if !(self.transfer.is_finite() && self.transfer >= 0.0) {
@@ -68,97 +89,133 @@ impl EmitSettings {
     }
 }
 
+/// One step's emission: the source's two frames and list, the particle buffers.
+pub struct EmitInput<'a> {
+    pub cur: &'a Buffer,
+    pub prev: &'a Buffer,
+    pub valid: &'a Buffer,
+    pub sources: u32,
+    pub pos: &'a Buffer,
+    pub vel: &'a Buffer,
+    pub vhalf: &'a Buffer,
+    pub life: &'a Buffer,
+}
+
 pub struct EmitPass {
     pipeline: ComputePipeline<EmitIo>,
     params: Buffer,
-    /// uvec4: due slots, slots alive (reset each step).
+    /// uvec4 per step: due slots, slots alive, birth requests.
     pub counts: Buffer,
+    /// uvec4 since cleared: births, summed birth speed, summed surface speed (cm/s).
+    pub stats: Buffer,
+    /// Births per emitting primitive (layout triangle or vertex).
+    pub hist: Buffer,
+    pub primitives: u32,
 }
 
 impl EmitPass {
     pub const NAME: &'static str = "emit";
+    /// Byte offset of the alive count in `counts`.
+    pub const ALIVE_OFFSET: u64 = 4;
 
-    pub fn new(ctx: &Context) -> Result<Self> {
-        let d = ComputeDesc::plain("emit", "emission/emit.comp", &[], 64);
+    /// For an emitter over `primitives` histogram bins; `uv`: the sources are texels whose
+    /// w holds the layout triangle + 1 (else vertices, binned by index).
+    pub fn new(ctx: &Context, uv: bool, primitives: u32) -> Result<Self> {
+        let defines = [("EMIT_UV", (uv as u32).to_string())];
+        let d = ComputeDesc::plain("emit", "emission/emit.comp", &defines, 64);
         let pipeline = Guard::new(ctx, ComputePipeline::new(ctx, &d)?);
-        let params = Guard::new(
-            ctx,
-            ctx.storage_buffer("emit params", std::mem::size_of::<EmitGpuParams>() as u64)?,
-        );
-        let counts = ctx.storage_buffer("emit counts", 16)?;
-        Ok(Self {
+        let buf = |name: &str, bytes| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
+        let params = buf("emit params", std::mem::size_of::<EmitGpuParams>() as u64)?;
+        let counts = buf("emit counts", 16)?;
+        let stats = buf("emit stats", 16)?;
+        let hist = buf("emit histogram", primitives.max(1) as u64 * 4)?;
+        let s = Self {
             pipeline: pipeline.take(),
             params: params.take(),
-            counts,
-        })
+            counts: counts.take(),
+            stats: stats.take(),
+            hist: hist.take(),
+            primitives,
+        };
+        let s = Guard::new(ctx, s);
+        ctx.one_shot(|cmd| s.record_clear(ctx, cmd))?;
+        Ok(s.take())
     }
 
-    /// Record one step of `dt` seconds over `n` slots (`pos`, `vel`: vec4; `life`: f32),
-    /// emitting from `uv`'s last two frames (`frame_dt` seconds apart); `step` seeds the
-    /// draws.
-    #[allow(clippy::too_many_arguments)]
+    /// Zero the per-frame stats and the histogram.
+    pub fn record_clear(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_READ | sync::COMPUTE_WRITE | sync::TRANSFER_READ,
+            sync::TRANSFER_WRITE,
+        );
+        ctx.fill(cmd, &self.stats, 0);
+        ctx.fill(cmd, &self.hist, 0);
+        ctx.barrier(
+            cmd,
+            sync::TRANSFER_WRITE,
+            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
+        );
+    }
+
+    /// Zero the per-frame stats (after the frame's copy of them).
+    pub fn record_clear_stats(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
+        ctx.fill(cmd, &self.stats, 0);
+        ctx.barrier(
+            cmd,
+            sync::TRANSFER_WRITE,
+            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
+        );
+    }
+
+    /// Record one step over `p.n` slots (in the caller's scope).
     pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        scopes: &mut dyn Scopes,
-        uv: &UvSurface,
-        (pos, vel, life): (&Buffer, &Buffer, &Buffer),
-        n: u32,
-        s: &EmitSettings,
-        (dt, frame_dt): (f32, f32),
-        step: u64,
-    ) -> Result<()> {
-        s.validate()?;
-        let seed = (step ^ (step >> 32)) as u32;
-        let p = EmitGpuParams {
-            n,
-            valid_count: uv.valid_count,
-            budget: s.budget,
-            seed: seed.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B,
-            limit: s.limit,
-            dt,
-            dtau: s.dtau,
-            k: if frame_dt > 0.0 {
-                s.transfer / frame_dt
-            } else {
-                0.0
-            },
-        };
-        scopes.begin(ctx, cmd, Self::NAME);
+        p: &EmitGpuParams,
+        input: &EmitInput,
+    ) {
         ctx.barrier(
             cmd,
             sync::COMPUTE_READ | sync::TRANSFER_READ,
             sync::TRANSFER_WRITE,
         );
-        ctx.update(cmd, &self.params, 0, &[p]);
+        ctx.update(cmd, &self.params, 0, &[*p]);
         ctx.fill(cmd, &self.counts, 0);
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
-        let c = uv.current();
         let bufs = EmitBufs {
             params: &self.params,
-            cur: &uv.pos[c],
-            prev: &uv.pos[1 - c],
-            valid: &uv.valid,
-            pos,
-            vel,
-            life,
+            cur: input.cur,
+            prev: input.prev,
+            valid: input.valid,
+            pos: input.pos,
+            vel: input.vel,
+            vhalf: input.vhalf,
+            life: input.life,
             counts: &self.counts,
+            stats: &self.stats,
+            hist: &self.hist,
         };
-        self.pipeline.dispatch(ctx, cmd, &bufs, &(), n as u64);
+        self.pipeline.dispatch(ctx, cmd, &bufs, &(), p.n as u64);
         ctx.barrier(
             cmd,
             sync::COMPUTE_WRITE,
             sync::COMPUTE_READ | sync::TRANSFER_READ,
         );
-        scopes.end(ctx, cmd);
-        Ok(())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
-        ctx.destroy_buffer(&mut self.params);
-        ctx.destroy_buffer(&mut self.counts);
+        for b in [
+            &mut self.params,
+            &mut self.counts,
+            &mut self.stats,
+            &mut self.hist,
+        ] {
+            ctx.destroy_buffer(b);
+        }
     }
 }
 crate::impl_destroy!(EmitPass);

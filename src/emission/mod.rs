@@ -1,4 +1,6 @@
 //! Motion-trail emission (seed 002): SPH particles shed from a moving character's surface,
 //! picked through a UV-space position buffer (RenderToUV).
 pub mod emit;
+pub mod emitter;
+pub mod layout;
 pub mod uv;

@@ -1,10 +1,11 @@
-//! RenderToUV (seed 002, scope `uv`): the skinned mesh rasterised into its UV layout at
-//! `size` texels, each covered texel holding the world position of its surface point; the
-//! positions of the current and the previous frame are kept (the emitter interpolates
-//! between them). Coverage depends on the UV layout only, so the covered texels are listed
+//! RenderToUV (seed 002, scope `uv`): the skinned mesh rasterised into its UV layout (the
+//! atlas of layout.rs, one draw per part at its scale and offset) at `size` texels, each
+//! covered texel holding the world position of its surface point and its layout triangle;
+//! the positions of the current and the previous frame are kept (the emitter interpolates
+//! between them). Coverage depends on the layout only, so the covered texels are listed
 //! once, at creation: mask -> exclusive scan -> compaction, and every random pick from the
 //! list lands on the surface.
-use crate::character::Mesh;
+use super::layout::UvLayout;
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::{
@@ -27,7 +28,7 @@ const _: () = assert!(std::mem::size_of::<UvPush>() == 32);
 crate::gpu_interface! {
     /// glsl/emission/uv.glsl
     pub UvIo / UvBufs: "UV", push UvPush {
-        verts = 0, uvs = 1, indices = 2, pos = 3, flags = 4, valid = 5,
+        verts = 0, uvs = 1, src = 2, pos = 3, flags = 4, valid = 5,
     }
 }
 
@@ -41,6 +42,7 @@ pub struct UvSurface {
     scan: ScanPass,
     scratch: ScanScratch,
     uvs: Buffer,
+    src: Buffer,
     flags: Buffer,
     /// World positions per texel: `pos[current()]` this frame's, the other the last.
     pub pos: [Buffer; 2],
@@ -48,19 +50,25 @@ pub struct UvSurface {
     pub valid: Buffer,
     pub valid_count: u32,
     pub size: [u32; 2],
-    current: usize,
+    current: std::cell::Cell<usize>,
     push: UvPush,
+    /// Per part: (atlas rect, first layout triangle, triangles).
+    parts: Vec<([f32; 4], u32, u32)>,
 }
 
 impl UvSurface {
     pub const NAME: &'static str = "uv";
 
-    /// For `mesh` (its UVs and triangles) at `size` texels; lists the covered texels.
-    pub fn new(ctx: &Context, mesh: &Mesh, size: [u32; 2]) -> Result<Self> {
-        if mesh.uvs.len() != mesh.positions.len() || mesh.uvs.is_empty() {
-            return Err(Error::Param(
-                "the emitting mesh has no UVs (texture coordinates): the UV emitter needs them (use --emitter vertices)".into(),
-            ));
+    /// For `layout` at `size` texels (the layout packed for that size); lists the texels
+    /// covered with the mesh at `rest` (its vertex positions).
+    pub fn new(
+        ctx: &Context,
+        layout: &UvLayout,
+        rest: &[glam::Vec3],
+        size: [u32; 2],
+    ) -> Result<Self> {
+        if layout.triangles() == 0 {
+            return Err(Error::Param("the emitting mesh has no triangles".into()));
         }
         if size.iter().any(|s| *s == 0 || *s > MAX_SIZE) {
             return Err(Error::Param(format!(
@@ -90,9 +98,11 @@ impl UvSurface {
         let scratch = Guard::new(ctx, scan.scratch(ctx, texels + 1)?);
         let buf =
             |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
-        let mut uvs = buf("uv coordinates", mesh.uvs.len() as u64 * 8)?;
-        let uv: Vec<[f32; 2]> = mesh.uvs.iter().map(|u| [u.x, u.y]).collect();
+        let mut uvs = buf("uv coordinates", layout.uvs.len() as u64 * 8)?;
+        let uv: Vec<[f32; 2]> = layout.uvs.iter().map(|u| [u.x, u.y]).collect();
         ctx.upload(&mut uvs, 0, &uv)?;
+        let mut src = buf("uv corner vertices", layout.src.len() as u64 * 4)?;
+        ctx.upload(&mut src, 0, &layout.src)?;
         let flags = buf("uv flags", (texels + 1) * 4)?;
         let pos0 = buf("uv positions 0", texels * 16)?;
         let pos1 = buf("uv positions 1", texels * 16)?;
@@ -106,34 +116,30 @@ impl UvSurface {
                 scan: scan.take(),
                 scratch: scratch.take(),
                 uvs: uvs.take(),
+                src: src.take(),
                 flags: flags.take(),
                 pos: [pos0.take(), pos1.take()],
                 valid: valid.take(),
                 valid_count: 0,
                 size,
-                current: 0,
+                current: std::cell::Cell::new(0),
                 push: UvPush {
                     atlas: [1.0, 1.0, 0.0, 0.0],
                     size: [size[0], size[1], texels as u32, 0],
                 },
+                parts: layout
+                    .parts
+                    .iter()
+                    .map(|p| (p.rect, p.first, p.count))
+                    .collect(),
             },
         );
         // The rest pose's positions: coverage is the UV layout's, whatever the pose.
-        let v4: Vec<[f32; 4]> = mesh
-            .positions
-            .iter()
-            .map(|p| [p.x, p.y, p.z, 1.0])
-            .collect();
+        let v4: Vec<[f32; 4]> = rest.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
         let mut verts = Guard::new(ctx, ctx.storage_buffer("uv rest", v4.len() as u64 * 16)?);
-        let mut idx = Guard::new(
-            ctx,
-            ctx.storage_buffer("uv indices", mesh.indices.len().max(1) as u64 * 4)?,
-        );
         ctx.upload(&mut verts, 0, &v4)?;
-        ctx.upload(&mut idx, 0, &mesh.indices)?;
-        let tris = (mesh.indices.len() / 3) as u32;
         ctx.one_shot(|cmd| -> Result<()> {
-            s.record(ctx, cmd, &mut Labels, &verts, &idx, tris)?;
+            s.record(ctx, cmd, &mut Labels, &verts)?;
             s.record_compact(ctx, cmd)
         })??;
         let count: Vec<u32> = ctx.readback(&s.flags, texels * 4, 1)?;
@@ -149,33 +155,31 @@ impl UvSurface {
 
     /// Index into `pos` of the latest frame's positions.
     pub fn current(&self) -> usize {
-        self.current
+        self.current.get()
     }
 
-    fn bufs<'a>(&'a self, verts: &'a Buffer, indices: &'a Buffer, pos: &'a Buffer) -> UvBufs<'a> {
+    fn bufs<'a>(&'a self, verts: &'a Buffer, pos: &'a Buffer) -> UvBufs<'a> {
         UvBufs {
             verts,
             uvs: &self.uvs,
-            indices,
+            src: &self.src,
             pos,
             flags: &self.flags,
             valid: &self.valid,
         }
     }
 
-    /// Rasterise the skinned mesh (`verts`, written and made visible to vertex shaders by
-    /// the caller; `indices` of `triangles` triangles) into the next position buffer,
-    /// which becomes the current one.
+    /// Rasterise the skinned mesh (`verts`: its vertices' positions, written and made
+    /// visible to vertex shaders by the caller) into the next position buffer, which
+    /// becomes the current one.
     pub fn record(
-        &mut self,
+        &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         verts: &Buffer,
-        indices: &Buffer,
-        triangles: u32,
     ) -> Result<()> {
-        let next = 1 - self.current;
+        let next = 1 - self.current.get();
         scopes.begin(ctx, cmd, Self::NAME);
         ctx.barrier(
             cmd,
@@ -185,9 +189,15 @@ impl UvSurface {
         ctx.fill(cmd, &self.pos[next], 0);
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::GRAPHICS_READ);
         begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
-        let bufs = self.bufs(verts, indices, &self.pos[next]);
-        self.raster.bind(ctx, cmd, &bufs, &self.push);
-        ctx.draw(cmd, 3 * triangles, 1);
+        let bufs = self.bufs(verts, &self.pos[next]);
+        for &(rect, first, count) in &self.parts {
+            let push = UvPush {
+                atlas: rect,
+                size: [self.size[0], self.size[1], self.push.size[2], 0],
+            };
+            self.raster.bind(ctx, cmd, &bufs, &push);
+            ctx.draw_range(cmd, 3 * count, 3 * first);
+        }
         ctx.end_rendering(cmd);
         // Positions -> the emitter (and copies).
         ctx.barrier(
@@ -196,16 +206,16 @@ impl UvSurface {
             sync::COMPUTE_READ | sync::TRANSFER_READ,
         );
         scopes.end(ctx, cmd);
-        self.current = next;
+        self.current.set(next);
         Ok(())
     }
 
     /// List the covered texels of the current positions (flags, scan, compaction).
     fn record_compact(&self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
         let texels = self.push.size[2] as u64;
-        let (v, i) = (&self.pos[self.current], &self.uvs);
-        // (Neither vertex buffer is read by the compute passes.)
-        let bufs = self.bufs(i, i, v);
+        let (v, i) = (&self.pos[self.current.get()], &self.uvs);
+        // (The vertex buffer is not read by the compute passes.)
+        let bufs = self.bufs(i, v);
         self.flags_pass
             .dispatch(ctx, cmd, &bufs, &self.push, texels + 1);
         ctx.compute_barrier(cmd);
@@ -235,7 +245,14 @@ impl UvSurface {
         self.scan.destroy(ctx);
         self.scratch.destroy(ctx);
         let [p0, p1] = &mut self.pos;
-        for b in [&mut self.uvs, &mut self.flags, p0, p1, &mut self.valid] {
+        for b in [
+            &mut self.uvs,
+            &mut self.src,
+            &mut self.flags,
+            p0,
+            p1,
+            &mut self.valid,
+        ] {
             ctx.destroy_buffer(b);
         }
     }

@@ -176,4 +176,9 @@ impl Context {
     pub fn draw(&self, cmd: vk::CommandBuffer, vertices: u32, instances: u32) {
         unsafe { self.device.cmd_draw(cmd, vertices, instances, 0, 0) };
     }
+
+    /// `vertices` vertices from `first` (gl_VertexIndex counts from `first`), one instance.
+    pub fn draw_range(&self, cmd: vk::CommandBuffer, vertices: u32, first: u32) {
+        unsafe { self.device.cmd_draw(cmd, vertices, 1, first, 0) };
+    }
 }

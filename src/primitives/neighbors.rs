@@ -305,13 +305,15 @@ impl NeighborSearch {
         let sorted_keys = buf("nb sorted keys", cap * 4)?;
         let perm = buf("nb permutation", cap * 4)?;
         let sorted_pos = buf("nb sorted positions", cap * 16)?;
-        let starts = buf("nb cell starts", cells * 4)?;
-        let ends = buf("nb cell ends", cells * 4)?;
+        // One bin past the cells: dead slots' key (nb_keys.comp), after every live particle.
+        let bins = cells + 1;
+        let starts = buf("nb cell starts", bins * 4)?;
+        let ends = buf("nb cell ends", bins * 4)?;
         let counting = Guard::new(
             ctx,
             match self.sort {
                 SortAlgo::Counting => {
-                    Some(CountingBuffers::new(ctx, &self.scan, cap, cells as u32)?)
+                    Some(CountingBuffers::new(ctx, &self.scan, cap, bins as u32)?)
                 }
                 _ => None,
             },

@@ -43,6 +43,39 @@ pub struct CharacterDesc {
     /// Playback rate (1: the clip's own timing).
     #[serde(default = "one")]
     pub speed: f32,
+    /// Waypoints of a closed loop the rest pose's bottom centre follows at `path_speed`,
+    /// turned to face along it (+Z forward after `rotation`); `position` is then unused.
+    #[serde(default)]
+    pub path: Vec<[f32; 3]>,
+    /// Metres per second along `path`.
+    #[serde(default)]
+    pub path_speed: f32,
+}
+
+/// Where on a closed loop through `points` a walker at `speed` is after `t` seconds, and
+/// its heading (yaw about +Y from +Z).
+pub fn path_pose(points: &[Vec3], speed: f32, t: f64) -> (Vec3, f32) {
+    let n = points.len();
+    if n < 2 {
+        return (points.first().copied().unwrap_or(Vec3::ZERO), 0.0);
+    }
+    let seg = |i: usize| (points[i], points[(i + 1) % n]);
+    let perimeter: f64 = (0..n).map(|i| seg(i).0.distance(seg(i).1) as f64).sum();
+    let mut d = match perimeter > 0.0 {
+        true => (speed as f64 * t).rem_euclid(perimeter),
+        false => 0.0,
+    };
+    for i in 0..n {
+        let (a, b) = seg(i);
+        let l = a.distance(b) as f64;
+        if d <= l || i == n - 1 {
+            let dir = (b - a).normalize_or_zero();
+            let at = a + dir * d.min(l) as f32;
+            return (at, dir.x.atan2(dir.z));
+        }
+        d -= l;
+    }
+    (points[0], 0.0)
 }
 
 impl CharacterDesc {
@@ -57,6 +90,8 @@ impl CharacterDesc {
             position: [0.0; 3],
             rotation: [0.0; 3],
             speed: 1.0,
+            path: Vec::new(),
+            path_speed: 0.0,
         }
     }
 
@@ -72,6 +107,18 @@ impl CharacterDesc {
         }
         if !(self.speed.is_finite() && self.speed >= 0.0) {
             return bad(format!("speed must be at least 0, got {}", self.speed));
+        }
+        if !(self.path_speed.is_finite() && self.path_speed >= 0.0) {
+            return bad(format!(
+                "path_speed must be at least 0, got {}",
+                self.path_speed
+            ));
+        }
+        if self.path.iter().flatten().any(|v| !v.is_finite()) {
+            return bad("path points must be finite".into());
+        }
+        if self.path_speed > 0.0 && self.path.len() < 2 {
+            return bad("path_speed needs a path of at least 2 points".into());
         }
         if self
             .position
@@ -101,8 +148,12 @@ impl CharacterDesc {
             _ => 1.0,
         };
         let bottom = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
-        let placement = anim::placement(s, self.rotation.into(), self.position.into())
-            * Mat4::from_translation(-bottom);
+        let at = match self.path.is_empty() {
+            true => self.position.into(),
+            false => Vec3::ZERO, // the path places it each frame
+        };
+        let placement =
+            anim::placement(s, self.rotation.into(), at) * Mat4::from_translation(-bottom);
         let animator = Animator {
             clip,
             looping: self.looping,
@@ -133,6 +184,8 @@ pub struct SceneCharacter {
     pub method: Skinning,
     pub speed: f32,
     pub show: ShowMesh,
+    /// (waypoints, metres per second) of a path it follows.
+    pub path: Option<(Vec<Vec3>, f32)>,
     skinner: Skinner,
 }
 
@@ -168,8 +221,34 @@ impl SceneCharacter {
             method,
             speed: desc.speed,
             show,
+            path: (!desc.path.is_empty()).then(|| {
+                (
+                    desc.path.iter().map(|p| Vec3::from(*p)).collect(),
+                    desc.path_speed,
+                )
+            }),
             skinner: skinner.take(),
         })
+    }
+
+    /// The placed joint matrices at scene time `t` (clip at `speed`, along the path).
+    pub fn matrices(&self, t: f64) -> Vec<Mat4> {
+        let mats = self
+            .anim
+            .joint_matrices(&self.ch, (t * self.speed as f64) as f32);
+        match &self.path {
+            None => mats,
+            Some((points, speed)) => {
+                let (at, yaw) = path_pose(points, *speed, t);
+                let m = Mat4::from_translation(at) * Mat4::from_rotation_y(yaw);
+                mats.into_iter().map(|x| m * x).collect()
+            }
+        }
+    }
+
+    /// The skinned positions (vec4 per vertex) of the last `record`.
+    pub fn skinned(&self) -> &crate::gpu::Buffer {
+        &self.skinner.mesh.pos
     }
 
     /// Record the pose at scene time `t`: joints uploaded, the `skin` pass, its output
@@ -181,9 +260,7 @@ impl SceneCharacter {
         prof: &mut Profiler,
         t: f64,
     ) -> Result<()> {
-        let mats = self
-            .anim
-            .joint_matrices(&self.ch, (t * self.speed as f64) as f32);
+        let mats = self.matrices(t);
         let joints = self.ch.gpu_joints(&mats, self.method)?;
         prof.begin(ctx, cmd, crate::character::skin::SkinPass::NAME);
         self.skinner.record(ctx, cmd, &joints)?;

@@ -1,4 +1,5 @@
 //! Scene parts beside the SPH scenes: the `orbits` test scene and characters.
 pub mod character;
+pub mod emission;
 pub mod orbits;
 pub mod targets;

@@ -3,18 +3,24 @@
 //! and released by the timeline; each attached target's pose set before the frame's
 //! steps, its metrics read after them; the first shown mesh drawn by the view.
 use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
+use super::emission::{EmissionMetrics, EmissionStats, SceneEmission};
+use crate::character::capsules::{self, BoneCapsule};
 use crate::config::{ShowMesh, Skinning, Switches};
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
+use crate::emission::emitter::{EmitHook, EmitSource, Emitter};
+use crate::emission::layout::UvLayout;
 use crate::error::Result;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
+use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::scene::MAIN_TARGET;
 use crate::sph::{Scene, SphSolver, SphState};
 use ash::vk;
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
+use std::rc::Rc;
 
 /// `stats.control` of summary.json: each control target's metrics and the fired events.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -33,6 +39,12 @@ struct Live {
 
 pub struct SceneTargets {
     live: Vec<Live>,
+    /// The character's emission, if the scene has one.
+    emission: Option<SceneEmission>,
+    /// The scene's own colliders (the emitting character's capsules join them per frame).
+    colliders: Vec<GpuCollider>,
+    /// The emitting character's capsules, when they collide.
+    capsules: Vec<BoneCapsule>,
     /// Index into `live` of each control target (timeline order of names).
     controlled: Vec<usize>,
     timeline: Timeline,
@@ -50,7 +62,8 @@ impl SceneTargets {
         scene: &Scene,
         sw: &Switches,
         solver: &mut SphSolver,
-        st: &SphState,
+        st: &mut SphState,
+        initial: &[[f32; 4]],
         slots: usize,
     ) -> Result<Self> {
         let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
@@ -65,6 +78,13 @@ impl SceneTargets {
             ctx,
             Self {
                 live: Vec::new(),
+                emission: None,
+                colliders: scene
+                    .colliders
+                    .iter()
+                    .map(|c| c.to_gpu())
+                    .collect::<Result<_>>()?,
+                capsules: Vec::new(),
                 controlled: Vec::new(),
                 timeline: Timeline::default(),
                 fired: Vec::new(),
@@ -110,6 +130,57 @@ impl SceneTargets {
             true => Timeline::all_attached(&names),
             false => Timeline::new(&scene.name, &scene.timeline, &names)?,
         };
+        if let Some(desc) = &scene.emission {
+            // validate() made sure of the [character]: the first character.
+            let (kind, settings, size) = desc.resolve(sw)?;
+            if desc.collide {
+                out.capsules = capsules::of(&out.live[0].character.ch);
+            }
+            let ch = &out.live[0].character.ch;
+            let layout = match kind {
+                crate::config::EmitterKind::Vertices => None,
+                _ if !ch.mesh.uvs.is_empty() => Some(UvLayout::from_mesh(&ch.mesh, size)?),
+                _ => Some(UvLayout::from_capsules(&ch.mesh, &capsules::of(ch), size)?),
+            };
+            let source = EmitSource::new(ctx, kind, layout, &ch.mesh.positions, size)?;
+            let emitter = Rc::new(Emitter::new(
+                ctx,
+                st,
+                initial,
+                source,
+                settings,
+                sw.common.seed,
+            )?);
+            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(&emitter))));
+            let metrics = EmissionMetrics::new(ctx, slots);
+            let mut e = SceneEmission {
+                emitter: Some(emitter),
+                metrics: EmissionMetrics::empty(),
+                character: 0,
+                collide: desc.collide,
+                slots: desc.slots,
+                primed: false,
+            };
+            match metrics {
+                Ok(m) => e.metrics = m,
+                Err(err) => {
+                    e.destroy(ctx);
+                    return Err(err);
+                }
+            }
+            if desc.collide {
+                if out.capsules.len() + out.colliders.len() > MAX_COLLIDERS {
+                    let n = out.capsules.len();
+                    e.destroy(ctx);
+                    return Err(crate::Error::Param(format!(
+                        "scene {}: {n} character capsules and {} colliders exceed {MAX_COLLIDERS}",
+                        scene.name,
+                        out.colliders.len()
+                    )));
+                }
+            }
+            out.emission = Some(e);
+        }
         let mut t = out.take();
         t.fading = vec![None; t.controlled.len()];
         for (k, &i) in t.controlled.iter().enumerate() {
@@ -177,9 +248,62 @@ impl SceneTargets {
                 continue;
             };
             let ch = &l.character;
-            let mats = ch.anim.joint_matrices(&ch.ch, (t * ch.speed as f64) as f32);
+            let mats = ch.matrices(t);
             c.set_pose(&ch.ch, &mats, frame_dt)?;
             l.poses[slot] = Some((mats, t));
+        }
+        Ok(())
+    }
+
+    /// Before the frame's `steps` steps from scene time `t` over `frame_dt`: the emitting
+    /// character skinned to the frame's end and taken by the emission source (on the
+    /// first frame its start too), and its capsules posed as colliders.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_before(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        st: &mut SphState,
+        t: f64,
+        frame_dt: f32,
+        steps: u32,
+    ) -> Result<()> {
+        let Some(e) = &mut self.emission else {
+            return Ok(());
+        };
+        let ch = &self.live[e.character].character;
+        let end = t + frame_dt as f64;
+        prof.begin(ctx, cmd, "emission");
+        let emitter = e.emitter.as_ref().expect("a live emitter");
+        let times: &[f64] = match e.primed {
+            true => &[end],
+            false => &[t, end],
+        };
+        for &at in times {
+            ch.record(ctx, cmd, prof, at)?;
+            emitter.source.record(ctx, cmd, prof, ch.skinned())?;
+        }
+        prof.end(ctx, cmd);
+        e.primed = true;
+        emitter.begin_frame(steps, frame_dt);
+        if e.collide {
+            let (m0, m1) = (ch.matrices(t), ch.matrices(end));
+            let mut list = self.colliders.clone();
+            for c in &self.capsules {
+                let (p0, p1) = (c.posed(&m0), c.posed(&m1));
+                let v = ((p1.a + p1.b) - (p0.a + p0.b)) * (0.5 / frame_dt.max(1e-9));
+                list.push(
+                    Collider::Capsule {
+                        a: p1.a.into(),
+                        b: p1.b.into(),
+                        radius: p1.r,
+                        velocity: v.into(),
+                    }
+                    .to_gpu()?,
+                );
+            }
+            st.set_colliders(&list)?;
         }
         Ok(())
     }
@@ -187,21 +311,27 @@ impl SceneTargets {
     /// After the frame's steps: the attached targets' metric copies, and the shown
     /// characters skinned to scene time `t` for the view.
     pub fn record_after(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         prof: &mut Profiler,
         st: &SphState,
         t: f64,
-        slot: usize,
+        (frame, slot): (u64, usize),
     ) -> Result<()> {
-        for l in &self.live {
+        let emitting = self.emission.as_ref().map(|e| e.character);
+        if let Some(e) = &mut self.emission {
+            let emitter = e.emitter.as_ref().expect("a live emitter");
+            e.metrics.record(ctx, cmd, emitter, slot, frame, t);
+        }
+        for (i, l) in self.live.iter().enumerate() {
             if let (Some((c, m)), Some(_)) = (&l.control, &l.poses[slot]) {
                 prof.begin(ctx, cmd, "control-metrics");
                 m.record(ctx, cmd, st, &c.force, slot)?;
                 prof.end(ctx, cmd);
             }
-            if l.character.show != ShowMesh::Off {
+            // (The emitting character is already skinned at t, the frame's end.)
+            if l.character.show != ShowMesh::Off && emitting != Some(i) {
                 l.character.record(ctx, cmd, prof, t)?;
             }
         }
@@ -231,6 +361,9 @@ impl SceneTargets {
         frame: u64,
         fluid: &crate::sph::FluidParams,
     ) -> Result<()> {
+        if let Some(e) = &mut self.emission {
+            e.metrics.retire(slot);
+        }
         for l in &mut self.live {
             let (Some((c, m)), Some((mats, time))) = (&mut l.control, l.poses[slot].take()) else {
                 continue;
@@ -294,7 +427,33 @@ impl SceneTargets {
         }))
     }
 
+    /// `stats.emission` (None without emission) and emission.csv in `out`, after the run
+    /// of `seconds` simulated seconds.
+    pub fn emission_summary(
+        &mut self,
+        ctx: &Context,
+        seconds: f64,
+        out: &std::path::Path,
+    ) -> Result<Option<EmissionStats>> {
+        let Some(e) = &mut self.emission else {
+            return Ok(None);
+        };
+        let mesh = &self.live[e.character].character.ch.mesh;
+        let emitter = e.emitter.as_ref().expect("a live emitter");
+        e.metrics
+            .finish(ctx, emitter, mesh, (e.slots, seconds), out)
+            .map(Some)
+    }
+
+    /// The emitter (tests and benches read its slots).
+    pub fn emitter(&self) -> Option<&Emitter> {
+        self.emission.as_ref().map(|e| e.emitter())
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(e) = &mut self.emission {
+            e.destroy(ctx);
+        }
         for l in &mut self.live {
             if let Some((_, m)) = &mut l.control {
                 m.destroy(ctx);

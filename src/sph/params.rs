@@ -219,7 +219,9 @@ pub struct SphGpuParams {
     pub eos: u32,
     pub clamp_negative: u32,
     pub colliders: u32,
-    pub pad: u32,
+    /// Live particles: slots at and past it are dead (an emitter's) and skipped. The host
+    /// sets the state's count; an emitter overwrites it on the GPU after each birth pass.
+    pub live: u32,
     pub poly6: f32,
     pub poly6_grad: f32,
     pub spiky_grad: f32,
@@ -228,6 +230,9 @@ pub struct SphGpuParams {
 const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 112);
 
 impl SphGpuParams {
+    /// Byte offset of `live` (the emitter copies its GPU-side count there).
+    pub const LIVE_OFFSET: u64 = std::mem::offset_of!(SphGpuParams, live) as u64;
+
     pub fn new(f: &FluidParams, lo: [f32; 3], hi: [f32; 3], dt: f32, colliders: u32) -> Self {
         let h = f.h;
         let k = Kernels::new(h as f64);
@@ -246,7 +251,7 @@ impl SphGpuParams {
             eos: f.eos as u32,
             clamp_negative: f.clamp_negative_pressure as u32,
             colliders,
-            pad: 0,
+            live: u32::MAX,
             poly6: k.poly6 as f32,
             poly6_grad: k.poly6_grad as f32,
             spiky_grad: k.spiky_grad as f32,

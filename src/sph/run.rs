@@ -114,6 +114,8 @@ pub struct SphRunStats {
     pub character: Option<crate::scene::character::CharacterStats>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<crate::scene::targets::ControlSummary>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<crate::scene::emission::EmissionStats>,
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

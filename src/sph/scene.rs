@@ -99,6 +99,9 @@ pub struct Scene {
     /// target attached from the start).
     #[serde(default)]
     pub timeline: Vec<crate::control::timeline::Event>,
+    /// The character sheds particles (seed 002): slots recycled by Emit.
+    #[serde(default)]
+    pub emission: Option<crate::scene::emission::EmissionDesc>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -167,6 +170,8 @@ pub const BUILT_IN: &[&str] = &[
     "union",
     "morph",
     "two-groups",
+    "trail",
+    "game",
 ];
 
 /// Kelager's water with a Tait equation of state stiff enough for < 1% compression in
@@ -255,6 +260,7 @@ fn liquid(
         }),
         targets: vec![],
         timeline: vec![],
+        emission: None,
     }
 }
 
@@ -314,6 +320,59 @@ fn target(
     }
 }
 
+/// Seed 002's setting: the walker runs a rectangular loop of `loop_` (half sizes x, z) at
+/// `speed` m/s through the box [lo, hi], shedding `slots` particles from its UV atlas at
+/// `rate` per second, living `life` seconds; its capsules are colliders. Seen from the
+/// front and above (camera at height and distance `view`).
+#[allow(clippy::too_many_arguments)]
+fn trail(
+    name: &str,
+    (lo, hi): ([f32; 3], [f32; 3]),
+    loop_: [f32; 2],
+    speed: f32,
+    slots: u32,
+    rate: f32,
+    life: f32,
+    view: [f32; 2],
+) -> Scene {
+    let [x, z] = loop_;
+    Scene {
+        name: name.into(),
+        domain: Domain { min: lo, max: hi },
+        fluid: pool_water(),
+        blocks: vec![],
+        balls: vec![],
+        colliders: vec![],
+        camera: Some(CameraDesc {
+            eye: [0.0, view[0], view[1]],
+            target: [0.0, 0.3, 0.0],
+            fov: 45.0,
+        }),
+        frames: 150,
+        look: Look {
+            material: Some(crate::config::Material::Tinted),
+            size: Some([320, 240]),
+            tank: Some(false),
+            ..Look::default()
+        },
+        character: Some(crate::scene::character::CharacterDesc {
+            // The walk cycle's stride (about 0.8 m a cycle) matched to the path speed.
+            speed: speed / 0.8,
+            path: vec![[-x, 0.0, z], [x, 0.0, z], [x, 0.0, -z], [-x, 0.0, -z]],
+            path_speed: speed,
+            ..crate::scene::character::CharacterDesc::new("builtin:walker")
+        }),
+        control: None,
+        targets: vec![],
+        timeline: vec![],
+        emission: Some(crate::scene::emission::EmissionDesc {
+            rate: Some(rate),
+            life_limit: Some(life),
+            ..crate::scene::emission::EmissionDesc::new(slots)
+        }),
+    }
+}
+
 /// A water column of size `column` at the origin released in a tank of size `tank`, seen
 /// from the front at height and distance `view`, 600 frames of stiff water.
 fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Scene {
@@ -344,6 +403,7 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         control: None,
         targets: vec![],
         timeline: vec![],
+        emission: None,
     }
 }
 
@@ -406,6 +466,7 @@ impl Scene {
                 control: None,
                 targets: vec![],
                 timeline: vec![],
+                emission: None,
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -435,6 +496,7 @@ impl Scene {
                 control: None,
                 targets: vec![],
                 timeline: vec![],
+                emission: None,
             },
             // A liquid character: a pool rises into the built-in walker (control particles,
             // adaptive pressure), follows its walk at half speed, and is released at 1.5 s.
@@ -490,6 +552,43 @@ impl Scene {
             // A pool of blue (group 0) and orange (group 1) stripes: the walker pulls the
             // blue out, a capsule beside it the orange (each target reaches the fluid
             // within h_c of its control particles); released at 1.5 s, they mix.
+            // The walker runs a 1.2 x 0.6 m loop shedding water: 8192 slots, 3000 births
+            // a second living up to 2 s (seed 002's UV emitter).
+            "trail" => trail(
+                name,
+                ([-1.0, 0.0, -0.7], [1.0, 1.3, 0.7]),
+                [0.6, 0.3],
+                0.8,
+                8192,
+                3000.0,
+                2.0,
+                [1.6, 2.6],
+            ),
+            // Seed 002's game scene: 65537 particles shed by a character running a 2.4 x
+            // 1.6 m loop through a 4 x 3 m room around two pillars.
+            "game" => {
+                let mut s = trail(
+                    name,
+                    ([-2.0, 0.0, -1.5], [2.0, 2.0, 1.5]),
+                    [1.2, 0.8],
+                    1.2,
+                    65537,
+                    22000.0,
+                    4.0,
+                    [2.6, 4.6],
+                );
+                s.colliders = [-0.5f32, 0.5]
+                    .iter()
+                    .map(|&x| Collider::Capsule {
+                        a: [x, 0.0, 0.0],
+                        b: [x, 1.2, 0.0],
+                        radius: 0.12,
+                        velocity: [0.0; 3],
+                    })
+                    .collect();
+                s.frames = 300;
+                s
+            }
             "two-groups" => {
                 let mut s = wide(name, -0.2);
                 // Stripes 0.1 m wide along x.
@@ -544,6 +643,7 @@ impl Scene {
                 control: None,
                 targets: vec![],
                 timeline: vec![],
+                emission: None,
             },
             _ => return None,
         })
@@ -659,6 +759,15 @@ impl Scene {
         if let Some(c) = &self.character {
             c.validate(&self.name)?;
         }
+        if let Some(e) = &self.emission {
+            e.validate(&self.name)?;
+            if self.character.is_none() {
+                return Err(Error::Param(format!(
+                    "scene {}: [emission] needs a [character] to shed from",
+                    self.name
+                )));
+            }
+        }
         if self.control.is_some() && (self.character.is_none() || !self.has_fluid()) {
             return Err(Error::Param(format!(
                 "scene {}: [control] needs a [character] and fluid",
@@ -700,9 +809,9 @@ impl Scene {
             .collect()
     }
 
-    /// Blocks or balls of fluid (a scene may hold a character alone).
+    /// Blocks or balls of fluid, or emission (a scene may hold a character alone).
     pub fn has_fluid(&self) -> bool {
-        !(self.blocks.is_empty() && self.balls.is_empty())
+        !(self.blocks.is_empty() && self.balls.is_empty()) || self.emission.is_some()
     }
 
     /// The scene scaled about the origin by `s` (geometry and camera; the fluid's
@@ -740,8 +849,15 @@ impl Scene {
         out
     }
 
-    /// Scaled so it holds about `n` particles.
+    /// Scaled so it holds about `n` particles; with emission, `n` slots in all (the
+    /// emitter's are what is left after the scene's own fluid).
     pub fn with_particles(&self, n: u32) -> Self {
+        if let Some(e) = &self.emission {
+            let mut out = self.clone();
+            let own = self.particles(0).len() as u32 - e.slots;
+            out.emission.as_mut().expect("emission").slots = n.saturating_sub(own).max(1);
+            return out;
+        }
         let natural = self.particles(0).len().max(1) as f64;
         self.scaled((n as f64 / natural).cbrt() as f32)
     }
@@ -769,7 +885,7 @@ impl Scene {
                 )
             })
             .sum();
-        blocks + balls
+        blocks + balls + self.emission.as_ref().map_or(0.0, |e| e.slots as f64)
     }
 
     /// Refuse a scene whose particles would not fit, before any is made: more than
@@ -859,6 +975,16 @@ impl Scene {
                             .push([color[0], color[1], color[2], f32::from_bits(group)]);
                     }
                 }
+            }
+        }
+        // Emission slots start dead (pos.w < 0) at the domain's centre.
+        if let Some(e) = &self.emission {
+            let c: [f32; 3] = std::array::from_fn(|k| 0.5 * (dlo[k] + dhi[k]));
+            let col = e.color;
+            for _ in 0..e.slots {
+                out.pos.push([c[0], c[1], c[2], -1.0]);
+                out.vel.push([0.0; 4]);
+                out.attr.push([col[0], col[1], col[2], f32::from_bits(0)]);
             }
         }
         out

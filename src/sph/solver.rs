@@ -165,18 +165,19 @@ impl SphState {
         )
     }
 
-    /// Positions, velocities, attributes, (density, pressure) and accelerations, all in the
-    /// current (sorted) order.
+    /// Positions, velocities, attributes, (density, pressure) and accelerations of the live
+    /// particles (dead slots, pos.w < 0, left out), in the current (sorted) order.
     pub fn read(&self, ctx: &Context) -> Result<StateDump> {
         let n = self.n as usize;
         let p = &self.particles;
-        Ok(StateDump {
+        let d = StateDump {
             pos: p.read(ctx, POS, n)?,
             vel: p.read(ctx, VEL, n)?,
             attr: p.read(ctx, ATTR, n)?,
             rho_p: p.read(ctx, RHO_P, n)?,
             acc: p.read(ctx, ACC, n)?,
-        })
+        };
+        Ok(d.live())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -193,6 +194,30 @@ pub struct StateDump {
     pub attr: Vec<[f32; 4]>,
     pub rho_p: Vec<[f32; 2]>,
     pub acc: Vec<[f32; 4]>,
+}
+
+impl StateDump {
+    /// Only the live particles (pos.w >= 0).
+    pub fn live(self) -> Self {
+        if self.pos.iter().all(|p| p[3] >= 0.0) {
+            return self;
+        }
+        let keep: Vec<bool> = self.pos.iter().map(|p| p[3] >= 0.0).collect();
+        fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
+            v.iter()
+                .zip(keep)
+                .filter(|(_, k)| **k)
+                .map(|(x, _)| *x)
+                .collect()
+        }
+        Self {
+            pos: pick(&self.pos, &keep),
+            vel: pick(&self.vel, &keep),
+            attr: pick(&self.attr, &keep),
+            rho_p: pick(&self.rho_p, &keep),
+            acc: pick(&self.acc, &keep),
+        }
+    }
 }
 
 impl SphSolver {
@@ -258,6 +283,9 @@ impl SphSolver {
         store.upload(ctx, VEL, &particles.vel)?;
         store.upload(ctx, VHALF, &particles.vel)?;
         store.upload(ctx, ATTR, &particles.attr)?;
+        // Dead slots (an emitter's) are never written by the step: start them finite.
+        store.upload(ctx, RHO_P, &vec![[0.0f32; 2]; n])?;
+        store.upload(ctx, ACC, &vec![[0.0f32; 4]; n])?;
         let params = Guard::new(
             ctx,
             ctx.storage_buffer("sph params", std::mem::size_of::<SphGpuParams>() as u64)?,

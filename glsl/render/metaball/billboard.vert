@@ -25,7 +25,7 @@ void main() {
     float r = radius();
     float w = -c.z;  // depth in front of the eye
     vec2 lo, hi;
-    if (w + r <= P.proj.z) {
+    if (w + r <= P.proj.z || centers[id].w < 0.0) {  // behind the eye, or a dead slot
         gl_Position = vec4(2.0, 2.0, 0.5, 1.0);  // behind the eye: degenerate, culled
         return;
     } else if (w - r <= P.proj.z) {

@@ -30,7 +30,8 @@ bool cut = false;
         for (; b_ < P.n; b_ += ALL_UNROLL) { \
             [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) { \
                 uint j_ = b_ + u_; \
-                if (j_ < P.n) { vec3 d = x - centers[j_].xyz; ACC += TERM; } } } \
+                vec4 c_ = j_ < P.n ? centers[j_] : vec4(-1.0); \
+                if (c_.w >= 0.0) { vec3 d = x - c_.xyz; ACC += TERM; } } } \
         CUT_UNLESS(!(b_ < P.n)) \
     } else { SUM_LIST(x, p, ACC, TERM) } }
 #if LIST == LIST_ABUFFER
