@@ -353,7 +353,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "emission/emit.comp",
             "EmitParams",
             fields!(fluidform::emission::emit::EmitGpuParams;
-            n, valid_count, budget, seed, limit, dt, dtau, k),
+            n, sources, budget, seed, limit, dt, dtau, k, tau_lo, tau_hi, frame_dt, pad),
         ),
         (
             "emission/uv_compact.comp",
