@@ -163,6 +163,20 @@ enum BenchWhat {
         #[arg(long, value_delimiter = ',', value_name = "K,...")]
         velocities: Vec<f32>,
     },
+    /// Seed 002's figure 9: frames per second of an emitting scene at 8K..64K particles
+    /// (or --particles), counting grid and hash + bitonic (or --neighbors, --sort)
+    Emission {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+        #[command(flatten)]
+        search: NeighborArgs,
+        #[command(flatten)]
+        fluid_args: FluidArgs,
+        #[command(flatten)]
+        emission: fluidform::config::EmissionArgs,
+    },
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
         #[command(flatten)]
@@ -272,6 +286,23 @@ impl BenchWhat {
                 },
             ),
             BenchWhat::Sph(a) => ("sph", a.switches()),
+            BenchWhat::Emission {
+                common,
+                sorting,
+                search,
+                fluid_args,
+                emission,
+            } => (
+                "emission",
+                Switches {
+                    common,
+                    sorting,
+                    search,
+                    fluid_args,
+                    emission,
+                    ..d()
+                },
+            ),
             BenchWhat::Stability(a) => ("stability", a.switches()),
             BenchWhat::Render {
                 common,

@@ -2,6 +2,7 @@
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
 pub mod control;
+pub mod emission;
 pub mod plot;
 pub mod primitives;
 pub mod render;
@@ -62,6 +63,7 @@ pub const WHATS: &[&str] = &[
     "render",
     "skin",
     "control",
+    "emission",
 ];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
@@ -134,6 +136,13 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
                 &[Group::Control, Group::Character, Group::Fluid],
             )?;
             control::control(opts)?
+        }
+        "emission" => {
+            sw.reject_unused(
+                "bench emission",
+                &[Group::Sort, Group::Neighbors, Group::Fluid, Group::Emission],
+            )?;
+            emission::emission(&ctx, opts)?
         }
         other => {
             return Err(Error::Param(format!(

@@ -136,7 +136,9 @@ pub fn sweep_dated(
             .y_label_area_size(72)
             .build_cartesian_2d(
                 (nmin / 1.3..nmax * 1.3).log_scale(),
-                (cmin / 1.5..cmax * 1.5).log_scale(),
+                // Whole decades: a log axis labels only its decades' ticks.
+                (10f64.powf((cmin / 1.5).log10().floor())..10f64.powf((cmax * 1.5).log10().ceil()))
+                    .log_scale(),
             )
             .map_err(|e| err(path, e))?;
         chart

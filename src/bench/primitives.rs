@@ -309,6 +309,30 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
     };
     let mut out = Vec::new();
     match what {
+        "emission" => {
+            if let (Some(h), Some(g)) =
+                (ms("hash/bitonic", 64 << 10), ms("grid/counting", 64 << 10))
+            {
+                out.push(format!(
+                    "the counting grid's frame is {:.2}x faster than hash + bitonic at 64K (target: 2x)",
+                    h / g
+                ));
+            }
+            let per = |v: &str, n: u64| {
+                rows.iter()
+                    .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
+                    .min_by_key(|r| r.n.abs_diff(n))
+                    .map(|r| r.main.median / r.n as f64)
+            };
+            for v in ["grid/counting", "hash/bitonic"] {
+                if let (Some(a), Some(b)) = (per(v, 8 << 10), per(v, 64 << 10)) {
+                    out.push(format!(
+                        "{v}: cost per particle at 64K is {:.2}x that at 8K (target for the grid: within 1.5x)",
+                        b / a
+                    ));
+                }
+            }
+        }
         "sort" => {
             if let (Some(o), Some(c)) = (ms("odd-even", 64 << 10), ms("counting", 64 << 10)) {
                 out.push(format!(

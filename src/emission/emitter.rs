@@ -164,14 +164,15 @@ pub struct Emitter {
 }
 
 impl Emitter {
-    /// Register the life attribute in `st` (slots whose initial pos.w < 0 start dead, the
-    /// others are permanent) and make the pass for `source`.
+    /// Register the life attribute in `st` (slots whose initial pos.w < 0 start dead; the
+    /// others are permanent, or with `recycle` alive at ages spread over (0, limit)) and
+    /// make the pass for `source`.
     pub fn new(
         ctx: &Context,
         st: &mut SphState,
         initial: &[[f32; 4]],
         source: EmitSource,
-        settings: EmitSettings,
+        (settings, recycle): (EmitSettings, bool),
         seed: u64,
     ) -> Result<Self> {
         settings.validate()?;
@@ -183,9 +184,15 @@ impl Emitter {
         let life = st.particles.register(ctx, LIFE)?;
         let init: Vec<[f32; 4]> = initial
             .iter()
-            .map(|p| match p[3] < 0.0 {
-                true => [-1.0, 0.0, 0.0, 0.0],
-                false => [0.0, 1.0, 0.0, 0.0],
+            .enumerate()
+            .map(|(i, p)| match (p[3] < 0.0, recycle) {
+                (true, _) => [-1.0, 0.0, 0.0, 0.0],
+                (false, false) => [0.0, 1.0, 0.0, 0.0],
+                (false, true) => {
+                    // A golden-ratio sequence: ages evenly over (0, limit), no two alike.
+                    let u = ((i as f64 + 0.5) * 0.618_033_988_749_895).fract() as f32;
+                    [u * settings.limit, 0.0, 0.0, 0.0]
+                }
             })
             .collect();
         st.particles.upload(ctx, life, &init)?;

@@ -44,6 +44,11 @@ pub struct EmissionDesc {
     /// Colour of emitted particles.
     #[serde(default = "water")]
     pub color: [f32; 3],
+    /// The scene's own fluid are emitter slots too, alive at the start with ages spread
+    /// over (0, life limit): they die in turn and come back from the character (a steady
+    /// turnover from the first step, as benchmarks want).
+    #[serde(default)]
+    pub recycle: bool,
 }
 
 fn water() -> [f32; 3] {
@@ -63,6 +68,7 @@ impl EmissionDesc {
             uv_size: None,
             collide: true,
             color: water(),
+            recycle: false,
         }
     }
 
@@ -83,9 +89,9 @@ impl EmissionDesc {
     }
 
     pub fn validate(&self, scene: &str) -> Result<()> {
-        if self.slots == 0 {
+        if self.slots == 0 && !self.recycle {
             return Err(Error::Param(format!(
-                "scene {scene}: [emission] needs at least one slot"
+                "scene {scene}: [emission] needs at least one slot (or recycle = true)"
             )));
         }
         EmitSettings {

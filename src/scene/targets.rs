@@ -148,7 +148,7 @@ impl SceneTargets {
                 st,
                 initial,
                 source,
-                settings,
+                (settings, desc.recycle),
                 sw.common.seed,
             )?);
             solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(&emitter))));
