@@ -231,7 +231,7 @@ fn births(
             tau_lo: 0.0,
             tau_hi: 1.0,
             frame_dt: 1.0 / 30.0,
-            pad: 0,
+            jitter: 0.0,
         };
         let input = EmitInput {
             cur,

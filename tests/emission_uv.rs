@@ -271,7 +271,7 @@ fn emitted_particles_start_on_the_surface_with_its_velocity() {
             tau_lo: 0.0,
             tau_hi: 1.0,
             frame_dt,
-            pad: 0,
+            jitter: 0.0,
         };
         let step = |p: EmitGpuParams| {
             let input = EmitInput {

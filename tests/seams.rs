@@ -353,7 +353,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "emission/emit.comp",
             "EmitParams",
             fields!(fluidform::emission::emit::EmitGpuParams;
-            n, sources, budget, seed, limit, dt, dtau, k, tau_lo, tau_hi, frame_dt, pad),
+            n, sources, budget, seed, limit, dt, dtau, k, tau_lo, tau_hi, frame_dt, jitter),
         ),
         (
             "emission/uv_compact.comp",

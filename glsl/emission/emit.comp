@@ -22,7 +22,7 @@ struct EmitParams {
     float tau_lo;      // this step's share of the frame interval
     float tau_hi;
     float frame_dt;    // seconds between the two source frames
-    uint pad;
+    float jitter;      // births moved this far in a random direction (coincident births)
 };
 layout(std430, binding = EMIT_B_PARAMS) readonly buffer Params { EmitParams E; };
 layout(std430, binding = EMIT_B_CUR) readonly buffer Cur { vec4 cur[]; };    // Position_t
@@ -72,6 +72,8 @@ void main() {
         h = pcg(h);
         float t0 = max(tau - E.dtau, 0.0), t1 = min(tau + E.dtau, 1.0);
         vec3 p = at(s, tau);
+        vec3 dir = vec3(unit(pcg(h ^ 1u)), unit(pcg(h ^ 2u)), unit(pcg(h ^ 3u))) * 2.0 - 1.0;
+        p += E.jitter * dir;
         vec3 v = E.k * (at(s, t1) - at(s, t0)) / (t1 - t0);
         pos[i] = vec4(p, 0.0);
         vel[i] = vec4(v, 0.0);

@@ -3,7 +3,7 @@
 #include "common.glsl"
 void main() {
     uint i = global_id();
-    if (i >= sph_live()) return;
+    if (i >= sph_live() || pos[i].w < 0.0) return;  // past the live, or dead
     vec3 xi = pos[i].xyz;
     float h2 = P.h * P.h;
     float sum = 0.0;

@@ -4,7 +4,7 @@
 #include "common.glsl"
 void main() {
     uint i = global_id();
-    if (i >= sph_live()) return;
+    if (i >= sph_live() || pos[i].w < 0.0) return;  // past the live, or dead
     vec3 xi = pos[i].xyz;
     vec3 vi = vel[i].xyz;
     float rho_i = rho_p[i].x, p_i = rho_p[i].y;

@@ -16,7 +16,7 @@ vec3 respond(vec3 v, vec3 n, vec3 wall_v) {
 
 void main() {
     uint i = global_id();
-    if (i >= sph_live()) return;
+    if (i >= sph_live() || pos[i].w < 0.0) return;  // past the live, or dead
     float dt = P.gravity.w;
     vec3 a = acc[i].xyz;
     vec3 vh_old = vhalf[i].xyz;

@@ -24,7 +24,9 @@ pub struct EmitGpuParams {
     pub tau_lo: f32,
     pub tau_hi: f32,
     pub frame_dt: f32,
-    pub pad: u32,
+    /// Births are moved this far (metres) in a random direction: two births at one
+    /// source on a still surface would otherwise coincide, and SPH cannot part them.
+    pub jitter: f32,
 }
 const _: () = assert!(std::mem::size_of::<EmitGpuParams>() == 48);
 

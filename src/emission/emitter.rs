@@ -104,7 +104,12 @@ impl EmitSource {
             EmitSource::Vertices(v) => {
                 let next = 1 - v.current.get();
                 scopes.begin(ctx, cmd, "vertices");
-                ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
+                // The skinned vertices -> the copy; earlier emits' reads -> its write.
+                ctx.barrier(
+                    cmd,
+                    sync::COMPUTE_WRITE | sync::COMPUTE_READ,
+                    sync::TRANSFER_READ | sync::TRANSFER_WRITE,
+                );
                 ctx.copy(cmd, verts, 0, &v.pos[next], 0, v.vertices as u64 * 16);
                 ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
                 scopes.end(ctx, cmd);
@@ -148,6 +153,9 @@ pub const LIFE: AttributeDecl = AttributeDecl {
     bytes: 16,
     reorder: true,
 };
+
+/// Births' random offset, in rest spacings (emit.comp's `jitter`).
+pub const JITTER: f32 = 0.01;
 
 pub struct Emitter {
     pub pass: EmitPass,
@@ -254,7 +262,7 @@ impl Emitter {
             tau_lo: (k.min(steps - 1)) as f32 / steps as f32,
             tau_hi: (k.min(steps - 1) + 1) as f32 / steps as f32,
             frame_dt,
-            pad: 0,
+            jitter: JITTER * st.fluid.spacing(),
         };
         let (cur, prev, valid) = self.source.frames();
         let input = EmitInput {

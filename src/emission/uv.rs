@@ -28,7 +28,7 @@ const _: () = assert!(std::mem::size_of::<UvPush>() == 32);
 crate::gpu_interface! {
     /// glsl/emission/uv.glsl
     pub UvIo / UvBufs: "UV", push UvPush {
-        verts = 0, uvs = 1, src = 2, pos = 3, flags = 4, valid = 5,
+        verts = 0, uvs = 1, src = 2, pos = 3, flags = 4, valid = 5, owner = 6,
     }
 }
 
@@ -44,6 +44,9 @@ pub struct UvSurface {
     uvs: Buffer,
     src: Buffer,
     flags: Buffer,
+    /// Per texel: the one layout triangle that writes it (the lowest covering it), so
+    /// overlapping UV islands give every frame the same surface point.
+    owner: Buffer,
     /// World positions per texel: `pos[current()]` this frame's, the other the last.
     pub pos: [Buffer; 2],
     /// Covered texel indices, `valid_count` of them.
@@ -77,6 +80,15 @@ impl UvSurface {
             )));
         }
         let texels = size[0] as u64 * size[1] as u64;
+        if texels * 16 > ctx.max_storage_range() {
+            return Err(Error::Memory(format!(
+                "a {}x{} UV atlas needs {} bytes per position buffer, more than one storage binding may address on this device ({}); lower --uv-size",
+                size[0],
+                size[1],
+                texels * 16,
+                ctx.max_storage_range()
+            )));
+        }
         let desc = GraphicsDesc {
             name: "uv",
             vertex: "emission/uv.vert",
@@ -104,6 +116,7 @@ impl UvSurface {
         let mut src = buf("uv corner vertices", layout.src.len() as u64 * 4)?;
         ctx.upload(&mut src, 0, &layout.src)?;
         let flags = buf("uv flags", (texels + 1) * 4)?;
+        let owner = buf("uv texel owners", texels * 4)?;
         let pos0 = buf("uv positions 0", texels * 16)?;
         let pos1 = buf("uv positions 1", texels * 16)?;
         let valid = buf("uv valid texels", texels * 4)?;
@@ -118,6 +131,7 @@ impl UvSurface {
                 uvs: uvs.take(),
                 src: src.take(),
                 flags: flags.take(),
+                owner: owner.take(),
                 pos: [pos0.take(), pos1.take()],
                 valid: valid.take(),
                 valid_count: 0,
@@ -139,6 +153,15 @@ impl UvSurface {
         let mut verts = Guard::new(ctx, ctx.storage_buffer("uv rest", v4.len() as u64 * 16)?);
         ctx.upload(&mut verts, 0, &v4)?;
         ctx.one_shot(|cmd| -> Result<()> {
+            ctx.fill(cmd, &s.owner, u32::MAX);
+            // Cleared owners -> the claiming atomics (a read and a write).
+            ctx.barrier(
+                cmd,
+                sync::TRANSFER_WRITE,
+                sync::GRAPHICS_READ | sync::FRAGMENT_WRITE,
+            );
+            s.raster(ctx, cmd, &verts, 1);
+            ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::GRAPHICS_READ);
             s.record(ctx, cmd, &mut Labels, &verts)?;
             s.record_compact(ctx, cmd)
         })??;
@@ -163,6 +186,7 @@ impl UvSurface {
             verts,
             uvs: &self.uvs,
             src: &self.src,
+            owner: &self.owner,
             pos,
             flags: &self.flags,
             valid: &self.valid,
@@ -187,18 +211,12 @@ impl UvSurface {
             sync::TRANSFER_WRITE,
         );
         ctx.fill(cmd, &self.pos[next], 0);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::GRAPHICS_READ);
-        begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
-        let bufs = self.bufs(verts, &self.pos[next]);
-        for &(rect, first, count) in &self.parts {
-            let push = UvPush {
-                atlas: rect,
-                size: [self.size[0], self.size[1], self.push.size[2], 0],
-            };
-            self.raster.bind(ctx, cmd, &bufs, &push);
-            ctx.draw_range(cmd, 3 * count, 3 * first);
-        }
-        ctx.end_rendering(cmd);
+        ctx.barrier(
+            cmd,
+            sync::TRANSFER_WRITE,
+            sync::GRAPHICS_READ | sync::FRAGMENT_WRITE,
+        );
+        self.raster_into(ctx, cmd, verts, &self.pos[next], 0);
         // Positions -> the emitter (and copies).
         ctx.barrier(
             cmd,
@@ -208,6 +226,33 @@ impl UvSurface {
         scopes.end(ctx, cmd);
         self.current.set(next);
         Ok(())
+    }
+
+    /// Draw every part into `pos` (mode 0: the owners write; 1: claim the owners).
+    fn raster_into(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        verts: &Buffer,
+        pos: &Buffer,
+        mode: u32,
+    ) {
+        begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
+        let bufs = self.bufs(verts, pos);
+        for &(rect, first, count) in &self.parts {
+            let push = UvPush {
+                atlas: rect,
+                size: [self.size[0], self.size[1], self.push.size[2], mode],
+            };
+            self.raster.bind(ctx, cmd, &bufs, &push);
+            ctx.draw_range(cmd, 3 * count, 3 * first);
+        }
+        ctx.end_rendering(cmd);
+    }
+
+    /// Claim each texel for the lowest layout triangle covering it.
+    fn raster(&self, ctx: &Context, cmd: vk::CommandBuffer, verts: &Buffer, mode: u32) {
+        self.raster_into(ctx, cmd, verts, &self.pos[0], mode);
     }
 
     /// List the covered texels of the current positions (flags, scan, compaction).
@@ -249,6 +294,7 @@ impl UvSurface {
             &mut self.uvs,
             &mut self.src,
             &mut self.flags,
+            &mut self.owner,
             p0,
             p1,
             &mut self.valid,

@@ -151,7 +151,6 @@ impl SceneTargets {
                 (settings, desc.recycle),
                 sw.common.seed,
             )?);
-            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(&emitter))));
             let metrics = EmissionMetrics::new(ctx, slots);
             let mut e = SceneEmission {
                 emitter: Some(emitter),
@@ -179,6 +178,10 @@ impl SceneTargets {
                     )));
                 }
             }
+            // Hooked last: no error path leaves the solver a hook without its emitter.
+            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(
+                e.emitter.as_ref().expect("emitter"),
+            ))));
             out.emission = Some(e);
         }
         let mut t = out.take();

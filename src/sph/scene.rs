@@ -840,6 +840,8 @@ impl Scene {
         let chars = out.character.iter_mut();
         for c in chars.chain(out.targets.iter_mut().map(|t| &mut t.character)) {
             c.position = m(c.position);
+            c.path = c.path.iter().map(|p| m(*p)).collect();
+            c.path_speed *= s;
             match (c.height, c.scale) {
                 (Some(h), _) => c.height = Some(h * s),
                 (_, Some(k)) => c.scale = Some(k * s),
