@@ -272,7 +272,7 @@ fn parse_size(s: &str) -> std::result::Result<[u32; 2], String> {
         Some((w, h)) => [parse(w)?, parse(h)?],
         None => [parse(s)?; 2],
     };
-    if v.iter().any(|x| *x == 0) {
+    if v.contains(&0) {
         return Err(format!("'{s}': sizes must be positive"));
     }
     Ok(v)

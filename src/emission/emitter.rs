@@ -27,8 +27,9 @@ pub struct VertexSource {
     current: Cell<usize>,
 }
 
+#[allow(clippy::large_enum_variant)] // one per scene
 pub enum EmitSource {
-    Uv(UvSurface, UvLayout),
+    Uv(Box<UvSurface>, UvLayout),
     Vertices(VertexSource),
 }
 
@@ -46,7 +47,7 @@ impl EmitSource {
             EmitterKind::Uv => {
                 let layout = layout
                     .ok_or_else(|| Error::Param("the UV emitter needs a UV layout".into()))?;
-                EmitSource::Uv(UvSurface::new(ctx, &layout, rest, size)?, layout)
+                EmitSource::Uv(Box::new(UvSurface::new(ctx, &layout, rest, size)?), layout)
             }
             EmitterKind::Vertices => {
                 let n = rest.len() as u64;

@@ -167,16 +167,14 @@ impl SceneTargets {
                     return Err(err);
                 }
             }
-            if desc.collide {
-                if out.capsules.len() + out.colliders.len() > MAX_COLLIDERS {
-                    let n = out.capsules.len();
-                    e.destroy(ctx);
-                    return Err(crate::Error::Param(format!(
-                        "scene {}: {n} character capsules and {} colliders exceed {MAX_COLLIDERS}",
-                        scene.name,
-                        out.colliders.len()
-                    )));
-                }
+            if desc.collide && out.capsules.len() + out.colliders.len() > MAX_COLLIDERS {
+                let n = out.capsules.len();
+                e.destroy(ctx);
+                return Err(crate::Error::Param(format!(
+                    "scene {}: {n} character capsules and {} colliders exceed {MAX_COLLIDERS}",
+                    scene.name,
+                    out.colliders.len()
+                )));
             }
             // Hooked last: no error path leaves the solver a hook without its emitter.
             solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(
