@@ -155,14 +155,8 @@ impl ParticleExport {
             attr: bytemuck::cast_slice(cast(&c.attr)),
         };
         // Live particles only: an emitter's dead slots (pos.w < 0) are left out.
-        let keep: Vec<bool> = all.pos.iter().map(|p| p[3] >= 0.0).collect();
-        fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
-            v.iter()
-                .zip(keep)
-                .filter(|(_, k)| **k)
-                .map(|(x, _)| *x)
-                .collect()
-        }
+        use crate::sph::solver::{live_mask, pick};
+        let keep = live_mask(all.pos);
         let (pos, vel, rho_p, attr) = (
             pick(all.pos, &keep),
             pick(all.vel, &keep),

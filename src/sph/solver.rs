@@ -196,20 +196,27 @@ pub struct StateDump {
     pub acc: Vec<[f32; 4]>,
 }
 
+/// Per particle: live (pos.w >= 0; an emitter's dead slots have -1).
+pub fn live_mask(pos: &[[f32; 4]]) -> Vec<bool> {
+    pos.iter().map(|p| p[3] >= 0.0).collect()
+}
+
+/// The elements of `v` whose `keep` is set.
+pub fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
+    v.iter()
+        .zip(keep)
+        .filter(|(_, k)| **k)
+        .map(|(x, _)| *x)
+        .collect()
+}
+
 impl StateDump {
     /// Only the live particles (pos.w >= 0).
     pub fn live(self) -> Self {
         if self.pos.iter().all(|p| p[3] >= 0.0) {
             return self;
         }
-        let keep: Vec<bool> = self.pos.iter().map(|p| p[3] >= 0.0).collect();
-        fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
-            v.iter()
-                .zip(keep)
-                .filter(|(_, k)| **k)
-                .map(|(x, _)| *x)
-                .collect()
-        }
+        let keep = live_mask(&self.pos);
         Self {
             pos: pick(&self.pos, &keep),
             vel: pick(&self.vel, &keep),
