@@ -7,7 +7,6 @@ use super::{measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
-use crate::primitives::neighbors::default_sort;
 use crate::scene::emission::EmissionDesc;
 use crate::scene::targets::SceneTargets;
 use crate::sph::scene::Block;
@@ -49,13 +48,13 @@ pub fn scene(n: u32) -> Scene {
 
 pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let sw = &opts.switches;
-    let strategies = match sw.search.neighbors {
-        Some(s) => vec![(s, sw.sorting.sort.unwrap_or(default_sort(s)))],
-        None => vec![
+    let strategies = super::sph::strategies(
+        opts,
+        &[
             (Neighbors::Grid, SortAlgo::Counting),
             (Neighbors::Hash, SortAlgo::Bitonic),
         ],
-    };
+    );
     let counts = match sw.common.particles {
         Some(n) => vec![n],
         None => COUNTS.to_vec(),

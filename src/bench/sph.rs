@@ -10,15 +10,15 @@ use crate::sph::{Scene, SphSolver};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
-fn strategies(opts: &BenchOptions) -> Vec<(Neighbors, SortAlgo)> {
+/// --neighbors (with --sort or its default sort), else `all`.
+pub fn strategies(
+    opts: &BenchOptions,
+    all: &[(Neighbors, SortAlgo)],
+) -> Vec<(Neighbors, SortAlgo)> {
     let sw = &opts.switches;
     match sw.search.neighbors {
         Some(s) => vec![(s, sw.sorting.sort.unwrap_or(default_sort(s)))],
-        None => vec![
-            (Neighbors::Grid, SortAlgo::Counting),
-            (Neighbors::Hash, SortAlgo::Bitonic),
-            (Neighbors::Morton, SortAlgo::OddEven),
-        ],
+        None => all.to_vec(),
     }
 }
 
@@ -27,7 +27,14 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut base = Scene::built_in("dam-break").expect("built-in");
     base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args.fluid)?;
     let mut rows = Vec::new();
-    for (strategy, sort) in strategies(opts) {
+    for (strategy, sort) in strategies(
+        opts,
+        &[
+            (Neighbors::Grid, SortAlgo::Counting),
+            (Neighbors::Hash, SortAlgo::Bitonic),
+            (Neighbors::Morton, SortAlgo::OddEven),
+        ],
+    ) {
         // Guards release the solver and state on every path, an early `?` included.
         let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
         for n in counts(opts) {
@@ -93,7 +100,14 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     if let Some(n) = opts.switches.common.particles {
         scene = scene.with_particles(n);
     }
-    let (strategy, sort) = strategies(opts)[0];
+    let (strategy, sort) = strategies(
+        opts,
+        &[
+            (Neighbors::Grid, SortAlgo::Counting),
+            (Neighbors::Hash, SortAlgo::Bitonic),
+            (Neighbors::Morton, SortAlgo::OddEven),
+        ],
+    )[0];
     let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
     let parts = scene.particles(opts.switches.common.seed);
     let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);

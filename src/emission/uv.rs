@@ -160,7 +160,7 @@ impl UvSurface {
                 sync::TRANSFER_WRITE,
                 sync::GRAPHICS_READ | sync::FRAGMENT_WRITE,
             );
-            s.raster(ctx, cmd, &verts, 1);
+            s.raster_into(ctx, cmd, &verts, &s.pos[0], 1); // claim the owners
             ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::GRAPHICS_READ);
             s.record(ctx, cmd, &mut Labels, &verts)?;
             s.record_compact(ctx, cmd)
@@ -248,11 +248,6 @@ impl UvSurface {
             ctx.draw_range(cmd, 3 * count, 3 * first);
         }
         ctx.end_rendering(cmd);
-    }
-
-    /// Claim each texel for the lowest layout triangle covering it.
-    fn raster(&self, ctx: &Context, cmd: vk::CommandBuffer, verts: &Buffer, mode: u32) {
-        self.raster_into(ctx, cmd, verts, &self.pos[0], mode);
     }
 
     /// List the covered texels of the current positions (flags, scan, compaction).

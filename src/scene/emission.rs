@@ -94,14 +94,9 @@ impl EmissionDesc {
                 "scene {scene}: [emission] needs at least one slot (or recycle = true)"
             )));
         }
-        EmitSettings {
-            limit: self.life_limit.unwrap_or(2.0),
-            rate: self.rate,
-            transfer: self.transfer.unwrap_or(1.0),
-            dtau: 0.05,
-        }
-        .validate()
-        .map_err(|e| Error::Param(format!("scene {scene}: [emission] {e}")))
+        self.resolve(&Switches::default())
+            .map(|_| ())
+            .map_err(|e| Error::Param(format!("scene {scene}: [emission] {e}")))
     }
 }
 
@@ -236,14 +231,6 @@ pub struct EmissionMetrics {
 }
 
 impl EmissionMetrics {
-    pub fn empty() -> Self {
-        Self {
-            readbacks: Vec::new(),
-            times: Vec::new(),
-            rows: Vec::new(),
-        }
-    }
-
     pub fn new(ctx: &Context, slots: usize) -> Result<Self> {
         let mut readbacks = crate::gpu::Guard::new(ctx, Vec::new());
         for _ in 0..slots {
@@ -386,7 +373,6 @@ pub struct SceneEmission {
     pub metrics: EmissionMetrics,
     /// Index of the emitting character in the scene's characters.
     pub character: usize,
-    pub collide: bool,
     pub slots: u32,
     /// The source has taken a frame (the first frame primes the previous one too).
     pub primed: bool,

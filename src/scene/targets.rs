@@ -133,15 +133,22 @@ impl SceneTargets {
         if let Some(desc) = &scene.emission {
             // validate() made sure of the [character]: the first character.
             let (kind, settings, size) = desc.resolve(sw)?;
-            if desc.collide {
-                out.capsules = capsules::of(&out.live[0].character.ch);
-            }
             let ch = &out.live[0].character.ch;
+            let caps = capsules::of(ch);
+            if desc.collide && caps.len() + out.colliders.len() > MAX_COLLIDERS {
+                return Err(crate::Error::Param(format!(
+                    "scene {}: {} character capsules and {} colliders exceed {MAX_COLLIDERS}",
+                    scene.name,
+                    caps.len(),
+                    out.colliders.len()
+                )));
+            }
             let layout = match kind {
                 crate::config::EmitterKind::Vertices => None,
                 _ if !ch.mesh.uvs.is_empty() => Some(UvLayout::from_mesh(&ch.mesh, size)?),
-                _ => Some(UvLayout::from_capsules(&ch.mesh, &capsules::of(ch), size)?),
+                _ => Some(UvLayout::from_capsules(&ch.mesh, &caps, size)?),
             };
+            let metrics = Guard::new(ctx, EmissionMetrics::new(ctx, slots)?);
             let source = EmitSource::new(ctx, kind, layout, &ch.mesh.positions, size)?;
             let emitter = Rc::new(Emitter::new(
                 ctx,
@@ -151,36 +158,18 @@ impl SceneTargets {
                 (settings, desc.recycle),
                 sw.common.seed,
             )?);
-            let metrics = EmissionMetrics::new(ctx, slots);
-            let mut e = SceneEmission {
+            // Hooked last: no error path leaves the solver a hook without its emitter.
+            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(&emitter))));
+            if desc.collide {
+                out.capsules = caps;
+            }
+            out.emission = Some(SceneEmission {
                 emitter: Some(emitter),
-                metrics: EmissionMetrics::empty(),
+                metrics: metrics.take(),
                 character: 0,
-                collide: desc.collide,
                 slots: desc.slots,
                 primed: false,
-            };
-            match metrics {
-                Ok(m) => e.metrics = m,
-                Err(err) => {
-                    e.destroy(ctx);
-                    return Err(err);
-                }
-            }
-            if desc.collide && out.capsules.len() + out.colliders.len() > MAX_COLLIDERS {
-                let n = out.capsules.len();
-                e.destroy(ctx);
-                return Err(crate::Error::Param(format!(
-                    "scene {}: {n} character capsules and {} colliders exceed {MAX_COLLIDERS}",
-                    scene.name,
-                    out.colliders.len()
-                )));
-            }
-            // Hooked last: no error path leaves the solver a hook without its emitter.
-            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(
-                e.emitter.as_ref().expect("emitter"),
-            ))));
-            out.emission = Some(e);
+            });
         }
         let mut t = out.take();
         t.fading = vec![None; t.controlled.len()];
@@ -276,7 +265,7 @@ impl SceneTargets {
         let ch = &self.live[e.character].character;
         let end = t + frame_dt as f64;
         prof.begin(ctx, cmd, "emission");
-        let emitter = e.emitter.as_ref().expect("a live emitter");
+        let emitter = e.emitter.as_deref().expect("a live emitter");
         let times: &[f64] = match e.primed {
             true => &[end],
             false => &[t, end],
@@ -288,7 +277,7 @@ impl SceneTargets {
         prof.end(ctx, cmd);
         e.primed = true;
         emitter.begin_frame(steps, frame_dt);
-        if e.collide {
+        if !self.capsules.is_empty() {
             let (m0, m1) = (ch.matrices(t), ch.matrices(end));
             let mut list = self.colliders.clone();
             for c in &self.capsules {
@@ -322,7 +311,7 @@ impl SceneTargets {
     ) -> Result<()> {
         let emitting = self.emission.as_ref().map(|e| e.character);
         if let Some(e) = &mut self.emission {
-            let emitter = e.emitter.as_ref().expect("a live emitter");
+            let emitter = e.emitter.as_deref().expect("a live emitter");
             e.metrics.record(ctx, cmd, emitter, slot, frame, t);
         }
         for (i, l) in self.live.iter().enumerate() {
@@ -440,7 +429,7 @@ impl SceneTargets {
             return Ok(None);
         };
         let mesh = &self.live[e.character].character.ch.mesh;
-        let emitter = e.emitter.as_ref().expect("a live emitter");
+        let emitter = e.emitter.as_deref().expect("a live emitter");
         e.metrics
             .finish(ctx, emitter, mesh, (e.slots, seconds), out)
             .map(Some)
