@@ -19,6 +19,7 @@ const STATIC_LIBS: &[&str] = &[
 
 fn main() {
     embed_glsl();
+    embed_commit();
     println!("cargo:rerun-if-env-changed=SHADERC_LIB_DIR");
     println!("cargo:rerun-if-changed=build.rs");
     if env::var("CARGO_FEATURE_BUILD_FROM_SOURCE").is_ok() {
@@ -34,6 +35,32 @@ fn main() {
 
 /// Embed every file under glsl/ so the binary runs from anywhere (a GPU machine gets
 /// only the binary); shaders are still compiled at run time, with the run's defines.
+/// FLUIDFORM_COMMIT: the commit the binary is built from (experiments record it, so
+/// results name the code that measured them, not the checkout they were run in).
+fn embed_commit() {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let commit = match git(&["rev-parse", "--short", "HEAD"]) {
+        Some(c) => match git(&["status", "--porcelain", "--untracked-files=no"]) {
+            Some(s) if !s.is_empty() => format!("{c} with uncommitted changes"),
+            _ => c,
+        },
+        None => "unknown (not built in a git checkout)".into(),
+    };
+    println!("cargo:rustc-env=FLUIDFORM_COMMIT={commit}");
+    for p in [".git/HEAD", ".git/index"] {
+        if Path::new(p).exists() {
+            println!("cargo:rerun-if-changed={p}");
+        }
+    }
+}
+
 fn embed_glsl() {
     let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("glsl");
     println!("cargo:rerun-if-changed={}", root.display());

@@ -7,6 +7,7 @@ pub mod config;
 pub mod control;
 pub mod emission;
 pub mod error;
+pub mod experiment;
 pub mod export;
 pub mod gpu;
 pub mod particles;

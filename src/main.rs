@@ -95,11 +95,18 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Reproduce a table of the papers
+    /// Reproduce a table or figure of the papers: table2..table8, fig9, adaptive,
+    /// scaling, or all; writes <out>/<name>.csv, .md, .png and findings.md
     Experiment {
         name: String,
+        /// Output directory (default results/<device-slug>)
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Shrunk sizes and repetitions: `all` in a few minutes on lavapipe
+        #[arg(long)]
+        quick: bool,
+        #[command(flatten)]
+        common: fluidform::config::CommonArgs,
     },
 }
 
@@ -416,6 +423,7 @@ fn real_main() -> Result<()> {
                 character,
                 vertices,
                 velocities,
+                counts: Vec::new(),
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{} configurations; wrote {}", rows.len(), out.display());
@@ -443,8 +451,27 @@ fn real_main() -> Result<()> {
             }
             Ok(())
         }
-        Command::Experiment { name, .. } => {
-            bail!("experiment '{name}' is not implemented yet: experiments arrive with the papers' tables")
+        Command::Experiment {
+            name,
+            out,
+            quick,
+            common,
+        } => {
+            if common.particles.is_some() {
+                bail!("experiment: --particles is not used (each experiment sets its own counts)");
+            }
+            let mut switches = Switches::parse_default();
+            switches.common = common;
+            let files = fluidform::experiment::run(&fluidform::experiment::ExperimentOptions {
+                name,
+                out,
+                quick,
+                switches,
+            })?;
+            for f in &files {
+                println!("wrote {}", f.display());
+            }
+            Ok(())
         }
     }
 }

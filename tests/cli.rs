@@ -241,7 +241,6 @@ fn unimplemented_switches_and_bad_values_fail_clearly() {
             vec!["bench", "scan", "--out", d, "--neighbors", "grid"],
             "unexpected argument '--neighbors'",
         ),
-        (vec!["experiment", "table2"], "not implemented yet"),
     ] {
         let o = fluidform(&args);
         let t = text(&o);

@@ -132,7 +132,7 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
 }
 
 /// (time, coverage) of `target` from a run's control.csv.
-fn coverage_of(path: &std::path::Path, target: &str) -> Result<Vec<(f64, f64)>> {
+pub fn coverage_of(path: &std::path::Path, target: &str) -> Result<Vec<(f64, f64)>> {
     let io = |e: csv::Error| Error::Param(format!("{}: {e}", path.display()));
     let mut r = csv::Reader::from_path(path).map_err(io)?;
     let mut out = Vec::new();

@@ -57,6 +57,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     );
     let counts = match sw.common.particles {
         Some(n) => vec![n],
+        None if !opts.counts.is_empty() => opts.counts.clone(),
         None => COUNTS.to_vec(),
     };
     let mut rows = Vec::new();

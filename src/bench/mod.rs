@@ -34,6 +34,8 @@ pub struct BenchOptions {
     pub vertices: Option<u32>,
     /// bench control: velocity-term gains to sweep (empty: --control-velocity or 0).
     pub velocities: Vec<f32>,
+    /// Particle counts to sweep where --particles is unset (empty: the benchmark's own).
+    pub counts: Vec<u32>,
 }
 
 /// `config` of one benchmark configuration's summary.json.
@@ -78,6 +80,7 @@ pub const SWEEP: &[u32] = &[
 ];
 
 /// One measured configuration: a row of the sweep table.
+#[derive(Clone)]
 pub struct Row {
     pub variant: String,
     pub n: u64,
@@ -161,6 +164,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
 pub fn counts(opts: &BenchOptions) -> Vec<u32> {
     match opts.switches.common.particles {
         Some(n) => vec![n],
+        None if !opts.counts.is_empty() => opts.counts.clone(),
         None => SWEEP.to_vec(),
     }
 }

@@ -275,3 +275,133 @@ pub fn coverage(
         .map_err(|e| err(path, e))?;
     root.present().map_err(|e| err(path, e))
 }
+
+/// Grouped bars on a log axis: one group per label, one bar per series (missing values
+/// leave a gap). `subtitle` names the device and date.
+pub fn grouped_bars(
+    path: &Path,
+    title: &str,
+    subtitle: &str,
+    labels: &[String],
+    series: &[(String, Vec<Option<f64>>)],
+    y_desc: &str,
+) -> Result<()> {
+    font()?;
+    let values = series.iter().flat_map(|(_, v)| v.iter().flatten().copied());
+    let (lo, hi) = values
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .fold((f64::MAX, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = match hi > 0.0 {
+        true => (lo, hi),
+        false => (1.0, 10.0),
+    };
+    let y0 = 10f64.powf((lo / 1.5).log10().floor());
+    let y1 = 10f64.powf((hi * 1.5).log10().ceil());
+    let root = BitMapBackend::new(path, (1000, 580)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{title} ({subtitle})"), ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(60)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..labels.len() as f64, (y0..y1).log_scale())
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(labels.len() * 2 + 1)
+        .x_label_formatter(&|x| {
+            let i = (*x - 0.5).round();
+            if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+                labels[i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .y_desc(y_desc)
+        .y_label_formatter(&|y| match *y >= 10.0 {
+            true => format!("{y:.0}"),
+            false => format!("{y:.2}"),
+        })
+        .draw()
+        .map_err(|e| err(path, e))?;
+    let k = series.len().max(1) as f64;
+    let w = 0.8 / k;
+    for (s, (name, vals)) in series.iter().enumerate() {
+        let c = PALETTE[s % PALETTE.len()];
+        let bars = vals.iter().enumerate().filter_map(|(i, v)| {
+            let v = (*v)?;
+            let x = i as f64 + 0.1 + s as f64 * w;
+            Some(Rectangle::new(
+                [(x, y0), (x + w * 0.9, v.max(y0))],
+                c.filled(),
+            ))
+        });
+        chart
+            .draw_series(bars)
+            .map_err(|e| err(path, e))?
+            .label(name.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    root.present().map_err(|e| err(path, e))
+}
+
+/// Frames side by side with a label above each and a title: an image sheet.
+pub fn sheet(
+    path: &Path,
+    title: &str,
+    labels: &[String],
+    images: &[Vec<u8>],
+    (w, h): (u32, u32),
+    cols: usize,
+) -> Result<()> {
+    font()?;
+    // Tiles at most 256 pixels wide keep sheets small.
+    let scale = (w.div_ceil(256)).max(1);
+    let (tw, th) = (w / scale, h / scale);
+    let cols = cols.max(1);
+    let rows = labels.len().div_ceil(cols);
+    let (pad, head, label) = (8u32, 36u32, 22u32);
+    let sw = cols as u32 * (tw + pad) + pad;
+    let sh = head + rows as u32 * (th + label + pad) + pad;
+    let mut buf = vec![255u8; (sw * sh * 3) as usize];
+    for (i, img) in images.iter().enumerate() {
+        if img.len() != (w * h * 4) as usize {
+            continue;
+        }
+        let (cx, cy) = ((i % cols) as u32, (i / cols) as u32);
+        let (x0, y0) = (
+            pad + cx * (tw + pad),
+            head + cy * (th + label + pad) + label,
+        );
+        for y in 0..th {
+            for x in 0..tw {
+                let s = (((y * scale) * w + x * scale) * 4) as usize;
+                let d = (((y0 + y) * sw + x0 + x) * 3) as usize;
+                buf[d..d + 3].copy_from_slice(&img[s..s + 3]);
+            }
+        }
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (sw, sh)).into_drawing_area();
+        let style = ("sans-serif", 18).into_font().color(&BLACK);
+        root.draw_text(title, &style, (pad as i32, 8))
+            .map_err(|e| err(path, e))?;
+        let small = ("sans-serif", 15).into_font().color(&BLACK);
+        for (i, l) in labels.iter().enumerate() {
+            let (cx, cy) = ((i % cols) as u32, (i / cols) as u32);
+            let (x0, y0) = (pad + cx * (tw + pad), head + cy * (th + label + pad));
+            root.draw_text(l, &small, (x0 as i32, y0 as i32 + 3))
+                .map_err(|e| err(path, e))?;
+        }
+        root.present().map_err(|e| err(path, e))?;
+    }
+    image::save_buffer(path, &buf, sw, sh, image::ExtendedColorType::Rgb8).map_err(|e| err(path, e))
+}

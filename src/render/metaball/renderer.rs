@@ -97,6 +97,22 @@ impl MetaballRenderer {
         })
     }
 
+    /// Take settings that compile to the same shaders at the same frame size (threshold,
+    /// radius, step, refinement, depth, ...), so sweeps over them reuse the pipelines.
+    pub fn retune(&mut self, settings: MetaballSettings) -> Result<()> {
+        settings.validate()?;
+        let same = settings.shader_defines() == self.settings.shader_defines()
+            && (settings.width, settings.height) == (self.settings.width, self.settings.height)
+            && settings.sky == self.settings.sky;
+        if !same {
+            return Err(Error::Param(
+                "retune: these settings need other shaders or another frame size".into(),
+            ));
+        }
+        self.settings = settings;
+        Ok(())
+    }
+
     /// Buffers for these settings, up to `n_capacity` metaballs and `slots` frames.
     pub fn buffers(
         &self,

@@ -1,0 +1,149 @@
+//! The papers' qualitative findings, each confirmed or refuted by an experiment's numbers.
+//! Every experiment saves its verdicts as `<name>.findings.json`; `findings.md` is rebuilt
+//! from all of them, one section per claim.
+use super::{io, write, Env, NAMES};
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+pub const ORDER: &str = "S-buffer faster than A-buffer faster than none in every row";
+pub const MEMORY: &str = "S-buffer memory below the A-buffer's";
+pub const ADAPTIVE: &str = "adaptive control pressure fills the shape faster";
+pub const GRID_BEATS: &str = "the counting grid beats hash + bitonic sort";
+pub const GRID_LINEAR: &str = "the counting grid scales linearly in N";
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    Confirmed,
+    Refuted,
+    NotMeasured,
+}
+
+impl Verdict {
+    pub fn of(holds: bool) -> Self {
+        match holds {
+            true => Verdict::Confirmed,
+            false => Verdict::Refuted,
+        }
+    }
+
+    pub fn word(self) -> &'static str {
+        match self {
+            Verdict::Confirmed => "confirmed",
+            Verdict::Refuted => "refuted",
+            Verdict::NotMeasured => "not measured",
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Finding {
+    pub claim: String,
+    pub verdict: Verdict,
+    /// The numbers behind the verdict.
+    pub evidence: String,
+}
+
+impl Finding {
+    pub fn new(claim: &str, verdict: Verdict, evidence: String) -> Self {
+        Self {
+            claim: claim.into(),
+            verdict,
+            evidence,
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct Saved {
+    experiment: String,
+    quick: bool,
+    device: String,
+    date: String,
+    findings: Vec<Finding>,
+}
+
+/// Save `<name>.findings.json` with the run's device, date and mode.
+pub fn save(env: &Env, name: &str, found: &[Finding]) -> Result<()> {
+    let s = Saved {
+        experiment: name.into(),
+        quick: env.quick,
+        device: env.meta.device.clone(),
+        date: env.meta.date.clone(),
+        findings: found.to_vec(),
+    };
+    let text = serde_json::to_string_pretty(&s).map_err(|e| Error::Param(e.to_string()))?;
+    write(&env.out.join(format!("{name}.findings.json")), &text)
+}
+
+/// findings.md from every `<name>.findings.json` in the output directory.
+pub fn rebuild(env: &Env) -> Result<PathBuf> {
+    let mut saved = Vec::new();
+    for name in NAMES {
+        let p = env.out.join(format!("{name}.findings.json"));
+        if !p.exists() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).map_err(|e| io(&p, e))?;
+        let s: Saved = serde_json::from_str(&text)
+            .map_err(|e| Error::Param(format!("{}: {e}", p.display())))?;
+        saved.push(s);
+    }
+    let mut claims: Vec<String> = Vec::new();
+    for s in &saved {
+        for f in &s.findings {
+            if !claims.contains(&f.claim) {
+                claims.push(f.claim.clone());
+            }
+        }
+    }
+    let mut md = format!(
+        "# The papers' findings on {}\n\nWritten by `fluidform experiment`: each claim of the \
+         papers, confirmed or refuted by the experiments that measure it (their tables are \
+         beside this file). A claim is refuted where any experiment refutes it.\n\n",
+        env.meta.device
+    );
+    for c in &claims {
+        let all: Vec<(&Saved, &Finding)> = saved
+            .iter()
+            .flat_map(|s| {
+                s.findings
+                    .iter()
+                    .filter(|f| &f.claim == c)
+                    .map(move |f| (s, f))
+            })
+            .collect();
+        let measured: Vec<_> = all
+            .iter()
+            .filter(|(_, f)| f.verdict != Verdict::NotMeasured)
+            .collect();
+        let overall = if measured.is_empty() {
+            Verdict::NotMeasured
+        } else if measured.iter().any(|(_, f)| f.verdict == Verdict::Refuted) {
+            Verdict::Refuted
+        } else {
+            Verdict::Confirmed
+        };
+        md.push_str(&format!("## {c}: **{}**\n\n", overall.word()));
+        for (s, f) in all {
+            md.push_str(&format!(
+                "- [{}]({}.md) ({}{}): {}. {}\n",
+                s.experiment,
+                s.experiment,
+                match s.date.is_empty() {
+                    true => "date not recorded".to_string(),
+                    false => s.date.clone(),
+                },
+                if s.quick { ", --quick" } else { "" },
+                f.verdict.word(),
+                f.evidence
+            ));
+        }
+        md.push('\n');
+    }
+    md.push_str(&env.meta.markdown(env));
+    let p = env.out.join("findings.md");
+    write(&p, &md)?;
+    Ok(p)
+}

@@ -1,0 +1,529 @@
+//! The experiments over N or time: seed 002's figure 9 (counting grid against hash +
+//! bitonic), the thesis's adaptive-pressure fill test (figures 12/13), and our own
+//! scaling sweep of the SPH step and the renderer.
+use super::findings::{self, Finding, Verdict};
+use super::{write, Env, Steps};
+use crate::bench::Row;
+use crate::config::{Adaptive, ListKind, Neighbors, SortAlgo};
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use std::path::PathBuf;
+
+fn per_particle_ns(r: &Row) -> f64 {
+    r.main.median * 1e6 / r.n.max(1) as f64
+}
+
+/// CSV of sweep rows: kind, variant, n, reps, median/min/max ms, ns per particle.
+fn csv(rows: &[(String, Row)]) -> String {
+    let mut s = String::from("kind,variant,n,reps,median_ms,min_ms,max_ms,fps,ns_per_particle\n");
+    for (kind, r) in rows {
+        s.push_str(&format!(
+            "{kind},{},{},{},{:.4},{:.4},{:.4},{:.3},{:.3}\n",
+            r.variant,
+            r.n,
+            r.reps,
+            r.main.median,
+            r.main.min,
+            r.main.max,
+            1000.0 / r.main.median,
+            per_particle_ns(r)
+        ));
+    }
+    s
+}
+
+/// Markdown rows: variant, N, reps, median [min, max] ms, fps, ns per particle.
+fn md_rows(rows: &[&Row]) -> String {
+    let mut s = String::from(
+        "| variant | N | reps | median ms [min, max] | fps | ns per particle |\n|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {} | {} | {:.3} [{:.3}, {:.3}] | {:.2} | {:.1} |\n",
+            r.variant,
+            r.n,
+            r.reps,
+            r.main.median,
+            r.main.min,
+            r.main.max,
+            1000.0 / r.main.median,
+            per_particle_ns(r)
+        ));
+    }
+    s
+}
+
+/// Grid against hash at each N (`a` and `b` variants), and the grid's growth of cost per
+/// particle from its cheapest N to its largest.
+fn grid_findings(rows: &[&Row], a: &str, b: &str, what: &str) -> Vec<Finding> {
+    let of = |v: &str| -> Vec<&Row> { rows.iter().copied().filter(|r| r.variant == v).collect() };
+    let (ga, hb) = (of(a), of(b));
+    let mut wins = Vec::new();
+    for g in &ga {
+        if let Some(h) = hb.iter().find(|h| h.n == g.n) {
+            wins.push((g.n, h.main.median / g.main.median));
+        }
+    }
+    let mut out = Vec::new();
+    out.push(match wins.is_empty() {
+        true => Finding::new(
+            findings::GRID_BEATS,
+            Verdict::NotMeasured,
+            format!("{what}: no N with both"),
+        ),
+        false => Finding::new(
+            findings::GRID_BEATS,
+            Verdict::of(wins.iter().all(|w| w.1 > 1.0)),
+            format!(
+                "{what}: {b} / {a} time {}",
+                wins.iter()
+                    .map(|(n, r)| format!("{r:.2}x at N = {n}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ),
+    });
+    if ga.len() >= 2 {
+        let last = ga.last().expect("two rows");
+        let best = ga
+            .iter()
+            .map(|r| per_particle_ns(r))
+            .fold(f64::INFINITY, f64::min);
+        let growth = per_particle_ns(last) / best;
+        out.push(Finding::new(
+            findings::GRID_LINEAR,
+            Verdict::of(growth <= 1.5),
+            format!(
+                "{what}: {a} cost per particle at N = {} is {growth:.2}x its lowest over N = {}..{} \
+                 (linear: at most 1.5x); {}",
+                last.n,
+                ga[0].n,
+                last.n,
+                ga.iter()
+                    .map(|r| format!("{:.0} ns at {}", per_particle_ns(r), r.n))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    }
+    out
+}
+
+pub fn fig9(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
+    let counts: Vec<u32> = match env.quick {
+        true => vec![8 << 10, 16 << 10],
+        false => crate::bench::emission::COUNTS.to_vec(),
+    };
+    let mut opts = env.bench_options("emission", "fig9");
+    let mut steps = Steps::new("fig9", counts.len() as u64, env.switches.common.quiet);
+    let mut rows = Vec::new();
+    for &n in &counts {
+        steps.start(&format!("N = {n}"));
+        opts.counts = vec![n];
+        rows.extend(crate::bench::emission::emission(ctx, &opts)?);
+        steps.tick();
+    }
+    steps.finish();
+    let refs: Vec<&Row> = rows.iter().collect();
+    let found = grid_findings(&refs, "grid/counting", "hash/bitonic", "emitting frame");
+    let tagged: Vec<(String, Row)> = rows
+        .iter()
+        .map(|r| ("frame".to_string(), r.clone()))
+        .collect();
+    let p_csv = env.out.join("fig9.csv");
+    write(&p_csv, &csv(&tagged))?;
+    let labels: Vec<String> = refs
+        .iter()
+        .filter(|r| r.variant == "grid/counting")
+        .map(|r| r.n.to_string())
+        .collect();
+    let series: Vec<(String, Vec<Option<f64>>)> = ["grid/counting", "hash/bitonic"]
+        .iter()
+        .map(|v| {
+            let vals = refs
+                .iter()
+                .filter(|r| r.variant == *v)
+                .map(|r| Some(1000.0 / r.main.median))
+                .collect();
+            (v.to_string(), vals)
+        })
+        .collect();
+    let png = env.out.join("fig9.png");
+    crate::bench::plot::grouped_bars(
+        &png,
+        "Seed 002 figure 9: emitting frame rate against N",
+        &format!("{}, {}", env.meta.device, env.meta.date),
+        &labels,
+        &series,
+        "frames per second",
+    )?;
+    let mut md = String::from(
+        "# Seed 002, figure 9: frame rate against particle count, counting grid vs hash + bitonic\n\n\
+         The paper's figure plots frames per second at 8K, 16K, 32K and 64K particles on a \
+         GeForce GT240M and a GTX 590 with the counting grid and with hashing + bitonic sort; \
+         its text gives no values, only that the grid is O(N) and faster. Ours: `bench \
+         emission`'s scene (the game room, a floor pool of N emitter slots kept alive by \
+         births), one frame = skin + RenderToUV (512x512) + one step with emit; medians of \
+         GPU frame time after warm-up.\n\n",
+    );
+    md.push_str(&md_rows(&refs));
+    md.push_str("\n| N | grid fps | hash fps | grid speed-up |\n|---|---|---|---|\n");
+    for g in refs.iter().filter(|r| r.variant == "grid/counting") {
+        let n = g.n;
+        let h = refs
+            .iter()
+            .find(|r| r.variant == "hash/bitonic" && r.n == n)
+            .map(|r| 1000.0 / r.main.median);
+        if let (g, Some(h)) = (1000.0 / g.main.median, h) {
+            md.push_str(&format!("| {n} | {g:.2} | {h:.2} | {:.2}x |\n", g / h));
+        }
+    }
+    md.push_str("\n![frames per second against N](fig9.png)\n");
+    let p_md = super::finish_md(env, "fig9", md, &found)?;
+    Ok((vec![p_csv, p_md, png], found))
+}
+
+fn extra<'a>(r: &'a Row, key: &str) -> &'a str {
+    r.extra
+        .iter()
+        .find(|(k, _)| k == key)
+        .map(|(_, v)| v.as_str())
+        .unwrap_or("-")
+}
+
+pub fn adaptive(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
+    let modes: &[Adaptive] = match env.quick {
+        true => &[Adaptive::Off, Adaptive::On],
+        false => &[Adaptive::Off, Adaptive::On, Adaptive::Smooth],
+    };
+    let mut opts = env.bench_options("control", "adaptive");
+    opts.character = Some("giraffe".into());
+    opts.frames = if env.quick { 40 } else { 700 };
+    let mut steps = Steps::new("adaptive", modes.len() as u64, env.switches.common.quiet);
+    let mut rows = Vec::new();
+    let mut series = Vec::new();
+    for &mode in modes {
+        steps.start(mode.as_str().as_str());
+        opts.switches.control.adaptive = Some(mode);
+        let r = crate::bench::control::control(&opts)?;
+        let row = r
+            .into_iter()
+            .next()
+            .ok_or_else(|| Error::Param("no row".into()))?;
+        let csv = opts.out.join("runs").join(&row.variant).join("control.csv");
+        series.push((
+            row.variant.clone(),
+            crate::bench::control::coverage_of(&csv, "character")?,
+        ));
+        rows.push(row);
+        steps.tick();
+    }
+    steps.finish();
+    let time = |r: &Row, k: &str| extra(r, k).parse::<f64>().ok();
+    let (off, on) = (&rows[0], &rows[1]);
+    let found = {
+        let t80 = (time(off, "time to 80% s"), time(on, "time to 80% s"));
+        let cov = |r: &Row| extra(r, "mean coverage").parse::<f64>().unwrap_or(0.0);
+        let f = match t80 {
+            (Some(a), Some(b)) => Finding::new(
+                findings::ADAPTIVE,
+                Verdict::of(b < a),
+                format!(
+                    "giraffe to 80% coverage: off {a:.2} s, on {b:.2} s of simulated time: \
+                     {:.2}x faster (the thesis: 6x, 180 s against 30 s)",
+                    a / b
+                ),
+            ),
+            (None, Some(b)) => Finding::new(
+                findings::ADAPTIVE,
+                Verdict::Confirmed,
+                format!("on reaches 80% coverage at {b:.2} s, off never within the run"),
+            ),
+            (Some(a), None) => Finding::new(
+                findings::ADAPTIVE,
+                Verdict::Refuted,
+                format!("off reaches 80% coverage at {a:.2} s, on never within the run"),
+            ),
+            (None, None) => Finding::new(
+                findings::ADAPTIVE,
+                Verdict::of(cov(on) > cov(off)),
+                format!(
+                    "neither reaches 80% coverage within {} frames; mean coverage over the \
+                     run: off {:.3}, on {:.3}",
+                    opts.frames,
+                    cov(off),
+                    cov(on)
+                ),
+            ),
+        };
+        vec![f]
+    };
+    let png = env.out.join("adaptive.png");
+    crate::bench::plot::coverage(
+        &png,
+        "giraffe fill, adaptive control pressure",
+        &env.meta.device,
+        &series,
+    )?;
+    let mut md = String::from(
+        "# Adaptive control pressure: the giraffe fill test (thesis figures 12/13)\n\n\
+         The thesis fills a giraffe (its neck 2-3 particles wide) from a pool: without adaptive \
+         control pressure the fill stalls at the neck and takes 180 s, with it 30 s (6x). Ours: \
+         the built-in `giraffe` scene (`bench control`, points view 64x64), one run per mode \
+         for the same number of frames. Times are simulated seconds to 80% and 90% coverage \
+         (control particles whose fluid density reaches half the rest density); 'not in T s': \
+         never within the run.\n\n\
+         | mode | control particles | frames | GPU frame ms (median) | time to 80% | time to 90% | final coverage | mean coverage | final inside |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        md.push_str(&format!(
+            "| {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |\n",
+            r.variant,
+            r.n,
+            r.reps,
+            r.main.median,
+            extra(r, "time to 80% s"),
+            extra(r, "time to 90% s"),
+            extra(r, "final coverage"),
+            extra(r, "mean coverage"),
+            extra(r, "final inside"),
+        ));
+    }
+    md.push_str("\n| thesis | time to fill |\n|---|---|\n| without adaptive pressure | 180 s |\n| with | 30 s |\n");
+    md.push_str("\n![coverage against time](adaptive.png)\n");
+    let mut csv = String::from("mode,control_particles,frames,frame_ms,time_to_80_s,time_to_90_s,final_coverage,mean_coverage,final_inside\n");
+    for r in &rows {
+        csv.push_str(&format!(
+            "{},{},{},{:.4},{},{},{},{},{}\n",
+            r.variant,
+            r.n,
+            r.reps,
+            r.main.median,
+            time(r, "time to 80% s")
+                .map(|t| t.to_string())
+                .unwrap_or_default(),
+            time(r, "time to 90% s")
+                .map(|t| t.to_string())
+                .unwrap_or_default(),
+            extra(r, "final coverage"),
+            extra(r, "mean coverage"),
+            extra(r, "final inside"),
+        ));
+    }
+    let p_csv = env.out.join("adaptive.csv");
+    write(&p_csv, &csv)?;
+    let p_md = super::finish_md(env, "adaptive", md, &found)?;
+    Ok((vec![p_csv, p_md, png], found))
+}
+
+pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
+    let (sph_counts, render_factors, cap_ms): (Vec<u32>, Vec<f64>, f64) = match env.quick {
+        true => (vec![1 << 10, 4 << 10], vec![0.5, 1.0, 2.0], 300.0),
+        false => (
+            vec![
+                1 << 10,
+                4 << 10,
+                16 << 10,
+                64 << 10,
+                256 << 10,
+                1 << 20,
+                4 << 20,
+            ],
+            vec![0.5, 1.0, 2.0, 4.0, 8.0, 16.0],
+            4000.0,
+        ),
+    };
+    let strategies = [
+        (Neighbors::Grid, SortAlgo::Counting),
+        (Neighbors::Hash, SortAlgo::Bitonic),
+        (Neighbors::Morton, SortAlgo::OddEven),
+    ];
+    let lists = [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer];
+    let total = strategies.len() * sph_counts.len() + lists.len() * render_factors.len();
+    let mut steps = Steps::new("scaling", total as u64, env.switches.common.quiet);
+    let mut rows: Vec<(String, Row)> = Vec::new();
+    let mut stops: Vec<String> = Vec::new();
+    let mut opts = env.bench_options("sph", "scaling");
+    let limit = crate::sph::solver::MAX_PARTICLES
+        .min(ctx.info.device_local_bytes / 2 / crate::sph::solver::BYTES_PER_PARTICLE);
+    for (strategy, sort) in strategies {
+        opts.switches.search.neighbors = Some(strategy);
+        opts.switches.sorting.sort = Some(sort);
+        let mut stopped = false;
+        for &n in &sph_counts {
+            steps.start(&format!("sph {} N = {n}", strategy.as_str()));
+            if !stopped && n as u64 > limit {
+                stops.push(format!(
+                    "sph {}: N = {n} exceeds what the device holds ({limit})",
+                    strategy.as_str()
+                ));
+                stopped = true;
+            }
+            if !stopped {
+                opts.counts = vec![n];
+                let r = crate::bench::sph::steps(ctx, &opts)?;
+                for row in r {
+                    if row.main.median > cap_ms {
+                        stops.push(format!(
+                            "sph {}: stopped after N = {} ({:.0} ms a step, over the {cap_ms:.0} ms cap)",
+                            row.variant, row.n, row.main.median
+                        ));
+                        stopped = true;
+                    }
+                    rows.push(("sph".into(), row));
+                }
+            }
+            steps.tick();
+        }
+    }
+    // Render: the thesis scene's walker and camera filled with more and more particles.
+    let base_n = env.particles;
+    let seed = env.switches.common.seed;
+    let cam = env.scene(ctx)?.camera;
+    let ropts = env.bench_options("render", "scaling");
+    for list in lists {
+        let mut stopped = false;
+        for &f in &render_factors {
+            let n = (base_n as f64 * f).round() as usize;
+            steps.start(&format!("render {} N = {n}", list.as_str()));
+            if !stopped {
+                match render_row(ctx, env, &ropts, list, n, seed, &cam) {
+                    Ok(row) => {
+                        if row.main.median > cap_ms {
+                            stops.push(format!(
+                                "render {}: stopped after N = {n} ({:.0} ms a frame, over the {cap_ms:.0} ms cap)",
+                                list.as_str(),
+                                row.main.median
+                            ));
+                            stopped = true;
+                        }
+                        rows.push(("render".into(), row));
+                    }
+                    Err(Error::Memory(m)) => {
+                        stops.push(format!(
+                            "render {}: N = {n} does not fit: {m}",
+                            list.as_str()
+                        ));
+                        stopped = true;
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+            steps.tick();
+        }
+    }
+    steps.finish();
+    let sph: Vec<&Row> = rows
+        .iter()
+        .filter(|(k, _)| k == "sph")
+        .map(|(_, r)| r)
+        .collect();
+    let render: Vec<&Row> = rows
+        .iter()
+        .filter(|(k, _)| k == "render")
+        .map(|(_, r)| r)
+        .collect();
+    let mut found = grid_findings(&sph, "grid/counting", "hash/bitonic", "SPH step");
+    let mut fails = Vec::new();
+    for list in lists {
+        let ms: Vec<f64> = render
+            .iter()
+            .filter(|r| r.variant == list.as_str())
+            .map(|r| r.main.median)
+            .collect();
+        if !ms.windows(2).all(|w| w[1] > w[0]) {
+            fails.push(list.as_str());
+        }
+    }
+    found.push(Finding::new(
+        "cost rises with the particle count N",
+        Verdict::of(fails.is_empty()),
+        format!(
+            "render frame time over N = {}..{} rises for {} of 3 lists{}",
+            render.first().map(|r| r.n).unwrap_or(0),
+            render.iter().map(|r| r.n).max().unwrap_or(0),
+            3 - fails.len(),
+            match fails.is_empty() {
+                true => String::new(),
+                false => format!(" (not for {})", fails.join(", ")),
+            }
+        ),
+    ));
+    let p_csv = env.out.join("scaling.csv");
+    write(&p_csv, &csv(&rows))?;
+    let png = env.out.join("scaling.png");
+    let plot_rows: Vec<Row> = rows
+        .iter()
+        .map(|(k, r)| Row {
+            variant: format!("{k} {}", r.variant),
+            ..r.clone()
+        })
+        .collect();
+    crate::bench::plot::sweep(
+        &png,
+        "scaling: SPH step and render frame",
+        "GPU",
+        &env.meta.device,
+        &plot_rows,
+    )?;
+    let mut md = String::from(
+        "# Scaling: SPH step and metaball frame from 1K particles up\n\n\
+         Ours (no paper table). SPH: one step of the dam break scaled to N (`bench sph`), per \
+         neighbour strategy. Render: the thesis scene's walker and camera (tables 2-8) filled \
+         with N particles at a shrinking spacing, Phong at the table size, per list. A series \
+         stops where the device cannot hold N or a repetition exceeds the time cap.\n\n## SPH step\n\n",
+    );
+    md.push_str(&md_rows(&sph));
+    md.push_str("\n## Render frame\n\n");
+    md.push_str(&md_rows(&render));
+    if !stops.is_empty() {
+        md.push_str("\nSeries stopped:\n\n");
+        for s in &stops {
+            md.push_str(&format!("- {s}\n"));
+        }
+    }
+    md.push_str("\n![cost per particle against N](scaling.png)\n");
+    let p_md = super::finish_md(env, "scaling", md, &found)?;
+    Ok((vec![p_csv, p_md, png], found))
+}
+
+/// One render configuration of the scaling sweep: the thesis walker with `n` particles.
+fn render_row(
+    ctx: &Context,
+    env: &mut Env,
+    opts: &crate::bench::BenchOptions,
+    list: ListKind,
+    n: usize,
+    seed: u64,
+    cam: &crate::render::Camera,
+) -> Result<Row> {
+    let centers = env.scene(ctx)?.with_particles(n, seed)?;
+    let mut s = super::measure::base(env.width, env.height)?;
+    s.list = list;
+    let mut buf = ctx.storage_buffer("scaling centers", (n * 16) as u64)?;
+    let result = (|| -> Result<Row> {
+        ctx.upload(&mut buf, 0, &centers)?;
+        let (r, b) = env.renderer(ctx, &s, n as u64)?;
+        r.render_sync(ctx, b, &buf, n as u32, cam, 0)?;
+        let detail = serde_json::json!({ "settings": s, "particles": n });
+        let mut row = crate::bench::measure(
+            ctx,
+            opts,
+            list.as_str().as_str(),
+            n as u64,
+            "render",
+            detail,
+            |prof, cmd| {
+                prof.begin(ctx, cmd, "render");
+                r.record(ctx, cmd, prof, b, &buf, n as u32, cam, 0)?;
+                prof.end(ctx, cmd);
+                Ok(())
+            },
+        )?;
+        row.variant = list.as_str();
+        Ok(row)
+    })();
+    ctx.destroy_buffer(&mut buf);
+    result
+}
