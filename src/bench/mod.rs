@@ -189,7 +189,8 @@ pub fn measure(
     let reps = if per_frame_s * opts.frames as f64 <= opts.budget_s {
         opts.frames
     } else {
-        ((opts.budget_s / per_frame_s.max(1e-9)) as u64).clamp(3, opts.frames)
+        // At least three repetitions where the run asks for that many.
+        ((opts.budget_s / per_frame_s.max(1e-9)) as u64).clamp(opts.frames.min(3), opts.frames)
     };
     let warmup = if per_frame_s * (opts.warmup as f64) < opts.budget_s / 10.0 {
         opts.warmup.saturating_sub(1)
