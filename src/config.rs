@@ -23,7 +23,18 @@ macro_rules! switch_enum {
 switch_enum!(SortAlgo {
     OddEven,
     Bitonic,
-    Counting
+    Counting,
+    None
+});
+switch_enum!(Integrator {
+    Euler,
+    Verlet,
+    Closed
+});
+switch_enum!(SpriteMode {
+    Points,
+    Streaks,
+    Sprites
 });
 switch_enum!(Neighbors { Morton, Grid, Hash });
 switch_enum!(ListKind {
@@ -105,6 +116,18 @@ impl FrameArgs {
 pub struct SortArgs {
     #[arg(long, value_enum)]
     pub sort: Option<SortAlgo>,
+}
+
+/// GPU particle systems (seed 003).
+#[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct ParticleArgs {
+    /// Particle-system integrator: euler and verlet keep state on the GPU; closed
+    /// evaluates p0 + v0 t + g t^2 / 2 in the vertex shader (gravity only, no update pass)
+    #[arg(long, value_enum)]
+    pub integrator: Option<Integrator>,
+    /// How particle systems are drawn (default: each system's own)
+    #[arg(long, value_enum)]
+    pub draw: Option<SpriteMode>,
 }
 
 /// Neighbour search strategy.
@@ -321,6 +344,9 @@ pub struct Switches {
     #[command(flatten)]
     #[serde(flatten)]
     pub emission: EmissionArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub particle: ParticleArgs,
 }
 
 impl Default for CommonArgs {
@@ -371,6 +397,7 @@ pub enum Group {
     Character,
     Control,
     Emission,
+    Particles,
 }
 
 /// The switches of `g` that differ from the group's defaults, as written on the command
@@ -394,7 +421,7 @@ impl Switches {
     /// applies, and for every control switch (not built yet), naming what brings it: a
     /// switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
-        let groups: [(Group, Vec<String>, &str); 10] = [
+        let groups: [(Group, Vec<String>, &str); 11] = [
             (
                 Group::Sort,
                 set_in(&self.sorting),
@@ -436,6 +463,11 @@ impl Switches {
                 Group::Emission,
                 set_in(&self.emission),
                 "scenes with [emission] (motion-trail emission) and bench emission",
+            ),
+            (
+                Group::Particles,
+                set_in(&self.particle),
+                "particle-system scenes (fountain, rain, smoke, flock) and bench particles",
             ),
         ];
         for (g, set, owner) in groups {

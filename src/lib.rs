@@ -13,6 +13,7 @@ pub mod gpu;
 pub mod particles;
 pub mod primitives;
 pub mod progress;
+pub mod psys;
 pub mod render;
 pub mod report;
 pub mod run;

@@ -72,6 +72,7 @@ pub enum RunStats {
     Sph(Box<SphRunStats>),
     Character(Box<CharacterRunStats>),
     Orbits(OrbitsStats),
+    Particles(Box<crate::psys::run::ParticleRunStats>),
 }
 
 pub type RunSummary = Summary<RunConfig, RunStats>;
@@ -90,7 +91,7 @@ pub struct RunResult {
 pub const ANIMATION_FPS: u16 = 30;
 
 /// Where saved frames go: frame_NNNN.png each, and animation.png (APNG) of them all.
-struct Frames<'a> {
+pub(crate) struct Frames<'a> {
     out: &'a Path,
     every: u64,
     /// Frames the run plays.
@@ -100,7 +101,7 @@ struct Frames<'a> {
 }
 
 impl<'a> Frames<'a> {
-    fn new(out: &'a Path, every: u64, total: u64) -> Self {
+    pub(crate) fn new(out: &'a Path, every: u64, total: u64) -> Self {
         Self {
             out,
             every,
@@ -110,12 +111,12 @@ impl<'a> Frames<'a> {
         }
     }
 
-    fn save(&self, f: u64) -> bool {
+    pub(crate) fn save(&self, f: u64) -> bool {
         self.every > 0 && f.is_multiple_of(self.every)
     }
 
     /// Write frame `f`'s picture as a PNG and as the animation's next frame.
-    fn store(&mut self, f: u64, pic: Option<Picture>) -> Result<()> {
+    pub(crate) fn store(&mut self, f: u64, pic: Option<Picture>) -> Result<()> {
         let Some(pic) = pic else { return Ok(()) };
         let path = self.out.join(format!("frame_{f:04}.png"));
         save_rgba(&path, pic.width, pic.height, pic.rgba)?;
@@ -152,6 +153,9 @@ pub fn run(opts: &RunOptions) -> Result<RunResult> {
     })?;
     if opts.scene == "orbits" {
         return run_orbits(opts);
+    }
+    if let Some(scene) = crate::psys::scenes::ParticleScene::find(&opts.scene)? {
+        return crate::psys::run::run(opts, scene);
     }
     let scene = crate::sph::Scene::load(&opts.scene)?;
     match scene.has_fluid() {
@@ -626,7 +630,7 @@ fn run_character(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResul
 
 /// The end of a run without fluid (orbits, a character alone): the animation closed,
 /// summary.json written, validation checked.
-fn finish_fluidless(
+pub(crate) fn finish_fluidless(
     ctx: &Context,
     opts: &RunOptions,
     sw: &Switches,

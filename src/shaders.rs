@@ -38,6 +38,20 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::render::mesh::MeshIo>("render/mesh.vert", &[]),
         with::<crate::render::mesh::MeshIo>("render/mesh.frag", &[]),
     ];
+    use crate::psys::gpu::{DrawIo, PsysIo};
+    for f in [
+        "psys/emit.comp",
+        "psys/args.comp",
+        "psys/update.comp",
+        "psys/keys.comp",
+    ] {
+        v.push(with::<PsysIo>(f, &[]));
+    }
+    for mode in 0..3 {
+        for f in ["psys/draw.vert", "psys/draw.frag"] {
+            v.push(with::<DrawIo>(f, &[kv("MODE", mode)]));
+        }
+    }
     use crate::character::skin::{SkinIo, SkinPass};
     for method in [crate::config::Skinning::Lbs, crate::config::Skinning::Dqs] {
         for sets in [1, 2] {

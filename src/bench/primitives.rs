@@ -1,7 +1,7 @@
 //! Benchmarks of the GPU primitives: scan (against a buffer copy), sorts, neighbours.
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, Context, Guard};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
@@ -117,6 +117,10 @@ fn cell_keys(n: u32, seed: u64) -> (Vec<u32>, u32) {
 
 pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let algos = match opts.switches.sorting.sort {
+        Some(SortAlgo::None) => return Err(Error::Param(
+            "bench sort --sort none: nothing to measure (none applies to particle-system sprites)"
+                .into(),
+        )),
         Some(s) => vec![s],
         None => vec![SortAlgo::OddEven, SortAlgo::Bitonic, SortAlgo::Counting],
     };
@@ -127,7 +131,7 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         let mut network = match algo {
             SortAlgo::OddEven => Some(NetworkSort::new(ctx, Network::OddEven)?),
             SortAlgo::Bitonic => Some(NetworkSort::new(ctx, Network::Bitonic)?),
-            SortAlgo::Counting => None,
+            SortAlgo::Counting | SortAlgo::None => None,
         };
         for n in counts(opts) {
             let (keys, cells) = cell_keys(n, opts.switches.common.seed);

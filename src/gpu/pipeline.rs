@@ -338,6 +338,8 @@ pub struct GraphicsDesc<'a> {
     /// None: no colour attachment (passes that only write storage buffers).
     pub color_format: Option<vk::Format>,
     pub depth_format: Option<vk::Format>,
+    /// Alpha blending (src alpha, one minus src alpha): drawn back to front, so depth is
+    /// tested but not written.
     pub blend: bool,
     pub topology: vk::PrimitiveTopology,
 }
@@ -393,7 +395,7 @@ impl<I: Interface> GraphicsPipeline<I> {
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(d.depth_format.is_some())
-            .depth_write_enable(d.depth_format.is_some())
+            .depth_write_enable(d.depth_format.is_some() && !d.blend)
             .depth_compare_op(vk::CompareOp::LESS);
         let attachment = [vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(d.blend)

@@ -177,6 +177,11 @@ impl Context {
         unsafe { self.device.cmd_draw(cmd, vertices, instances, 0, 0) };
     }
 
+    /// One draw whose VkDrawIndirectCommand a GPU pass wrote into `args` at byte `offset`.
+    pub fn draw_indirect(&self, cmd: vk::CommandBuffer, args: &super::Buffer, offset: u64) {
+        unsafe { self.device.cmd_draw_indirect(cmd, args.raw, offset, 1, 16) };
+    }
+
     /// `vertices` vertices from `first` (gl_VertexIndex counts from `first`), one instance.
     pub fn draw_range(&self, cmd: vk::CommandBuffer, vertices: u32, first: u32) {
         unsafe { self.device.cmd_draw(cmd, vertices, 1, first, 0) };

@@ -198,6 +198,11 @@ impl NeighborBuffers {
 impl NeighborSearch {
     pub fn new(ctx: &Context, strategy: Neighbors, sort: Option<SortAlgo>) -> Result<Self> {
         let sort = sort.unwrap_or(default_sort(strategy));
+        if sort == SortAlgo::None {
+            return Err(Error::Param(
+                "--sort none applies only to particle-system sprites: the neighbour search needs a sort (odd-even, bitonic or counting)".into(),
+            ));
+        }
         if strategy == Neighbors::Morton && sort == SortAlgo::Counting {
             return Err(Error::Param(
                 "--neighbors morton sorts 30-bit codes: use --sort odd-even or bitonic (counting needs bounded cell keys)".into(),
@@ -214,6 +219,7 @@ impl NeighborSearch {
                 SortAlgo::Counting => Sorter::Counting(CountingSort::new(ctx)?),
                 SortAlgo::OddEven => Sorter::Network(NetworkSort::new(ctx, Network::OddEven)?),
                 SortAlgo::Bitonic => Sorter::Network(NetworkSort::new(ctx, Network::Bitonic)?),
+                SortAlgo::None => unreachable!("refused above"),
             },
         );
         let keys = Guard::new(

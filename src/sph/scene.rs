@@ -657,8 +657,9 @@ impl Scene {
         let path = Path::new(name_or_path);
         if !path.exists() {
             return Err(Error::Param(format!(
-                "unknown scene '{name_or_path}': not a built-in ({}, orbits) nor an existing file",
-                BUILT_IN.join(", ")
+                "unknown scene '{name_or_path}': not a built-in ({}, orbits, {}) nor an existing file",
+                BUILT_IN.join(", "),
+                crate::psys::scenes::BUILT_IN.join(", ")
             )));
         }
         let text = std::fs::read_to_string(path).map_err(|e| Error::Io {

@@ -1,0 +1,116 @@
+// GPU particle systems (seed 003): the system's parameters, the counters and helpers.
+// Mirrors src/psys/gpu.rs (SystemParams, Counters); one source of truth for the layout.
+#ifndef PSYS_COMMON_GLSL
+#define PSYS_COMMON_GLSL
+#define MAX_KEYS 8
+#define MAX_FORCES 8
+#define MAX_COLLIDERS 8
+// Force kinds (Force.a.w).
+#define F_ATTRACTOR 1
+#define F_VORTEX 2
+#define F_CURL 3
+// Collider kinds (Collider.a.w).
+#define C_PLANE 1
+#define C_SPHERE 2
+#define C_BOX 3
+#define C_CAPSULE 4
+// Emitter shapes (emitter.w).
+#define E_POINT 0
+#define E_BOX 1
+#define E_SPHERE 2
+#define E_DISC 3
+// Integrators.
+#define I_EULER 0
+#define I_VERLET 1
+#define I_CLOSED 2
+// Slot of a free or culled entry in an order list.
+#define NO_SLOT 0xFFFFFFFFu
+
+struct Force {
+    vec4 a;  // attractor: xyz point, w kind | vortex: xyz centre | curl: -
+    vec4 b;  // attractor: x strength (< 0 repels), y eps | vortex: xyz axis, w strength |
+             // curl: x strength, y scale (1/m), z speed (1/s)
+};
+struct Collider {
+    vec4 a;  // plane: xyz normal, w kind | sphere: xyz centre | box: xyz min | capsule: xyz end 0
+    vec4 b;  // plane: x offset | sphere: x radius | box: xyz max | capsule: xyz end 1, w radius
+    vec4 c;  // x restitution, y friction, z inside (1: keep inside), w kill on hit (1)
+};
+struct SystemParams {
+    vec4 emitter;       // xyz centre, w shape
+    vec4 extent;        // box half extents xyz; sphere and disc radius x; w surface only (1)
+    vec4 normal;        // disc normal
+    vec4 offset_mean;   // position offset
+    vec4 offset_var;
+    vec4 vel_mean;
+    vec4 vel_var;
+    vec4 color_mean;    // rgba (a: opacity)
+    vec4 color_var;
+    vec4 scalar_mean;   // x size (m), y life (s)
+    vec4 scalar_var;
+    vec4 gravity;       // xyz
+    vec4 wind;          // xyz wind velocity, w drag per second toward it
+    vec4 death;         // x damping per second, y max distance from the source (0: off),
+                        // z die out of view (1), w type id
+    uvec4 counts;       // x forces, y colliders, z size keys, w colour keys
+    uvec4 counts2;      // x opacity keys, y integrator, z -, w -
+    vec4 size_keys[MAX_KEYS];     // x life fraction, y factor
+    vec4 color_keys[MAX_KEYS];    // rgb factor, w life fraction
+    vec4 opacity_keys[MAX_KEYS];  // x life fraction, y factor
+    Force forces[MAX_FORCES];
+    Collider colliders[MAX_COLLIDERS];
+};
+struct Counters {
+    int dead_count;     // free slots on the dead stack (stateful)
+    uint alive[2];      // alive-list lengths (ping-pong)
+    uint pad0;
+    uint update_args[4];  // VkDispatchIndirectCommand over the alive list (+ pad)
+    uint draw_args[4];    // VkDrawIndirectCommand: vertices, instances, first vertex, first
+    uint births;
+    uint refused;       // births refused: no free slot (the budget)
+    uint died_life;
+    uint died_view;
+    uint died_distance;
+    uint died_collision;
+    uint overwritten;   // closed form: live particles overwritten by the ring (the budget)
+    uint pad1;
+};
+
+// PCG hash (Jarzynski & Olano 2020): a uniform u32 per input.
+uint pcg(uint v) {
+    uint s = v * 747796405u + 2891336453u;
+    uint w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (w >> 22u) ^ w;
+}
+// Uniform in [0, 1) from a stream state that advances.
+float rnd(inout uint s) { s = pcg(s); return float(s >> 8) * (1.0 / 16777216.0); }
+// Uniform in [-1, 1).
+float srnd(inout uint s) { return 2.0 * rnd(s) - 1.0; }
+vec3 srnd3(inout uint s) { return vec3(srnd(s), srnd(s), srnd(s)); }
+vec4 srnd4(inout uint s) { return vec4(srnd(s), srnd(s), srnd(s), srnd(s)); }
+
+// Piecewise-linear keyframes (x: life fraction, y: value); 1 without keys.
+float curve1(vec4 keys[MAX_KEYS], uint n, float u) {
+    if (n == 0u) return 1.0;
+    if (u <= keys[0].x) return keys[0].y;
+    for (uint k = 1u; k < n; k++) {
+        if (u <= keys[k].x) {
+            float t = (u - keys[k - 1u].x) / max(keys[k].x - keys[k - 1u].x, 1e-6);
+            return mix(keys[k - 1u].y, keys[k].y, t);
+        }
+    }
+    return keys[n - 1u].y;
+}
+// Colour keys: rgb, w life fraction.
+vec3 curve3(vec4 keys[MAX_KEYS], uint n, float u) {
+    if (n == 0u) return vec3(1.0);
+    if (u <= keys[0].w) return keys[0].xyz;
+    for (uint k = 1u; k < n; k++) {
+        if (u <= keys[k].w) {
+            float t = (u - keys[k - 1u].w) / max(keys[k].w - keys[k - 1u].w, 1e-6);
+            return mix(keys[k - 1u].xyz, keys[k].xyz, t);
+        }
+    }
+    return keys[n - 1u].xyz;
+}
+#endif

@@ -1,0 +1,75 @@
+#version 450
+// Births: one invocation per new particle. Euler and Verlet pop a free slot from the dead
+// stack (none left: the birth is refused and counted) and append it to the alive list the
+// update reads; closed form writes the ring's next slots (a live particle there is
+// overwritten and counted). Every attribute is mean + rand * variance, rand in [-1, 1).
+#include "common/index.glsl"
+#include "state.glsl"
+
+vec3 shape_point(inout uint s) {
+    uint shape = uint(sp.emitter.w);
+    vec3 e = sp.extent.xyz;
+    bool surface = sp.extent.w > 0.5;
+    if (shape == E_BOX) {
+        vec3 p = srnd3(s);
+        if (surface) {  // push one random axis to a face
+            uint k = min(uint(rnd(s) * 3.0), 2u);
+            p[k] = p[k] < 0.0 ? -1.0 : 1.0;
+        }
+        return p * e;
+    }
+    if (shape == E_SPHERE) {
+        // Uniform direction; radius cube root for a uniform volume.
+        float z = srnd(s), phi = 6.2831853 * rnd(s);
+        vec3 d = vec3(sqrt(max(1.0 - z * z, 0.0)) * vec2(cos(phi), sin(phi)), z);
+        return d * e.x * (surface ? 1.0 : pow(rnd(s), 1.0 / 3.0));
+    }
+    if (shape == E_DISC) {
+        vec3 n = normalize(sp.normal.xyz);
+        vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
+        vec3 b = cross(n, t);
+        float r = e.x * (surface ? 1.0 : sqrt(rnd(s))), phi = 6.2831853 * rnd(s);
+        return r * (cos(phi) * t + sin(phi) * b);
+    }
+    return vec3(0.0);
+}
+
+void main() {
+    uint i = global_id();
+    if (i >= pc.births) return;
+    uint slot;
+    uint integrator = sp.counts2.y;
+    if (integrator == I_CLOSED) {
+        slot = (pc.head + i) % pc.capacity;
+        vec4 old = pos[slot];
+        if (old.w >= 0.0 && pc.source.w - old.w < vel[slot].w) atomicAdd(c.overwritten, 1u);
+    } else {
+        int d = atomicAdd(c.dead_count, -1) - 1;
+        if (d < 0) {  // no free slot: the budget is spent
+            atomicAdd(c.dead_count, 1);
+            atomicAdd(c.refused, 1u);
+            return;
+        }
+        slot = dead[d];
+    }
+    uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
+    vec3 p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+    vec3 v = sp.vel_mean.xyz + srnd3(s) * sp.vel_var.xyz;
+    vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
+    float size = max(sl.x, 0.0), life = max(sl.y, 1e-4);
+    vec4 col = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
+    if (integrator == I_CLOSED) {
+        pos[slot] = vec4(p, pc.source.w);  // birth time
+        vel[slot] = vec4(v, life);
+    } else {
+        pos[slot] = vec4(p, 0.0);
+        // Verlet keeps the previous position: a Taylor step back, exact for gravity.
+        vec3 back = p - v * pc.dt + 0.5 * sp.gravity.xyz * pc.dt * pc.dt;
+        vel[slot] = vec4(integrator == I_VERLET ? back : v, life);
+        uint a = atomicAdd(c.alive[pc.cur], 1u);
+        alive[pc.cur * pc.capacity + a] = slot;
+    }
+    prev[slot] = vec4(p, size);
+    color[slot] = col;
+    atomicAdd(c.births, 1u);
+}

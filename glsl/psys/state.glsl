@@ -1,0 +1,36 @@
+// The per-slot state and the per-frame push constants every particle-system pass shares.
+#ifndef PSYS_STATE_GLSL
+#define PSYS_STATE_GLSL
+#include "common.glsl"
+layout(std430, binding = PSYS_B_PARAMS) readonly buffer Params { SystemParams sp; };
+layout(std430, binding = PSYS_B_COUNTERS) buffer Counters_ { Counters c; };
+layout(std430, binding = PSYS_B_DEAD) buffer Dead { uint dead[]; };    // free slots (stack)
+layout(std430, binding = PSYS_B_ALIVE) buffer Alive { uint alive[]; }; // two lists of capacity
+// euler, verlet: xyz position, w age (s) | closed: xyz p0, w birth time (s; < 0: never born)
+layout(std430, binding = PSYS_B_POS) buffer Pos { vec4 pos[]; };
+// euler: xyz velocity | verlet: xyz previous step's position | closed: xyz v0; w: life span
+layout(std430, binding = PSYS_B_VEL) buffer Vel { vec4 vel[]; };
+// xyz: position a frame ago (streaks), w: size at birth
+layout(std430, binding = PSYS_B_PREV) buffer Prev { vec4 prev[]; };
+layout(std430, binding = PSYS_B_COLOR) buffer Color { vec4 color[]; };  // rgba at birth
+// keys.comp: sort keys and values (alive slots; NO_SLOT past them).
+layout(std430, binding = PSYS_B_KEYS) buffer Keys { uint keys[]; };
+layout(std430, binding = PSYS_B_VALS) buffer Vals { uint vals[]; };
+layout(push_constant) uniform Push {
+    mat4 view_proj;  // out-of-view death
+    vec4 source;     // xyz the emitter's centre this frame, w time (s)
+    uint births;     // emit: births this frame
+    uint seed;       // frame seed
+    uint cur;        // the alive list this frame reads (0 or 1)
+    uint head;       // closed: the ring's next slot
+    float dt;
+    uint capacity;
+    uint mode;       // args: 0 before the update, 1 after, 2 zero the draw count |
+                     // keys: 0 network keys, 1 counting-sort cells
+    uint cells;      // keys: counting-sort cells
+    float near;      // keys: the depth range the counting sort quantises (log scale)
+    float far;
+    uint pad1;
+    uint pad2;
+} pc;
+#endif

@@ -1,0 +1,143 @@
+#version 450
+// The state-preserving step (Euler or Verlet) over the alive list: forces, integration,
+// collisions and death. A survivor is appended to the other alive list, a dead particle
+// pushed on the dead stack: the lists stay compact with no CPU read-back.
+#include "common/index.glsl"
+#include "state.glsl"
+#include "noise.glsl"
+
+// Acceleration at p moving with v, at time t.
+vec3 accel(vec3 p, vec3 v, float t) {
+    vec3 a = sp.gravity.xyz + sp.wind.w * (sp.wind.xyz - v);
+    for (uint k = 0u; k < sp.counts.x; k++) {
+        Force f = sp.forces[k];
+        uint kind = uint(f.a.w);
+        if (kind == F_ATTRACTOR) {
+            vec3 d = f.a.xyz - p;
+            float r2 = dot(d, d);
+            a += d * inversesqrt(max(r2, 1e-12)) * f.b.x / (r2 + f.b.y);
+        } else if (kind == F_VORTEX) {
+            vec3 axis = normalize(f.b.xyz);
+            vec3 d = p - f.a.xyz;
+            vec3 radial = d - dot(d, axis) * axis;
+            float r2 = dot(radial, radial);
+            // Tangential pull, 1 / (r^2 + 1) past the core (its radius is 1 m / sqrt).
+            a += cross(axis, radial) * f.b.w / (r2 + 1.0);
+        } else if (kind == F_CURL) {
+            a += f.b.x * curl_noise(p * f.b.y + vec3(0.0, 0.0, t * f.b.z));
+        }
+    }
+    return a;
+}
+
+// Push p out of (or back into) collider k; true on contact, with the surface normal.
+bool contact(Collider k, inout vec3 p, out vec3 n) {
+    uint kind = uint(k.a.w);
+    bool inside = k.c.z > 0.5;
+    n = vec3(0.0);
+    if (kind == C_PLANE) {
+        n = normalize(k.a.xyz);
+        float s = dot(n, p) - k.b.x;
+        if (s >= 0.0) return false;
+        p -= s * n;
+        return true;
+    }
+    if (kind == C_SPHERE || kind == C_CAPSULE) {
+        vec3 centre = k.a.xyz;
+        float r = k.b.x;
+        if (kind == C_CAPSULE) {
+            vec3 ab = k.b.xyz - k.a.xyz;
+            float h = clamp(dot(p - k.a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
+            centre = k.a.xyz + h * ab;
+            r = k.b.w;
+        }
+        vec3 d = p - centre;
+        float l = length(d);
+        vec3 dir = l > 1e-9 ? d / l : vec3(0, 1, 0);
+        if (!inside && l < r) { n = dir; p = centre + dir * r; return true; }
+        if (inside && l > r) { n = -dir; p = centre + dir * r; return true; }
+        return false;
+    }
+    if (kind == C_BOX) {
+        vec3 lo = k.a.xyz, hi = k.b.xyz;
+        if (inside) {
+            vec3 q = clamp(p, lo, hi);
+            if (q == p) return false;
+            n = normalize(q - p);
+            p = q;
+            return true;
+        }
+        if (any(lessThan(p, lo)) || any(greaterThan(p, hi))) return false;
+        // Out through the nearest face.
+        vec3 dlo = p - lo, dhi = hi - p;
+        float best = 1e30;
+        for (int ax = 0; ax < 3; ax++) {
+            if (dlo[ax] < best) { best = dlo[ax]; n = vec3(0.0); n[ax] = -1.0; }
+            if (dhi[ax] < best) { best = dhi[ax]; n = vec3(0.0); n[ax] = 1.0; }
+        }
+        p += n * best;
+        return true;
+    }
+    return false;
+}
+
+void main() {
+    uint i = global_id();
+    if (i >= c.alive[pc.cur]) return;
+    uint slot = alive[pc.cur * pc.capacity + i];
+    vec4 P = pos[slot], V = vel[slot];
+    vec3 p = P.xyz;
+    float dt = pc.dt, t = pc.source.w;
+    float keep = exp(-sp.death.x * dt);  // damping v = c v, c per step from a rate
+    vec3 v;
+    if (sp.counts2.y == I_VERLET) {
+        vec3 vel_est = (p - V.xyz) / dt;
+        vec3 next = p + (p - V.xyz) * keep + accel(p, vel_est, t) * dt * dt;
+        v = (next - p) / dt;
+        p = next;
+    } else {
+        v = V.xyz + accel(p, V.xyz, t) * dt;
+        v *= keep;
+        p += v * dt;
+    }
+    bool killed = false;
+    for (uint k = 0u; k < sp.counts.y; k++) {
+        Collider col = sp.colliders[k];
+        vec3 n;
+        if (contact(col, p, n)) {
+            if (col.c.w > 0.5) killed = true;
+            // Split the velocity: the normal part bounces with restitution e, the
+            // tangential part loses the friction fraction.
+            float vn = dot(v, n);
+            if (vn < 0.0) {
+                vec3 vt = v - vn * n;
+                v = -col.c.x * vn * n + (1.0 - col.c.y) * vt;
+            }
+        }
+    }
+    float age = P.w + dt;
+    prev[slot].xyz = P.xyz;
+    uint cause = 0u;
+    if (killed) cause = 4u;
+    else if (age >= V.w) cause = 1u;
+    else if (sp.death.y > 0.0 && distance(p, pc.source.xyz) > sp.death.y) cause = 3u;
+    else if (sp.death.z > 0.5) {
+        vec4 clip = pc.view_proj * vec4(p, 1.0);
+        if (clip.w <= 0.0 || any(greaterThan(abs(clip.xy), vec2(clip.w * 1.1)))) cause = 2u;
+    }
+    if (cause != 0u) {
+        pos[slot] = vec4(p, -1.0);
+        vel[slot] = vec4(0.0);
+        if (cause == 1u) atomicAdd(c.died_life, 1u);
+        else if (cause == 2u) atomicAdd(c.died_view, 1u);
+        else if (cause == 3u) atomicAdd(c.died_distance, 1u);
+        else atomicAdd(c.died_collision, 1u);
+        int d = atomicAdd(c.dead_count, 1);
+        dead[d] = slot;
+        return;
+    }
+    pos[slot] = vec4(p, age);
+    vel[slot] = vec4(sp.counts2.y == I_VERLET ? p - v * dt : v, V.w);
+    uint a = atomicAdd(c.alive[1u - pc.cur], 1u);
+    alive[(1u - pc.cur) * pc.capacity + a] = slot;
+}

@@ -1,0 +1,269 @@
+//! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
+use super::gpu::Passes;
+use super::scenes::ParticleScene;
+use super::system::{FrameInfo, ParticleSystem};
+use crate::config::{Group, Integrator, SortAlgo, SpriteMode};
+use crate::error::Result;
+use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
+use crate::render::Camera;
+use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
+use crate::session::{camera_with_switches, open, play, SLOTS};
+use crate::viewer::Picture;
+use ash::vk;
+use serde::{Deserialize, Serialize};
+
+/// One system's totals in summary.json.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SystemStats {
+    pub name: String,
+    pub capacity: u32,
+    pub integrator: Integrator,
+    pub draw: SpriteMode,
+    pub sort: SortAlgo,
+    pub births: u64,
+    /// Births per frame drawn on the CPU: mean and variance.
+    pub births_per_frame_mean: f64,
+    pub births_per_frame_variance: f64,
+    /// Births refused: no free slot (the budget).
+    pub refused: u64,
+    /// Closed form: live particles overwritten by the ring (the budget).
+    pub overwritten: u64,
+    pub died_life: u64,
+    pub died_view: u64,
+    pub died_distance: u64,
+    pub died_collision: u64,
+    /// Alive after the last frame (closed form: born within a life, not overwritten).
+    pub alive: u64,
+}
+
+/// `stats` of a particle-system run.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleRunStats {
+    pub systems: Vec<SystemStats>,
+}
+
+impl SystemStats {
+    pub fn of(ctx: &Context, s: &ParticleSystem) -> Result<Self> {
+        let c = s.read_counters(ctx)?;
+        let frames = s.frames.max(1) as f64;
+        let mean = s.births_sum.0 / frames;
+        let alive = match s.closed() {
+            true => s.read(ctx)?.alive_closed(s.time_now()),
+            false => c.alive[s.drawn() as usize] as u64,
+        };
+        Ok(Self {
+            name: s.spec.name.clone(),
+            capacity: s.capacity,
+            integrator: s.spec.integrator(),
+            draw: s.mode,
+            sort: s.sort,
+            births: c.births as u64,
+            births_per_frame_mean: mean,
+            births_per_frame_variance: (s.births_sum.1 / frames - mean * mean).max(0.0),
+            refused: c.refused as u64 + s.refused_cpu,
+            overwritten: c.overwritten as u64,
+            died_life: c.died_life as u64,
+            died_view: c.died_view as u64,
+            died_distance: c.died_distance as u64,
+            died_collision: c.died_collision as u64,
+            alive,
+        })
+    }
+}
+
+/// The systems of a scene and the frame they are drawn in.
+pub struct SceneSystems {
+    pub passes: Passes,
+    pub systems: Vec<ParticleSystem>,
+    pub cam: Camera,
+    pub dt: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl SceneSystems {
+    pub fn new(
+        ctx: &Context,
+        scene: &ParticleScene,
+        cam: Camera,
+        width: u32,
+        height: u32,
+        seed: u64,
+    ) -> Result<Self> {
+        let passes = Guard::new(ctx, Passes::new(ctx)?);
+        let mut systems = Guard::new(ctx, Vec::new());
+        for (i, spec) in scene.system.iter().enumerate() {
+            systems.push(ParticleSystem::new(
+                ctx,
+                &passes,
+                spec,
+                i as u32,
+                seed.wrapping_add(i as u64),
+            )?);
+        }
+        Ok(Self {
+            passes: passes.take(),
+            systems: systems.take(),
+            cam,
+            dt: scene.dt,
+            width,
+            height,
+        })
+    }
+
+    pub fn frame(&self, frame: u64) -> FrameInfo<'_> {
+        FrameInfo {
+            cam: &self.cam,
+            time: frame as f64 * self.dt as f64,
+            dt: self.dt,
+            frame,
+            width: self.width,
+            height: self.height,
+        }
+    }
+
+    /// Record every system's step and sort; their writes made visible to the draw.
+    pub fn record_simulation(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut dyn crate::gpu::Scopes,
+        frame: u64,
+    ) -> Result<()> {
+        let cam = self.cam;
+        let f = FrameInfo {
+            cam: &cam,
+            ..self.frame(frame)
+        };
+        for s in &mut self.systems {
+            s.record_step(ctx, cmd, prof, &self.passes, &f);
+        }
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+        for s in &mut self.systems {
+            s.record_sort(ctx, cmd, prof, &self.passes, &f)?;
+        }
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::GRAPHICS_READ | sync::INDIRECT_READ,
+        );
+        Ok(())
+    }
+
+    /// Record every system's draw (inside a rendering scope).
+    pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: u64) {
+        let f = self.frame(frame);
+        for s in &self.systems {
+            s.record_draw(ctx, cmd, &self.passes, &f);
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for s in &mut self.systems {
+            s.destroy(ctx);
+        }
+        self.passes.destroy(ctx);
+    }
+}
+crate::impl_destroy!(SceneSystems);
+
+struct ParticleWork<'a> {
+    scene: SceneSystems,
+    target: ColorTarget,
+    background: [f32; 3],
+    frames: Frames<'a>,
+}
+
+impl FrameWork for ParticleWork<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        self.scene.record_simulation(ctx, cmd, prof, frame)?;
+        prof.begin(ctx, cmd, Passes::DRAW);
+        let b = self.background;
+        self.target
+            .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);
+        self.scene.record_draws(ctx, cmd, frame);
+        self.target.end_rendering(ctx, cmd);
+        prof.end(ctx, cmd);
+        if self.frames.save(frame) {
+            prof.begin(ctx, cmd, "readback");
+            self.target.copy_out(ctx, cmd, slot);
+            prof.end(ctx, cmd);
+        }
+        Ok(())
+    }
+
+    fn retire(&mut self, _: &Context, frame: u64, slot: usize) -> Result<()> {
+        let pic = self.frames.save(frame).then(|| Picture {
+            rgba: self.target.pixels(slot),
+            width: self.target.width(),
+            height: self.target.height(),
+        });
+        self.frames.store(frame, pic)
+    }
+}
+
+pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
+    let sw = &opts.switches;
+    sw.reject_unused(
+        &format!("particle-system scene {}", scene.name),
+        &[Group::Particles, Group::Sort, Group::Camera],
+    )?;
+    let scene = scene.with_switches(
+        sw.particle.integrator,
+        sw.particle.draw,
+        sw.sorting.sort,
+        sw.common.particles,
+    )?;
+    let frame_count = opts.frames.unwrap_or(scene.frames);
+    let ctx = open(sw)?;
+    let (w, h) = (sw.frame.width(), sw.frame.height());
+    let c = &scene.camera;
+    let cam = camera_with_switches(
+        Camera::look_at(c.eye.into(), c.target.into(), c.fov, w as f32 / h as f32),
+        sw,
+    );
+    let systems = Guard::new(
+        &ctx,
+        SceneSystems::new(&ctx, &scene, cam, w, h, sw.common.seed)?,
+    );
+    let target = ColorTarget::new(&ctx, w, h, SLOTS)?;
+    let mut work = ParticleWork {
+        scene: systems.take(),
+        target,
+        background: scene.background,
+        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+    };
+    let memory = ctx.memory_bytes();
+    let timings = play(&ctx, frame_count, &mut work, &scene.name, sw.common.quiet);
+    let stats = match &timings {
+        Ok(_) => work
+            .scene
+            .systems
+            .iter()
+            .map(|s| SystemStats::of(&ctx, s))
+            .collect::<Result<Vec<_>>>(),
+        Err(_) => Ok(Vec::new()),
+    };
+    let particles = work.scene.systems.iter().map(|s| s.capacity as u64).sum();
+    work.scene.destroy(&ctx);
+    work.target.destroy(&ctx);
+    let timings = timings?;
+    finish_fluidless(
+        &ctx,
+        opts,
+        sw,
+        (&scene.name, frame_count, particles),
+        (&timings, memory),
+        RunStats::Particles(Box::new(ParticleRunStats { systems: stats? })),
+        work.frames,
+    )
+}

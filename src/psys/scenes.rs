@@ -1,0 +1,312 @@
+//! Particle-system scenes: built-ins (`fountain`, `smoke`) and TOML files holding
+//! `[[system]]` tables (see tests/scenes/). Built-ins use no asset files.
+use super::spec::*;
+use crate::config::{Integrator, SortAlgo, SpriteMode};
+use crate::error::{Error, Result};
+use crate::sph::scene::CameraDesc;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub const BUILT_IN: &[&str] = &["fountain", "smoke"];
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleScene {
+    #[serde(default)]
+    pub name: String,
+    /// Frames `run` plays by default.
+    #[serde(default = "default_frames")]
+    pub frames: u64,
+    /// Seconds per frame (one step per frame).
+    #[serde(default = "default_dt")]
+    pub dt: f32,
+    pub camera: CameraDesc,
+    /// Background colour (linear RGB).
+    #[serde(default = "default_sky")]
+    pub background: [f32; 3],
+    pub system: Vec<SystemSpec>,
+}
+
+fn default_frames() -> u64 {
+    180
+}
+fn default_dt() -> f32 {
+    1.0 / 60.0
+}
+fn default_sky() -> [f32; 3] {
+    [0.02, 0.02, 0.04]
+}
+
+fn vary3(mean: [f32; 3], variance: [f32; 3]) -> Vec3 {
+    Vary { mean, variance }
+}
+fn vary(mean: f32, variance: f32) -> Scalar {
+    Vary { mean, variance }
+}
+
+fn plane(y: f32, restitution: f32, friction: f32) -> ColliderSpec {
+    ColliderSpec {
+        kind: ColliderKind::Plane,
+        normal: [0.0, 1.0, 0.0],
+        offset: y,
+        centre: [0.0; 3],
+        radius: 0.0,
+        min: [0.0; 3],
+        max: [0.0; 3],
+        a: [0.0; 3],
+        b: [0.0; 3],
+        restitution,
+        friction,
+        inside: false,
+        kill: false,
+    }
+}
+
+/// A system with no forces, colliders or curves: the built-ins start from it.
+pub fn base_system(
+    name: &str,
+    capacity: u32,
+    emitter: EmitterSpec,
+    particle: ParticleSpec,
+) -> SystemSpec {
+    SystemSpec {
+        name: name.into(),
+        capacity,
+        integrator: None,
+        draw: None,
+        sort: None,
+        sprite: None,
+        point_px: 3.0,
+        emitter,
+        particle,
+        over_life: OverLife::default(),
+        gravity: [0.0, -9.81, 0.0],
+        wind: [0.0; 4],
+        damping: 0.0,
+        force: vec![],
+        collider: vec![],
+        death: DeathSpec::default(),
+    }
+}
+
+pub fn emitter(shape: Shape, centre: [f32; 3], radius: f32, rate: Scalar) -> EmitterSpec {
+    EmitterSpec {
+        shape,
+        centre,
+        half: [radius; 3],
+        radius,
+        normal: [0.0, 1.0, 0.0],
+        surface: false,
+        rate: Some(rate),
+        per_area: None,
+        orbit: None,
+    }
+}
+
+impl ParticleScene {
+    pub fn built_in(name: &str) -> Option<Self> {
+        let camera = |eye, target, fov| CameraDesc { eye, target, fov };
+        Some(match name {
+            // Water thrown up from a nozzle, falling back onto the ground and bouncing,
+            // fading as it dies: sprites sorted back to front (the counting sort).
+            "fountain" => {
+                let mut water = base_system(
+                    "water",
+                    1 << 15,
+                    emitter(Shape::Disc, [0.0, 0.3, 0.0], 0.04, vary(240.0, 60.0)),
+                    ParticleSpec {
+                        offset: vary3([0.0; 3], [0.0; 3]),
+                        velocity: vary3([0.0, 5.2, 0.0], [0.7, 0.4, 0.7]),
+                        size: vary(0.05, 0.015),
+                        life: vary(2.6, 0.4),
+                        color: Vary {
+                            mean: [0.45, 0.65, 1.0, 0.55],
+                            variance: [0.05, 0.05, 0.0, 0.1],
+                        },
+                    },
+                );
+                water.over_life.opacity = vec![[0.0, 1.0], [0.75, 0.9], [1.0, 0.0]];
+                water.over_life.color = vec![[0.0, 0.9, 0.95, 1.0], [1.0, 0.55, 0.7, 1.0]];
+                water.collider.push(plane(0.0, 0.35, 0.25));
+                water.damping = 0.05;
+                let mut spray = base_system(
+                    "spray",
+                    1 << 13,
+                    emitter(Shape::Disc, [0.0, 0.3, 0.0], 0.03, vary(60.0, 20.0)),
+                    ParticleSpec {
+                        offset: vary3([0.0; 3], [0.0; 3]),
+                        velocity: vary3([0.0, 5.6, 0.0], [1.4, 0.6, 1.4]),
+                        size: vary(0.0, 0.0),
+                        life: vary(2.0, 0.5),
+                        color: Vary {
+                            mean: [0.8, 0.9, 1.0, 0.8],
+                            variance: [0.0; 4],
+                        },
+                    },
+                );
+                spray.draw = Some(SpriteMode::Streaks);
+                spray.collider.push(plane(0.0, 0.2, 0.5));
+                spray.over_life.opacity = vec![[0.0, 1.0], [1.0, 0.0]];
+                Self {
+                    name: name.into(),
+                    frames: 180,
+                    dt: 1.0 / 60.0,
+                    camera: camera([0.0, 1.7, 5.2], [0.0, 1.1, 0.0], 40.0),
+                    background: default_sky(),
+                    system: vec![water, spray],
+                }
+            }
+            // Smoke rising from a sphere, pushed by wind and stirred by curl noise,
+            // growing and fading: soft noisy sprites, sorted.
+            "smoke" => {
+                let mut smoke = base_system(
+                    "smoke",
+                    1 << 12,
+                    emitter(Shape::Sphere, [-0.8, 0.2, 0.0], 0.15, vary(12.0, 4.0)),
+                    ParticleSpec {
+                        offset: vary3([0.0; 3], [0.0; 3]),
+                        velocity: vary3([0.0, 0.7, 0.0], [0.15, 0.1, 0.15]),
+                        size: vary(0.35, 0.1),
+                        life: vary(4.0, 1.0),
+                        color: Vary {
+                            mean: [0.62, 0.62, 0.66, 0.5],
+                            variance: [0.04, 0.04, 0.04, 0.1],
+                        },
+                    },
+                );
+                smoke.sprite = Some(SpriteTexture::Smoke);
+                smoke.gravity = [0.0, 0.25, 0.0]; // buoyancy
+                smoke.wind = [0.5, 0.0, 0.0, 0.4];
+                smoke.damping = 0.3;
+                smoke.force.push(ForceSpec {
+                    kind: ForceKind::Curl,
+                    at: [0.0; 3],
+                    axis: [0.0, 1.0, 0.0],
+                    strength: 1.2,
+                    eps: 0.01,
+                    scale: 1.1,
+                    speed: 0.4,
+                });
+                smoke.over_life.size = vec![[0.0, 0.5], [1.0, 2.6]];
+                smoke.over_life.opacity = vec![[0.0, 0.0], [0.12, 1.0], [1.0, 0.0]];
+                smoke.over_life.color = vec![[0.0, 1.0, 0.9, 0.8], [1.0, 0.75, 0.75, 0.8]];
+                Self {
+                    name: name.into(),
+                    frames: 240,
+                    dt: 1.0 / 60.0,
+                    camera: camera([0.0, 1.4, 4.6], [0.0, 1.2, 0.0], 45.0),
+                    background: [0.16, 0.2, 0.28],
+                    system: vec![smoke],
+                }
+            }
+            _ => return None,
+        })
+    }
+
+    /// A built-in particle scene, or a TOML file with `[[system]]` tables; None for any
+    /// other scene (the caller tries the SPH scenes).
+    pub fn find(name_or_path: &str) -> Result<Option<Self>> {
+        if let Some(s) = Self::built_in(name_or_path) {
+            return Ok(Some(s));
+        }
+        let path = Path::new(name_or_path);
+        if !path.is_file() {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: name_or_path.into(),
+            source: e,
+        })?;
+        // Only files with [[system]] are particle scenes.
+        let is_particles = matches!(text.parse::<toml::Table>(), Ok(t) if t.contains_key("system"));
+        if !is_particles {
+            return Ok(None);
+        }
+        let mut s: Self = toml::from_str(&text).map_err(|e| {
+            Error::Param(format!(
+                "scene file {name_or_path}: {}",
+                e.message().trim().replace('\n', " ")
+            ))
+        })?;
+        if s.name.is_empty() {
+            s.name = path
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+        }
+        s.validate()?;
+        Ok(Some(s))
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if self.system.is_empty() {
+            return Err(Error::Param(format!("scene {}: no [[system]]", self.name)));
+        }
+        if !(self.dt > 0.0 && self.dt <= 0.1) {
+            return Err(Error::Param(format!(
+                "scene {}: dt must be in (0, 0.1] s",
+                self.name
+            )));
+        }
+        for (i, s) in self.system.iter().enumerate() {
+            if self.system[..i].iter().any(|o| o.name == s.name) {
+                return Err(Error::Param(format!(
+                    "scene {}: two systems named '{}'",
+                    self.name, s.name
+                )));
+            }
+            s.validate()?;
+        }
+        Ok(())
+    }
+
+    /// The switches applied: --integrator and --draw to every system, --sort to every
+    /// sorted (non-point) one, --particles as every system's capacity with its birth rate
+    /// scaled to match.
+    pub fn with_switches(
+        mut self,
+        integrator: Option<Integrator>,
+        draw: Option<SpriteMode>,
+        sort: Option<SortAlgo>,
+        particles: Option<u32>,
+    ) -> Result<Self> {
+        for s in &mut self.system {
+            if let Some(i) = integrator {
+                s.integrator = Some(i);
+            }
+            if let Some(d) = draw {
+                s.draw = Some(d);
+            }
+            if let Some(n) = particles {
+                let k = n as f32 / s.capacity as f32;
+                if let Some(r) = &mut s.emitter.rate {
+                    r.mean *= k;
+                    r.variance *= k;
+                }
+                if let Some(a) = &mut s.emitter.per_area {
+                    *a *= k;
+                }
+                s.capacity = n;
+            }
+        }
+        if let Some(algo) = sort {
+            let mut any = false;
+            for s in self
+                .system
+                .iter_mut()
+                .filter(|s| s.draw() != SpriteMode::Points)
+            {
+                s.sort = Some(algo);
+                any = true;
+            }
+            if !any {
+                return Err(Error::Param(format!(
+                    "--sort does not apply to scene {}: its systems draw opaque points",
+                    self.name
+                )));
+            }
+        }
+        self.validate()?;
+        Ok(self)
+    }
+}

@@ -1,0 +1,414 @@
+//! A particle system as declared in a scene file's `[[system]]` table (seed 003): the
+//! emitter, every attribute as mean + rand x variance (rand uniform in [-1, 1)),
+//! attributes over life as keyframe curves, forces, colliders and death rules.
+use crate::config::{Integrator, SortAlgo, SpriteMode};
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// mean + rand x variance, per component.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Vary<T> {
+    pub mean: T,
+    #[serde(default)]
+    pub variance: T,
+}
+
+pub type Scalar = Vary<f32>;
+pub type Vec3 = Vary<[f32; 3]>;
+pub type Vec4 = Vary<[f32; 4]>;
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shape {
+    Point,
+    Box,
+    Sphere,
+    Disc,
+    /// The skinned character's surface: needs a scene character.
+    Mesh,
+}
+
+/// Births per frame: `rate` (mean + rand x variance, rounded stochastically) or
+/// `per_area` births per pixel of the emitter's projected bounding disc (level of detail).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EmitterSpec {
+    pub shape: Shape,
+    #[serde(default)]
+    pub centre: [f32; 3],
+    /// Box half extents.
+    #[serde(default)]
+    pub half: [f32; 3],
+    /// Sphere or disc radius.
+    #[serde(default)]
+    pub radius: f32,
+    /// Disc normal.
+    #[serde(default = "up")]
+    pub normal: [f32; 3],
+    /// Born on the surface only (box faces, sphere shell, disc rim).
+    #[serde(default)]
+    pub surface: bool,
+    #[serde(default)]
+    pub rate: Option<Scalar>,
+    #[serde(default)]
+    pub per_area: Option<f32>,
+    /// Circle the centre moves on: radius (m) and period (s); none: fixed.
+    #[serde(default)]
+    pub orbit: Option<[f32; 2]>,
+}
+
+fn up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// Attributes at birth.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    #[serde(default = "zero3")]
+    pub offset: Vec3,
+    #[serde(default = "zero3")]
+    pub velocity: Vec3,
+    pub size: Scalar,
+    pub life: Scalar,
+    pub color: Vec4,
+}
+
+fn zero3() -> Vec3 {
+    Vary {
+        mean: [0.0; 3],
+        variance: [0.0; 3],
+    }
+}
+
+/// Keyframes over life (life fraction in [0, 1], ascending): factors on the birth values.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OverLife {
+    /// [t, factor]
+    #[serde(default)]
+    pub size: Vec<[f32; 2]>,
+    /// [t, r, g, b]
+    #[serde(default)]
+    pub color: Vec<[f32; 4]>,
+    /// [t, factor]
+    #[serde(default)]
+    pub opacity: Vec<[f32; 2]>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ForceKind {
+    /// strength / (r^2 + eps) toward `at` (negative strength: a repeller).
+    Attractor,
+    /// Swirl about `axis` through `at`: strength / (r^2 + 1) m/s^2 at distance r.
+    Vortex,
+    /// Curl-noise flow field: strength, scale (1/m), speed (1/s).
+    Curl,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    pub kind: ForceKind,
+    #[serde(default)]
+    pub at: [f32; 3],
+    #[serde(default = "up")]
+    pub axis: [f32; 3],
+    pub strength: f32,
+    #[serde(default = "default_eps")]
+    pub eps: f32,
+    #[serde(default = "one")]
+    pub scale: f32,
+    #[serde(default)]
+    pub speed: f32,
+}
+
+fn default_eps() -> f32 {
+    0.01
+}
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColliderKind {
+    /// normal . p >= offset is free space.
+    Plane,
+    Sphere,
+    Box,
+    /// The segment a-b swept by radius: the character's capsules are these.
+    Capsule,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ColliderSpec {
+    pub kind: ColliderKind,
+    #[serde(default = "up")]
+    pub normal: [f32; 3],
+    #[serde(default)]
+    pub offset: f32,
+    #[serde(default)]
+    pub centre: [f32; 3],
+    #[serde(default)]
+    pub radius: f32,
+    #[serde(default)]
+    pub min: [f32; 3],
+    #[serde(default)]
+    pub max: [f32; 3],
+    #[serde(default)]
+    pub a: [f32; 3],
+    #[serde(default)]
+    pub b: [f32; 3],
+    /// Normal velocity kept (and reversed) on contact, 0..=1.
+    #[serde(default = "default_restitution")]
+    pub restitution: f32,
+    /// Tangential velocity lost on contact, 0..=1.
+    #[serde(default)]
+    pub friction: f32,
+    /// Keep particles inside (spheres and boxes as containers).
+    #[serde(default)]
+    pub inside: bool,
+    /// The particle dies on contact.
+    #[serde(default)]
+    pub kill: bool,
+}
+
+fn default_restitution() -> f32 {
+    0.3
+}
+
+/// Death besides the end of life (always on) and the budget (the capacity).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DeathSpec {
+    /// Farther than this from the emitter's centre (m).
+    #[serde(default)]
+    pub max_distance: Option<f32>,
+    /// Leaving the camera's view.
+    #[serde(default)]
+    pub out_of_view: bool,
+}
+
+/// One `[[system]]` of a scene.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SystemSpec {
+    pub name: String,
+    /// Slots: the budget of live particles (births past it are refused and counted).
+    pub capacity: u32,
+    #[serde(default)]
+    pub integrator: Option<Integrator>,
+    #[serde(default)]
+    pub draw: Option<SpriteMode>,
+    /// Depth sort of sprites and streaks (default counting; none shows the artefact).
+    #[serde(default)]
+    pub sort: Option<SortAlgo>,
+    /// Sprite texture: disc (soft round drop) or smoke (noisy puff).
+    #[serde(default)]
+    pub sprite: Option<SpriteTexture>,
+    /// Point size in pixels (draw = points).
+    #[serde(default = "default_point")]
+    pub point_px: f32,
+    pub emitter: EmitterSpec,
+    pub particle: ParticleSpec,
+    #[serde(default)]
+    pub over_life: OverLife,
+    #[serde(default = "gravity")]
+    pub gravity: [f32; 3],
+    /// Drag toward the wind velocity: [vx, vy, vz, rate per second].
+    #[serde(default)]
+    pub wind: [f32; 4],
+    /// Damping v = c v with c = exp(-damping dt).
+    #[serde(default)]
+    pub damping: f32,
+    #[serde(default)]
+    pub force: Vec<ForceSpec>,
+    #[serde(default)]
+    pub collider: Vec<ColliderSpec>,
+    #[serde(default)]
+    pub death: DeathSpec,
+}
+
+fn default_point() -> f32 {
+    3.0
+}
+fn gravity() -> [f32; 3] {
+    [0.0, -9.81, 0.0]
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpriteTexture {
+    Disc,
+    Smoke,
+}
+
+/// Most keyframes per curve, forces and colliders per system (glsl/psys/common.glsl).
+pub const MAX_KEYS: usize = 8;
+pub const MAX_FORCES: usize = 8;
+pub const MAX_COLLIDERS: usize = 8;
+
+fn finite(v: &[f32]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+impl SystemSpec {
+    /// The integrator after `--integrator`.
+    pub fn integrator(&self) -> Integrator {
+        self.integrator.unwrap_or(Integrator::Euler)
+    }
+
+    pub fn draw(&self) -> SpriteMode {
+        self.draw.unwrap_or(SpriteMode::Sprites)
+    }
+
+    /// The sort: points are opaque and depth-tested, so they are never sorted.
+    pub fn sort(&self) -> SortAlgo {
+        match self.draw() {
+            SpriteMode::Points => SortAlgo::None,
+            _ => self.sort.unwrap_or(SortAlgo::Counting),
+        }
+    }
+
+    /// Every value in range; the closed form only with forces that have one.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::Param(format!("system '{}': {m}", self.name)));
+        if self.capacity == 0 || self.capacity > 1 << 26 {
+            return bad(format!("capacity {} is not in 1..=67108864", self.capacity));
+        }
+        let e = &self.emitter;
+        match (&e.rate, e.per_area) {
+            (Some(r), None)
+                if r.mean >= 0.0 && r.variance >= 0.0 && finite(&[r.mean, r.variance]) => {}
+            (None, Some(a)) if a > 0.0 && a.is_finite() => {}
+            (Some(_), Some(_)) => return bad("emitter: give rate or per_area, not both".into()),
+            (None, None) => return bad("emitter: give rate = {mean, variance} or per_area".into()),
+            _ => return bad("emitter: the rate must be finite and not negative".into()),
+        }
+        if e.shape == Shape::Mesh {
+            return Err(Error::Unsupported(format!(
+                "system '{}': emitter shape 'mesh' (the character's surface) is not implemented yet: use point, box, sphere or disc",
+                self.name
+            )));
+        }
+        if matches!(e.shape, Shape::Sphere | Shape::Disc) && !(e.radius > 0.0) {
+            return bad(format!("emitter: a {:?} needs a positive radius", e.shape).to_lowercase());
+        }
+        if e.shape == Shape::Disc && !(glam::Vec3::from(e.normal).length() > 1e-6) {
+            return bad("emitter: the disc normal is zero".into());
+        }
+        if e.shape == Shape::Box && e.half.iter().any(|h| !(*h >= 0.0)) {
+            return bad("emitter: box half extents must not be negative".into());
+        }
+        if let Some([r, period]) = e.orbit {
+            if !(r >= 0.0 && period > 0.0) {
+                return bad("emitter: orbit = [radius >= 0, period > 0]".into());
+            }
+        }
+        let p = &self.particle;
+        if !(p.life.mean > 0.0) || p.life.variance < 0.0 || p.life.variance >= p.life.mean {
+            return bad("particle.life: mean must be positive and variance in [0, mean)".into());
+        }
+        if p.size.mean < 0.0 || p.size.variance < 0.0 {
+            return bad("particle.size: mean and variance must not be negative".into());
+        }
+        let nums: Vec<f32> = [
+            p.offset.mean,
+            p.offset.variance,
+            p.velocity.mean,
+            p.velocity.variance,
+        ]
+        .iter()
+        .flatten()
+        .chain(p.color.mean.iter())
+        .chain(p.color.variance.iter())
+        .chain(self.gravity.iter())
+        .chain(self.wind.iter())
+        .copied()
+        .collect();
+        if !finite(&nums) || !self.damping.is_finite() || self.damping < 0.0 || self.wind[3] < 0.0 {
+            return bad(
+                "attributes, gravity, wind and damping must be finite (damping and drag >= 0)"
+                    .into(),
+            );
+        }
+        let o = &self.over_life;
+        for (what, ts) in [
+            ("size", o.size.iter().map(|k| k[0]).collect::<Vec<_>>()),
+            ("color", o.color.iter().map(|k| k[0]).collect()),
+            ("opacity", o.opacity.iter().map(|k| k[0]).collect()),
+        ] {
+            if ts.len() > MAX_KEYS {
+                return bad(format!("over_life.{what}: at most {MAX_KEYS} keys"));
+            }
+            if ts.windows(2).any(|w| !(w[0] < w[1])) || ts.iter().any(|t| !(0.0..=1.0).contains(t))
+            {
+                return bad(format!(
+                    "over_life.{what}: key times must rise within [0, 1]"
+                ));
+            }
+        }
+        if self.force.len() > MAX_FORCES || self.collider.len() > MAX_COLLIDERS {
+            return bad(format!(
+                "at most {MAX_FORCES} forces and {MAX_COLLIDERS} colliders"
+            ));
+        }
+        for f in &self.force {
+            if !f.strength.is_finite() || !(f.eps > 0.0) || !(f.scale > 0.0) {
+                return bad(format!(
+                    "force {:?}: strength finite, eps and scale positive",
+                    f.kind
+                )
+                .to_lowercase());
+            }
+        }
+        for c in &self.collider {
+            let ok = match c.kind {
+                ColliderKind::Plane => glam::Vec3::from(c.normal).length() > 1e-6,
+                ColliderKind::Sphere => c.radius > 0.0,
+                ColliderKind::Box => (0..3).all(|k| c.min[k] < c.max[k]),
+                ColliderKind::Capsule => c.radius > 0.0,
+            };
+            if !ok {
+                return bad(format!("collider {:?}: a plane needs a normal, a sphere or capsule a radius, a box min < max", c.kind).to_lowercase());
+            }
+            if !(0.0..=1.0).contains(&c.restitution) || !(0.0..=1.0).contains(&c.friction) {
+                return bad("collider: restitution and friction must be in [0, 1]".into());
+            }
+        }
+        if let Some(d) = self.death.max_distance {
+            if !(d > 0.0) {
+                return bad("death.max_distance must be positive".into());
+            }
+        }
+        if self.integrator() == Integrator::Closed {
+            let stateful = |what: &str| {
+                Err(Error::Unsupported(format!(
+                    "system '{}': --integrator closed evaluates p0 + v0 t + g t^2 / 2 with no state: {what} has no closed form here (use euler or verlet)",
+                    self.name
+                )))
+            };
+            if !self.force.is_empty() {
+                return stateful("a force");
+            }
+            if !self.collider.is_empty() {
+                return stateful("a collider");
+            }
+            if self.wind[3] != 0.0 || self.damping != 0.0 {
+                return stateful("wind drag or damping");
+            }
+            if self.death.max_distance.is_some() || self.death.out_of_view {
+                return stateful("death by distance or view (a state change)");
+            }
+        }
+        if self.draw() == SpriteMode::Points && matches!(self.sort, Some(s) if s != SortAlgo::None)
+        {
+            return bad("points are opaque and depth-tested: they take no sort".into());
+        }
+        Ok(())
+    }
+}

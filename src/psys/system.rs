@@ -1,0 +1,539 @@
+//! One particle system's sized part: its slots, alive and dead lists, counters, sort
+//! buffers and sprite texture, and how a frame is recorded: emit, update (indirect over
+//! the alive list), sort by view depth, draw (indirect). The CPU draws only the number of
+//! births per frame; nothing is read back per frame.
+use super::gpu::{
+    vertices, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams,
+};
+use super::spec::{Shape, SystemSpec};
+use super::sprite;
+use crate::config::{Integrator, SortAlgo, SpriteMode};
+use crate::error::{Error, Result};
+use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
+use crate::primitives::counting::CountingBuffers;
+use crate::render::Camera;
+use ash::vk;
+use bytemuck::Zeroable;
+use rand::{Rng, SeedableRng};
+
+/// Cells of the counting sort of sprite depths: log-scale depth buckets between the
+/// camera's near and far planes (relative depth resolution ln(far / near) / cells).
+pub const DEPTH_CELLS: u32 = 1 << 18;
+
+/// The frame a system steps to and is drawn in.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInfo<'a> {
+    pub cam: &'a Camera,
+    /// Scene time at the start of the frame (s).
+    pub time: f64,
+    pub dt: f32,
+    pub frame: u64,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The state read back (tests, summaries).
+pub struct StateDump {
+    pub counters: Counters,
+    pub pos: Vec<[f32; 4]>,
+    pub vel: Vec<[f32; 4]>,
+    /// The alive list the last step wrote.
+    pub alive: Vec<u32>,
+    /// Free slots (euler, verlet).
+    pub dead: Vec<u32>,
+}
+
+pub struct ParticleSystem {
+    pub spec: SystemSpec,
+    pub capacity: u32,
+    pub sort: SortAlgo,
+    pub mode: SpriteMode,
+    params: Buffer,
+    pub counters: Buffer,
+    dead: Buffer,
+    alive: Buffer,
+    pos: Buffer,
+    vel: Buffer,
+    prev: Buffer,
+    color: Buffer,
+    keys: Buffer,
+    vals: Buffer,
+    counting: Option<DepthSort>,
+    sprite: Buffer,
+    sprite_side: u32,
+    /// The alive list the last step wrote (the one drawn).
+    drawn: u32,
+    /// Closed form: the ring's next slot.
+    head: u32,
+    rng: rand_pcg::Pcg32,
+    seed: u64,
+    /// Births drawn on the CPU (closed form: more than the capacity in one frame are
+    /// refused here).
+    pub births_asked: u64,
+    pub refused_cpu: u64,
+    /// Sum and sum of squares of the births drawn per frame.
+    pub births_sum: (f64, f64),
+    pub frames: u64,
+    /// Scene time after the last recorded step (s).
+    last_time: f64,
+}
+
+impl StateDump {
+    /// Closed form: slots born within their life at time `t`.
+    pub fn alive_closed(&self, t: f64) -> u64 {
+        self.pos
+            .iter()
+            .zip(&self.vel)
+            .filter(|(p, v)| p[3] >= 0.0 && t - (p[3] as f64) < v[3] as f64)
+            .count() as u64
+    }
+}
+
+impl ParticleSystem {
+    /// Slots for `spec` (validated by the caller), every slot free.
+    pub fn new(
+        ctx: &Context,
+        passes: &Passes,
+        spec: &SystemSpec,
+        type_id: u32,
+        seed: u64,
+    ) -> Result<Self> {
+        spec.validate()?;
+        let cap = spec.capacity as u64;
+        let bytes = cap * 16;
+        let need = bytes * 4
+            + cap * 4 * 5
+            + if spec.sort() == SortAlgo::Counting {
+                cap * 12
+            } else {
+                0
+            };
+        if need > ctx.info.device_local_bytes {
+            return Err(Error::Param(format!(
+                "system '{}': {} slots need {} MB, more than the device's {} MB",
+                spec.name,
+                cap,
+                need >> 20,
+                ctx.info.device_local_bytes >> 20
+            )));
+        }
+        let name = &spec.name;
+        let buf = |what: &str, size: u64| {
+            ctx.storage_buffer(&format!("{name} {what}"), size)
+                .map(|b| Guard::new(ctx, b))
+        };
+        let mut params = buf("params", std::mem::size_of::<SystemParams>() as u64)?;
+        let mut counters = Guard::new(
+            ctx,
+            ctx.indirect_buffer(
+                &format!("{name} counters"),
+                std::mem::size_of::<Counters>() as u64,
+            )?,
+        );
+        let mut dead = buf("dead list", cap * 4)?;
+        let alive = buf("alive lists", cap * 8)?;
+        let mut pos = buf("positions", bytes)?;
+        let vel = buf("velocities", bytes)?;
+        let prev = buf("previous positions", bytes)?;
+        let color = buf("colours", bytes)?;
+        let keys = buf("sort keys", cap * 4)?;
+        let vals = buf("sort values", cap * 4)?;
+        let counting = Guard::new(
+            ctx,
+            match spec.sort() {
+                SortAlgo::Counting => Some(DepthSort::new(ctx, passes, name, cap)?),
+                _ => None,
+            },
+        );
+        let (side, texels) = sprite::texture(
+            spec.sprite.unwrap_or(super::spec::SpriteTexture::Disc),
+            seed,
+        );
+        let mut sprite_buf = buf("sprite", texels.len() as u64 * 4)?;
+        ctx.upload(&mut sprite_buf, 0, &texels)?;
+        ctx.upload(&mut params, 0, &[SystemParams::new(spec, type_id)])?;
+        // Every slot free; popped from the end, so low slots are used first.
+        let free: Vec<u32> = (0..spec.capacity).rev().collect();
+        ctx.upload(&mut dead, 0, &free)?;
+        let c = Counters {
+            dead_count: spec.capacity as i32,
+            draw_args: [vertices(spec.draw()), 0, 0, 0],
+            ..Counters::zeroed()
+        };
+        ctx.upload(&mut counters, 0, &[c])?;
+        // Closed form: birth time -1 marks a slot never born.
+        let unborn = vec![[0.0f32, 0.0, 0.0, -1.0]; spec.capacity as usize];
+        ctx.upload(&mut pos, 0, &unborn)?;
+        Ok(Self {
+            spec: spec.clone(),
+            capacity: spec.capacity,
+            sort: spec.sort(),
+            mode: spec.draw(),
+            params: params.take(),
+            counters: counters.take(),
+            dead: dead.take(),
+            alive: alive.take(),
+            pos: pos.take(),
+            vel: vel.take(),
+            prev: prev.take(),
+            color: color.take(),
+            keys: keys.take(),
+            vals: vals.take(),
+            counting: counting.take(),
+            sprite: sprite_buf.take(),
+            sprite_side: side,
+            drawn: 0,
+            head: 0,
+            rng: rand_pcg::Pcg32::seed_from_u64(seed ^ (type_id as u64).wrapping_mul(0x9e37_79b9)),
+            seed,
+            births_asked: 0,
+            refused_cpu: 0,
+            births_sum: (0.0, 0.0),
+            frames: 0,
+            last_time: 0.0,
+        })
+    }
+
+    /// The alive list the last step wrote.
+    pub fn drawn(&self) -> u32 {
+        self.drawn
+    }
+
+    /// Scene time after the last recorded step (s).
+    pub fn time_now(&self) -> f64 {
+        self.last_time
+    }
+
+    pub fn closed(&self) -> bool {
+        self.spec.integrator() == Integrator::Closed
+    }
+
+    /// The emitter's centre at time `t` (an orbit moves it).
+    pub fn source(&self, t: f64) -> glam::Vec3 {
+        let e = &self.spec.emitter;
+        let c = glam::Vec3::from(e.centre);
+        match e.orbit {
+            Some([r, period]) => {
+                let a = std::f64::consts::TAU * t / period as f64;
+                c + glam::Vec3::new(r * a.cos() as f32, 0.0, r * a.sin() as f32)
+            }
+            None => c,
+        }
+    }
+
+    /// Radius of the emitter's bounding sphere (per-area emission).
+    fn emitter_radius(&self) -> f32 {
+        let e = &self.spec.emitter;
+        let r = match e.shape {
+            Shape::Box => glam::Vec3::from(e.half).length(),
+            Shape::Sphere | Shape::Disc => e.radius,
+            Shape::Point | Shape::Mesh => 0.0,
+        };
+        r.max(self.spec.particle.size.mean * 0.5).max(1e-3)
+    }
+
+    /// Births this frame: mean + rand x variance (rand in [-1, 1)), or per_area x the
+    /// emitter's projected area in pixels; rounded stochastically so the mean is exact.
+    pub fn draw_births(&mut self, f: &FrameInfo) -> u32 {
+        let e = &self.spec.emitter;
+        let x = match (&e.rate, e.per_area) {
+            (Some(r), _) => r.mean + self.rng.random_range(-1.0f32..1.0) * r.variance,
+            (None, Some(a)) => {
+                let d = (self.source(f.time) - f.cam.eye).length().max(f.cam.near);
+                let focal = f.height as f32 / (2.0 * (f.cam.fov_y_deg.to_radians() * 0.5).tan());
+                let px = self.emitter_radius() * focal / d;
+                a * std::f32::consts::PI * px * px
+            }
+            (None, None) => 0.0,
+        };
+        let n = (x.max(0.0) + self.rng.random_range(0.0f32..1.0)).floor() as u64;
+        self.births_sum.0 += n as f64;
+        self.births_sum.1 += (n * n) as f64;
+        self.births_asked += n;
+        let cap = if self.closed() {
+            self.capacity as u64
+        } else {
+            u32::MAX as u64
+        };
+        if n > cap {
+            self.refused_cpu += n - cap;
+        }
+        n.min(cap) as u32
+    }
+
+    fn bufs(&self) -> PsysBufs<'_> {
+        PsysBufs {
+            params: &self.params,
+            counters: &self.counters,
+            dead: &self.dead,
+            alive: &self.alive,
+            pos: &self.pos,
+            vel: &self.vel,
+            prev: &self.prev,
+            color: &self.color,
+            keys: &self.keys,
+            vals: &self.vals,
+        }
+    }
+
+    fn push(&self, f: &FrameInfo, t: f64, births: u32) -> StepPush {
+        let s = self.source(f.time);
+        StepPush {
+            view_proj: f.cam.view_proj().to_cols_array_2d(),
+            source: [s.x, s.y, s.z, t as f32],
+            births,
+            seed: (crate::psys::hash64(self.seed ^ f.frame.wrapping_mul(0x2545_f491)) & 0xffff_ffff)
+                as u32,
+            cur: self.drawn,
+            head: self.head,
+            dt: f.dt,
+            capacity: self.capacity,
+            mode: 0,
+            cells: DEPTH_CELLS,
+            near: f.cam.near,
+            far: f.cam.far,
+            pad: [0; 2],
+        }
+    }
+
+    /// Record a frame's births and step (Euler, Verlet) or births only (closed form).
+    pub fn record_step(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let births = self.draw_births(f);
+        self.frames += 1;
+        self.last_time = f.time + f.dt as f64;
+        let push = self.push(f, f.time, births);
+        let bufs = self.bufs();
+        scopes.begin(ctx, cmd, Passes::EMIT);
+        passes.emit.dispatch(ctx, cmd, &bufs, &push, births as u64);
+        scopes.end(ctx, cmd);
+        if self.closed() {
+            self.head = ((self.head as u64 + births as u64) % self.capacity as u64) as u32;
+            return;
+        }
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ); // births -> args, update
+        scopes.begin(ctx, cmd, Passes::UPDATE);
+        passes.args.dispatch_groups(ctx, cmd, &bufs, &push, 1);
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::COMPUTE_READ | sync::INDIRECT_READ,
+        );
+        passes.update.dispatch_indirect(
+            ctx,
+            cmd,
+            &bufs,
+            &push,
+            &self.counters,
+            Counters::UPDATE_ARGS,
+        );
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ); // list length -> args
+        let after = StepPush { mode: 1, ..push };
+        passes.args.dispatch_groups(ctx, cmd, &bufs, &after, 1);
+        scopes.end(ctx, cmd);
+        self.drawn = 1 - self.drawn;
+    }
+
+    /// Record the depth sort of what is drawn (nothing with --sort none). The step's
+    /// writes must be visible to compute.
+    pub fn record_sort(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) -> Result<()> {
+        if self.sort == SortAlgo::None {
+            return Ok(());
+        }
+        let t = f.time + f.dt as f64;
+        let mut push = self.push(f, t, 0);
+        // Keys read the list the step wrote: the shader reads alive[1 - cur].
+        push.cur = 1 - self.drawn;
+        push.mode = (self.sort == SortAlgo::Counting) as u32;
+        let bufs = self.bufs();
+        let cap = self.capacity as u64;
+        scopes.begin(ctx, cmd, Passes::SORT);
+        if self.closed() {
+            let zero = StepPush { mode: 2, ..push };
+            passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+        }
+        passes.keys.dispatch(ctx, cmd, &bufs, &push, cap);
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+        match (self.sort, &self.counting) {
+            (SortAlgo::Counting, Some(d)) => {
+                passes.counting.record(
+                    ctx,
+                    cmd,
+                    &passes.scan,
+                    &d.cells,
+                    &self.keys,
+                    &self.vals,
+                    &d.keys,
+                    &d.vals,
+                    cap,
+                )?;
+            }
+            (SortAlgo::OddEven, _) => {
+                passes
+                    .odd_even
+                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
+            }
+            (SortAlgo::Bitonic, _) => {
+                passes
+                    .bitonic
+                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
+            }
+            _ => unreachable!("counting buffers exist for the counting sort"),
+        }
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    /// Record the draw (inside a rendering scope; the step's and sort's writes visible to
+    /// vertex shaders and indirect reads).
+    pub fn record_draw(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let (r, u) = f.cam.axes();
+        let t = (f.time + f.dt as f64) as f32;
+        let (order, offset, identity) = match (self.sort, &self.counting) {
+            (SortAlgo::None, _) if self.closed() => (&self.alive, 0, 1),
+            (SortAlgo::None, _) => (&self.alive, self.drawn * self.capacity, 0),
+            (SortAlgo::Counting, Some(d)) => (&d.vals, 0, 0),
+            _ => (&self.vals, 0, 0),
+        };
+        let push = DrawPush {
+            view_proj: f.cam.view_proj().to_cols_array_2d(),
+            right: [r.x, r.y, r.z, self.spec.point_px],
+            up: [u.x, u.y, u.z, t],
+            screen: [
+                2.0 / f.width as f32,
+                2.0 / f.height as f32,
+                f.dt,
+                self.sprite_side as f32,
+            ],
+            offset,
+            identity,
+            pad: [0; 2],
+        };
+        let bufs = DrawBufs {
+            params: &self.params,
+            pos: &self.pos,
+            vel: &self.vel,
+            prev: &self.prev,
+            color: &self.color,
+            order,
+            sprite: &self.sprite,
+        };
+        passes.pipeline(self.mode).bind(ctx, cmd, &bufs, &push);
+        if identity == 1 {
+            ctx.draw(cmd, vertices(self.mode), self.capacity);
+        } else {
+            ctx.draw_indirect(cmd, &self.counters, Counters::DRAW_ARGS);
+        }
+    }
+
+    pub fn read_counters(&self, ctx: &Context) -> Result<Counters> {
+        Ok(ctx.readback::<Counters>(&self.counters, 0, 1)?[0])
+    }
+
+    /// The state after the last submitted frame (waits for nothing: call after it).
+    pub fn read(&self, ctx: &Context) -> Result<StateDump> {
+        let counters = self.read_counters(ctx)?;
+        let cap = self.capacity as usize;
+        let all: Vec<u32> = ctx.readback(&self.alive, 0, 2 * cap)?;
+        let n_alive = counters.alive[self.drawn as usize] as usize;
+        let start = self.drawn as usize * cap;
+        let dead_n = counters.dead_count.max(0) as usize;
+        Ok(StateDump {
+            pos: ctx.readback(&self.pos, 0, cap)?,
+            vel: ctx.readback(&self.vel, 0, cap)?,
+            alive: all[start..start + n_alive.min(cap)].to_vec(),
+            dead: ctx.readback(&self.dead, 0, cap)?[..dead_n.min(cap)].to_vec(),
+            counters,
+        })
+    }
+
+    /// The sorted slots (NO_SLOT past the drawn ones) and their keys after `record_sort`.
+    pub fn read_sorted(&self, ctx: &Context) -> Result<(Vec<u32>, Vec<u32>)> {
+        let cap = self.capacity as usize;
+        match &self.counting {
+            Some(d) => Ok((
+                ctx.readback(&d.keys, 0, cap)?,
+                ctx.readback(&d.vals, 0, cap)?,
+            )),
+            None => Ok((
+                ctx.readback(&self.keys, 0, cap)?,
+                ctx.readback(&self.vals, 0, cap)?,
+            )),
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [
+            &mut self.params,
+            &mut self.counters,
+            &mut self.dead,
+            &mut self.alive,
+            &mut self.pos,
+            &mut self.vel,
+            &mut self.prev,
+            &mut self.color,
+            &mut self.keys,
+            &mut self.vals,
+            &mut self.sprite,
+        ] {
+            ctx.destroy_buffer(b);
+        }
+        if let Some(d) = &mut self.counting {
+            d.destroy(ctx);
+        }
+    }
+}
+
+/// The counting sort's cells and its sorted copies of the keys and values.
+struct DepthSort {
+    cells: CountingBuffers,
+    keys: Buffer,
+    vals: Buffer,
+}
+
+impl DepthSort {
+    fn new(ctx: &Context, passes: &Passes, name: &str, cap: u64) -> Result<Self> {
+        let mut cells = CountingBuffers::new(ctx, &passes.scan, cap, DEPTH_CELLS)?;
+        let keys = ctx.storage_buffer(&format!("{name} sorted keys"), cap * 4);
+        let vals = ctx.storage_buffer(&format!("{name} sorted values"), cap * 4);
+        match (keys, vals) {
+            (Ok(keys), Ok(vals)) => Ok(Self { cells, keys, vals }),
+            (k, v) => {
+                cells.destroy(ctx);
+                for mut b in [k.ok(), v.ok()].into_iter().flatten() {
+                    ctx.destroy_buffer(&mut b);
+                }
+                Err(Error::Param(format!(
+                    "{name}: out of device memory for the depth sort"
+                )))
+            }
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.cells.destroy(ctx);
+        ctx.destroy_buffer(&mut self.keys);
+        ctx.destroy_buffer(&mut self.vals);
+    }
+}
+crate::impl_destroy!(ParticleSystem, DepthSort);
