@@ -42,7 +42,7 @@ struct SystemParams {
     vec4 normal;        // disc normal
     vec4 offset_mean;   // position offset
     vec4 offset_var;
-    vec4 vel_mean;
+    vec4 vel_mean;      // w: cone half-angle (rad) the direction is spread over
     vec4 vel_var;
     vec4 color_mean;    // rgba (a: opacity)
     vec4 color_var;

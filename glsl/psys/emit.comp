@@ -55,6 +55,15 @@ void main() {
     uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
     vec3 p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
     vec3 v = sp.vel_mean.xyz + srnd3(s) * sp.vel_var.xyz;
+    float spread = sp.vel_mean.w;  // cone half-angle (rad) about the mean direction
+    if (spread > 0.0 && dot(sp.vel_mean.xyz, sp.vel_mean.xyz) > 0.0) {
+        vec3 a = normalize(sp.vel_mean.xyz);
+        vec3 t = normalize(abs(a.y) < 0.9 ? cross(a, vec3(0, 1, 0)) : cross(a, vec3(1, 0, 0)));
+        vec3 b = cross(a, t);
+        float z = mix(cos(spread), 1.0, rnd(s)), phi = 6.2831853 * rnd(s);  // uniform on the cap
+        float r = sqrt(max(1.0 - z * z, 0.0));
+        v = length(v) * (z * a + r * (cos(phi) * t + sin(phi) * b));
+    }
     vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
     float size = max(sl.x, 0.0), life = max(sl.y, 1e-4);
     vec4 col = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);

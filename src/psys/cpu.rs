@@ -8,10 +8,10 @@ pub fn closed_pos(p0: Vec3, v0: Vec3, g: Vec3, t: f32) -> Vec3 {
 }
 
 /// Potential energy per unit mass of the attractor strength / (r^2 + eps) at distance r:
-/// U(r) = -(s / sqrt(eps)) atan(r / sqrt(eps)) (dU/dr is the force's magnitude).
+/// U(r) = (s / sqrt(eps)) atan(r / sqrt(eps)): the pull -dU/dr = -s / (r^2 + eps).
 pub fn attractor_potential(r: f32, strength: f32, eps: f32) -> f64 {
     let e = (eps as f64).sqrt();
-    -(strength as f64 / e) * (r as f64 / e).atan()
+    (strength as f64 / e) * (r as f64 / e).atan()
 }
 
 /// Whether the alive and dead lists partition 0..capacity: each slot in exactly one.

@@ -105,7 +105,7 @@ impl SystemParams {
         let q = &spec.particle;
         p.offset_mean = v3(q.offset.mean, 0.0);
         p.offset_var = v3(q.offset.variance, 0.0);
-        p.vel_mean = v3(q.velocity.mean, 0.0);
+        p.vel_mean = v3(q.velocity.mean, q.spread.to_radians());
         p.vel_var = v3(q.velocity.variance, 0.0);
         p.color_mean = q.color.mean;
         p.color_var = q.color.variance;

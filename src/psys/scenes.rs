@@ -116,7 +116,8 @@ impl ParticleScene {
                     emitter(Shape::Disc, [0.0, 0.3, 0.0], 0.04, vary(240.0, 60.0)),
                     ParticleSpec {
                         offset: vary3([0.0; 3], [0.0; 3]),
-                        velocity: vary3([0.0, 5.2, 0.0], [0.7, 0.4, 0.7]),
+                        velocity: vary3([0.0, 5.2, 0.0], [0.0, 0.3, 0.0]),
+                        spread: 9.0,
                         size: vary(0.05, 0.015),
                         life: vary(2.6, 0.4),
                         color: Vary {
@@ -135,7 +136,8 @@ impl ParticleScene {
                     emitter(Shape::Disc, [0.0, 0.3, 0.0], 0.03, vary(60.0, 20.0)),
                     ParticleSpec {
                         offset: vary3([0.0; 3], [0.0; 3]),
-                        velocity: vary3([0.0, 5.6, 0.0], [1.4, 0.6, 1.4]),
+                        velocity: vary3([0.0, 5.6, 0.0], [0.0, 0.6, 0.0]),
+                        spread: 16.0,
                         size: vary(0.0, 0.0),
                         life: vary(2.0, 0.5),
                         color: Vary {
@@ -166,6 +168,7 @@ impl ParticleScene {
                     ParticleSpec {
                         offset: vary3([0.0; 3], [0.0; 3]),
                         velocity: vary3([0.0, 0.7, 0.0], [0.15, 0.1, 0.15]),
+                        spread: 0.0,
                         size: vary(0.35, 0.1),
                         life: vary(4.0, 1.0),
                         color: Vary {

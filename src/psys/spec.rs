@@ -70,6 +70,10 @@ pub struct ParticleSpec {
     pub offset: Vec3,
     #[serde(default = "zero3")]
     pub velocity: Vec3,
+    /// Degrees: the velocity's direction uniform in a cone about its mean (its speed
+    /// still mean + rand x variance); 0 keeps the per-component variance alone.
+    #[serde(default)]
+    pub spread: f32,
     pub size: Scalar,
     pub life: Scalar,
     pub color: Vec4,
@@ -312,6 +316,9 @@ impl SystemSpec {
         let p = &self.particle;
         if !(p.life.mean > 0.0) || p.life.variance < 0.0 || p.life.variance >= p.life.mean {
             return bad("particle.life: mean must be positive and variance in [0, mean)".into());
+        }
+        if !(0.0..=180.0).contains(&p.spread) {
+            return bad("particle.spread must be in [0, 180] degrees".into());
         }
         if p.size.mean < 0.0 || p.size.variance < 0.0 {
             return bad("particle.size: mean and variance must not be negative".into());

@@ -306,6 +306,25 @@ impl ParticleSystem {
         f: &FrameInfo,
     ) {
         let births = self.draw_births(f);
+        self.record_births(ctx, cmd, scopes, passes, f, births);
+    }
+
+    /// `record_step` with `births` chosen by the caller (tests, a benchmark's prefill).
+    pub fn record_births(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        passes: &Passes,
+        f: &FrameInfo,
+        births: u32,
+    ) {
+        // A previous step recorded in the same command buffer, or a draw, read the lists.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE | sync::GRAPHICS_READ,
+            sync::COMPUTE_READ,
+        );
         self.frames += 1;
         self.last_time = f.time + f.dt as f64;
         let push = self.push(f, f.time, births);
@@ -444,6 +463,11 @@ impl ParticleSystem {
         } else {
             ctx.draw_indirect(cmd, &self.counters, Counters::DRAW_ARGS);
         }
+    }
+
+    /// Colours at birth (tests identify particles by them).
+    pub fn color_buffer(&self) -> &Buffer {
+        &self.color
     }
 
     pub fn read_counters(&self, ctx: &Context) -> Result<Counters> {

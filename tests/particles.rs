@@ -1,0 +1,624 @@
+//! GPU particle systems (seed 003): integrators against the closed form, energy, emission
+//! statistics, depth sorts, collisions, and the alive/dead lists.
+mod common;
+use common::{finish, fluidform, text};
+use fluidform::config::{Integrator, SortAlgo, SpriteMode};
+use fluidform::gpu::{Context, Labels};
+use fluidform::psys::cpu::{attractor_potential, closed_pos, partitions};
+use fluidform::psys::scenes::{base_system, emitter, ParticleScene};
+use fluidform::psys::spec::*;
+use fluidform::psys::{FrameInfo, ParticleSystem, Passes};
+use fluidform::render::Camera;
+use glam::Vec3;
+
+fn cam() -> Camera {
+    Camera::look_at(
+        Vec3::new(0.0, 1.5, 6.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        45.0,
+        1.0,
+    )
+}
+
+fn frame(cam: &Camera, k: u64, dt: f32) -> FrameInfo<'_> {
+    FrameInfo {
+        cam,
+        time: k as f64 * dt as f64,
+        dt,
+        frame: k,
+        width: 256,
+        height: 256,
+    }
+}
+
+/// A spec with colourful, distinct particles (their colour identifies them across systems
+/// made with the same seed) and long lives.
+fn ballistic(integrator: Integrator, capacity: u32) -> SystemSpec {
+    let mut s = base_system(
+        "ballistic",
+        capacity,
+        emitter(
+            Shape::Sphere,
+            [0.0, 1.0, 0.0],
+            0.3,
+            Vary {
+                mean: 0.0,
+                variance: 0.0,
+            },
+        ),
+        ParticleSpec {
+            offset: Vary {
+                mean: [0.0; 3],
+                variance: [0.0; 3],
+            },
+            velocity: Vary {
+                mean: [0.5, 4.0, -0.3],
+                variance: [1.0, 1.0, 1.0],
+            },
+            spread: 0.0,
+            size: Vary {
+                mean: 0.05,
+                variance: 0.0,
+            },
+            life: Vary {
+                mean: 100.0,
+                variance: 0.0,
+            },
+            color: Vary {
+                mean: [0.5; 4],
+                variance: [0.5; 4],
+            },
+        },
+    );
+    s.integrator = Some(integrator);
+    s
+}
+
+/// Record `steps` steps (births only in the first) in one command buffer.
+fn steps(
+    ctx: &Context,
+    passes: &Passes,
+    s: &mut ParticleSystem,
+    cam: &Camera,
+    dt: f32,
+    from: u64,
+    steps: u64,
+    first_births: u32,
+) {
+    ctx.one_shot(|cmd| {
+        for k in from..from + steps {
+            let births = if k == 0 { first_births } else { 0 };
+            s.record_births(ctx, cmd, &mut Labels, passes, &frame(cam, k, dt), births);
+        }
+    })
+    .unwrap();
+}
+
+fn key(c: [f32; 4]) -> [u32; 4] {
+    c.map(f32::to_bits)
+}
+
+#[test]
+fn closed_form_equals_verlet_and_euler_with_a_tiny_step() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let n = 256u32;
+    let t_end = 0.5f32;
+    let g = Vec3::new(0.0, -9.81, 0.0);
+    let run = |integrator, dt: f32| {
+        let mut s = ParticleSystem::new(&ctx, &passes, &ballistic(integrator, n), 0, 7).unwrap();
+        let k = (t_end / dt).round() as u64;
+        steps(&ctx, &passes, &mut s, &cam, dt, 0, k, n);
+        let d = s.read(&ctx).unwrap();
+        let colors: Vec<[f32; 4]> = ctx.readback(&s.color_buffer(), 0, n as usize).unwrap();
+        s.destroy(&ctx);
+        (d, colors)
+    };
+    // Closed form: the state is p0, v0 and the birth time.
+    let (closed, ccol) = run(Integrator::Closed, 1.0 / 60.0);
+    let exact: std::collections::HashMap<[u32; 4], Vec3> = (0..n as usize)
+        .map(|i| {
+            let (p, v) = (closed.pos[i], closed.vel[i]);
+            assert_eq!(p[3], 0.0, "born at t = 0");
+            (
+                key(ccol[i]),
+                closed_pos(
+                    Vec3::from_slice(&p[..3]),
+                    Vec3::from_slice(&v[..3]),
+                    g,
+                    t_end,
+                ),
+            )
+        })
+        .collect();
+    assert_eq!(exact.len(), n as usize, "colours identify particles");
+    for (integrator, dt, bound) in [
+        (Integrator::Verlet, 1.0 / 60.0, 2e-4f32),
+        (
+            Integrator::Euler,
+            1e-4,
+            0.5 * 9.81 * 1e-4 * t_end * 1.05 + 1e-4,
+        ),
+    ] {
+        let (d, col) = run(integrator, dt);
+        assert_eq!(d.alive.len(), n as usize);
+        let mut worst = 0.0f32;
+        for &slot in &d.alive {
+            let p = Vec3::from_slice(&d.pos[slot as usize][..3]);
+            let e = exact[&key(col[slot as usize])];
+            worst = worst.max((p - e).length());
+            assert!((d.pos[slot as usize][3] - t_end).abs() < 1e-3, "age");
+        }
+        assert!(
+            worst <= bound,
+            "{integrator:?} at dt {dt}: {worst} m from the closed form (bound {bound})"
+        );
+    }
+    // Euler's error is first order in dt: a coarse step is visibly off.
+    let (d, col) = run(Integrator::Euler, 1.0 / 60.0);
+    let worst = d
+        .alive
+        .iter()
+        .map(|&s| {
+            (Vec3::from_slice(&d.pos[s as usize][..3]) - exact[&key(col[s as usize])]).length()
+        })
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst > 0.02,
+        "euler at 1/60 s should miss by ~g dt t / 2 = 0.04 m, got {worst}"
+    );
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+#[test]
+fn verlet_conserves_energy_in_an_orbit() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let (strength, eps, r) = (1.0f32, 0.01f32, 0.5f32);
+    let speed = (strength * r / (r * r + eps)).sqrt();
+    let mut spec = ballistic(Integrator::Verlet, 1);
+    spec.emitter = emitter(
+        Shape::Point,
+        [r, 0.0, 0.0],
+        0.0,
+        Vary {
+            mean: 0.0,
+            variance: 0.0,
+        },
+    );
+    spec.particle.velocity = Vary {
+        mean: [0.0, 0.0, speed * 0.9],
+        variance: [0.0; 3],
+    };
+    spec.gravity = [0.0; 3];
+    spec.force.push(ForceSpec {
+        kind: ForceKind::Attractor,
+        at: [0.0; 3],
+        axis: [0.0, 1.0, 0.0],
+        strength,
+        eps,
+        scale: 1.0,
+        speed: 0.0,
+    });
+    let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 1).unwrap();
+    let dt = 1.0 / 240.0;
+    let energy = |d: &fluidform::psys::system::StateDump| {
+        let slot = d.alive[0] as usize;
+        let p = Vec3::from_slice(&d.pos[slot][..3]);
+        let v = (p - Vec3::from_slice(&d.vel[slot][..3])) / dt;
+        0.5 * v.length_squared() as f64 + attractor_potential(p.length(), strength, eps)
+    };
+    steps(&ctx, &passes, &mut s, &cam, dt, 0, 1, 1);
+    let e0 = energy(&s.read(&ctx).unwrap());
+    let mut worst = 0.0f64;
+    let mut radii = (f32::MAX, 0.0f32);
+    for chunk in 0..20 {
+        steps(&ctx, &passes, &mut s, &cam, dt, 1 + chunk * 100, 100, 0);
+        let d = s.read(&ctx).unwrap();
+        assert_eq!(d.alive.len(), 1);
+        let rr = Vec3::from_slice(&d.pos[d.alive[0] as usize][..3]).length();
+        radii = (radii.0.min(rr), radii.1.max(rr));
+        worst = worst.max((energy(&d) - e0).abs() / e0.abs());
+    }
+    // An eccentric orbit (0.9 of the circular speed) over several periods.
+    assert!(
+        radii.1 - radii.0 > 0.05,
+        "the orbit is eccentric: {radii:?}"
+    );
+    assert!(
+        worst < 0.01,
+        "verlet energy drift {worst} of |E0| (bound 1%)"
+    );
+    s.destroy(&ctx);
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+#[test]
+fn emitted_counts_match_mean_and_variance() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let (mean, var) = (20.0f32, 10.0f32);
+    let mut spec = ballistic(Integrator::Euler, 1 << 15);
+    spec.emitter.rate = Some(Vary {
+        mean,
+        variance: var,
+    });
+    spec.particle.life = Vary {
+        mean: 0.05,
+        variance: 0.0,
+    };
+    let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 3).unwrap();
+    let frames = 1500u64;
+    ctx.one_shot(|cmd| {
+        for k in 0..frames {
+            s.record_step(&ctx, cmd, &mut Labels, &passes, &frame(&cam, k, 1.0 / 60.0));
+        }
+    })
+    .unwrap();
+    let c = s.read_counters(&ctx).unwrap();
+    assert_eq!(
+        c.births as u64, s.births_asked,
+        "the GPU bore every birth drawn"
+    );
+    assert_eq!(c.refused, 0);
+    let m = s.births_sum.0 / frames as f64;
+    let v = s.births_sum.1 / frames as f64 - m * m;
+    // rand uniform in [-1, 1): variance var^2 / 3, plus the stochastic rounding's (<= 1/4).
+    let expect_v = (var * var / 3.0) as f64 + 1.0 / 6.0;
+    let se = (expect_v / frames as f64).sqrt();
+    assert!(
+        (m - mean as f64).abs() < 4.0 * se,
+        "mean {m} vs {mean} (se {se})"
+    );
+    assert!(
+        (v / expect_v - 1.0).abs() < 0.12,
+        "variance {v} vs {expect_v}"
+    );
+    // Lives of 3 frames: births and deaths balance.
+    assert_eq!(
+        c.births as u64 - c.deaths(),
+        c.alive[s.drawn() as usize] as u64
+    );
+    s.destroy(&ctx);
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+/// View depth of a point.
+fn depth(cam: &Camera, p: Vec3) -> f32 {
+    (cam.view_proj() * p.extend(1.0)).w
+}
+
+#[test]
+fn sprites_are_back_to_front_after_every_sort() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let cells = fluidform::psys::system::DEPTH_CELLS as f32;
+    for (integrator, sort) in [
+        (Integrator::Euler, SortAlgo::OddEven),
+        (Integrator::Euler, SortAlgo::Bitonic),
+        (Integrator::Euler, SortAlgo::Counting),
+        (Integrator::Verlet, SortAlgo::Counting),
+        (Integrator::Closed, SortAlgo::OddEven),
+        (Integrator::Closed, SortAlgo::Counting),
+    ] {
+        let mut spec = ballistic(integrator, 3000);
+        spec.sort = Some(sort);
+        spec.emitter.rate = Some(Vary {
+            mean: 150.0,
+            variance: 50.0,
+        });
+        spec.particle.life = Vary {
+            mean: 0.25,
+            variance: 0.1,
+        };
+        let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 11).unwrap();
+        let dt = 1.0 / 60.0;
+        let last = 30u64;
+        ctx.one_shot(|cmd| {
+            for k in 0..=last {
+                let f = frame(&cam, k, dt);
+                s.record_step(&ctx, cmd, &mut Labels, &passes, &f);
+                ctx.barrier(
+                    cmd,
+                    fluidform::gpu::sync::COMPUTE_WRITE,
+                    fluidform::gpu::sync::COMPUTE_READ,
+                );
+                s.record_sort(&ctx, cmd, &mut Labels, &passes, &f).unwrap();
+            }
+        })
+        .unwrap();
+        let d = s.read(&ctx).unwrap();
+        let (_, order) = s.read_sorted(&ctx).unwrap();
+        let t = s.time_now();
+        let g = Vec3::new(0.0, -9.81, 0.0);
+        let drawn: Vec<u32> = order
+            .iter()
+            .copied()
+            .take_while(|&x| x != u32::MAX)
+            .collect();
+        assert!(
+            order[drawn.len()..].iter().all(|&x| x == u32::MAX),
+            "{sort:?}: slots after the end"
+        );
+        let pos = |slot: u32| {
+            let (p, v) = (d.pos[slot as usize], d.vel[slot as usize]);
+            match integrator {
+                Integrator::Closed => closed_pos(
+                    Vec3::from_slice(&p[..3]),
+                    Vec3::from_slice(&v[..3]),
+                    g,
+                    (t - p[3] as f64) as f32,
+                ),
+                _ => Vec3::from_slice(&p[..3]),
+            }
+        };
+        // The drawn set is exactly the live particles.
+        let mut a: Vec<u32> = drawn.clone();
+        let mut b: Vec<u32> = match integrator {
+            Integrator::Closed => (0..3000u32)
+                .filter(|&i| {
+                    d.pos[i as usize][3] >= 0.0
+                        && t - (d.pos[i as usize][3] as f64) < d.vel[i as usize][3] as f64
+                })
+                .collect(),
+            _ => d.alive.clone(),
+        };
+        a.sort();
+        b.sort();
+        assert!(a.len() > 500, "{integrator:?}/{sort:?}: {} drawn", a.len());
+        assert_eq!(
+            a, b,
+            "{integrator:?}/{sort:?}: drawn slots are the live ones"
+        );
+        // Counting: one log-depth cell of slack.
+        let slack = match sort {
+            SortAlgo::Counting => 1.0 + 2.0 * (cam.far / cam.near).ln() / cells,
+            _ => 1.0 + 1e-6,
+        };
+        for w in drawn.windows(2) {
+            let (d0, d1) = (depth(&cam, pos(w[0])), depth(&cam, pos(w[1])));
+            assert!(
+                d1 <= d0 * slack,
+                "{integrator:?}/{sort:?}: depth {d1} after {d0}"
+            );
+        }
+        s.destroy(&ctx);
+    }
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+#[test]
+fn no_particle_passes_a_collider_and_the_lists_partition_the_slots() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let plane = ColliderSpec {
+        kind: ColliderKind::Plane,
+        normal: [0.0, 1.0, 0.0],
+        offset: 0.0,
+        centre: [0.0; 3],
+        radius: 0.0,
+        min: [0.0; 3],
+        max: [0.0; 3],
+        a: [0.0; 3],
+        b: [0.0; 3],
+        restitution: 0.5,
+        friction: 0.2,
+        inside: false,
+        kill: false,
+    };
+    let container = ColliderSpec {
+        kind: ColliderKind::Sphere,
+        centre: [0.0, 1.0, 0.0],
+        radius: 1.5,
+        inside: true,
+        ..plane.clone()
+    };
+    let ball = ColliderSpec {
+        kind: ColliderKind::Sphere,
+        centre: [0.6, 0.4, 0.0],
+        radius: 0.3,
+        kill: true,
+        ..plane.clone()
+    };
+    for integrator in [Integrator::Euler, Integrator::Verlet] {
+        let mut spec = ballistic(integrator, 700);
+        spec.emitter.rate = Some(Vary {
+            mean: 60.0,
+            variance: 30.0,
+        });
+        spec.particle.velocity = Vary {
+            mean: [0.0, -3.0, 0.0],
+            variance: [4.0, 4.0, 4.0],
+        };
+        spec.particle.life = Vary {
+            mean: 1.5,
+            variance: 1.0,
+        };
+        spec.collider = vec![plane.clone(), container.clone(), ball.clone()];
+        spec.death.max_distance = Some(1.4);
+        let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 5).unwrap();
+        let dt = 1.0 / 60.0;
+        for chunk in 0..12 {
+            ctx.one_shot(|cmd| {
+                for k in chunk * 10..chunk * 10 + 10 {
+                    s.record_step(&ctx, cmd, &mut Labels, &passes, &frame(&cam, k, dt));
+                }
+            })
+            .unwrap();
+            let d = s.read(&ctx).unwrap();
+            partitions(&d.alive, &d.dead, 700)
+                .unwrap_or_else(|e| panic!("{integrator:?} frame {}: {e}", chunk * 10 + 9));
+            for &slot in &d.alive {
+                let p = Vec3::from_slice(&d.pos[slot as usize][..3]);
+                assert!(p.y >= -1e-5, "{integrator:?}: below the plane at {p}");
+                assert!(
+                    (p - Vec3::new(0.0, 1.0, 0.0)).length() <= 1.5 + 1e-4,
+                    "{integrator:?}: out of the container at {p}"
+                );
+            }
+            let c = d.counters;
+            assert_eq!(c.births as u64 - c.deaths(), d.alive.len() as u64);
+        }
+        let c = s.read_counters(&ctx).unwrap();
+        assert!(
+            c.refused > 0,
+            "{integrator:?}: the budget of 700 was reached"
+        );
+        assert!(
+            c.died_life > 0 && c.died_collision > 0 && c.died_distance > 0,
+            "{integrator:?}: {c:?}"
+        );
+        s.destroy(&ctx);
+    }
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+#[test]
+fn bad_systems_are_clear_errors() {
+    let mut s = ballistic(Integrator::Closed, 64);
+    s.collider.push(ColliderSpec {
+        kind: ColliderKind::Plane,
+        normal: [0.0, 1.0, 0.0],
+        offset: 0.0,
+        centre: [0.0; 3],
+        radius: 0.0,
+        min: [0.0; 3],
+        max: [0.0; 3],
+        a: [0.0; 3],
+        b: [0.0; 3],
+        restitution: 0.5,
+        friction: 0.2,
+        inside: false,
+        kill: false,
+    });
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("closed") && e.contains("collider"), "{e}");
+    let mut s = ballistic(Integrator::Euler, 64);
+    s.particle.life.variance = 200.0;
+    assert!(s.validate().unwrap_err().to_string().contains("life"));
+    let mut s = ballistic(Integrator::Euler, 64);
+    s.emitter.shape = Shape::Mesh;
+    assert!(s
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("not implemented yet"));
+    let mut s = ballistic(Integrator::Euler, 64);
+    s.draw = Some(SpriteMode::Points);
+    s.sort = Some(SortAlgo::Bitonic);
+    assert!(s.validate().unwrap_err().to_string().contains("no sort"));
+    // Scenes: --sort for points only, closed with forces.
+    let smoke = ParticleScene::built_in("smoke").unwrap();
+    let e = smoke
+        .with_switches(Some(Integrator::Closed), None, None, None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("force"), "{e}");
+}
+
+#[test]
+fn particle_scenes_run_with_every_integrator_sort_and_draw() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = format!("{}/tests/scenes/sparks.toml", env!("CARGO_MANIFEST_DIR"));
+    for args in [
+        vec!["--scene", "fountain"],
+        vec![
+            "--scene",
+            "fountain",
+            "--integrator",
+            "verlet",
+            "--sort",
+            "bitonic",
+            "--particles",
+            "4096",
+        ],
+        vec!["--scene", "smoke", "--sort", "none"],
+        vec![
+            "--scene",
+            file.as_str(),
+            "--integrator",
+            "closed",
+            "--sort",
+            "odd-even",
+        ],
+        vec!["--scene", file.as_str(), "--draw", "points"],
+    ] {
+        let out = dir.path().join("run");
+        let mut all = vec![
+            "run",
+            "--frames",
+            "4",
+            "--save-every",
+            "3",
+            "--validation",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--quiet",
+        ];
+        all.extend(&args);
+        all.extend(["--out", out.to_str().unwrap()]);
+        let o = fluidform(&all);
+        assert!(o.status.success(), "{args:?}: {}", text(&o));
+        let sum: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let systems = sum["stats"]["systems"].as_array().unwrap();
+        for s in systems {
+            assert!(s["births"].as_u64().unwrap() > 0, "{args:?}: {s}");
+        }
+        assert!(out.join("frame_0003.png").exists());
+    }
+    for (args, says) in [
+        (
+            vec!["--scene", "smoke", "--integrator", "closed"],
+            "no closed form",
+        ),
+        (
+            vec!["--scene", "fountain", "--list", "abuffer"],
+            "--list does not apply",
+        ),
+        (
+            vec![
+                "--scene",
+                file.as_str(),
+                "--draw",
+                "points",
+                "--sort",
+                "bitonic",
+            ],
+            "opaque points",
+        ),
+    ] {
+        let mut all = vec![
+            "run",
+            "--frames",
+            "1",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ];
+        all.extend(&args);
+        let o = fluidform(&all);
+        let t = text(&o);
+        assert!(
+            !o.status.success() && t.contains(says) && !t.contains("panicked"),
+            "{args:?}: {t}"
+        );
+    }
+}
