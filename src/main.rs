@@ -37,7 +37,8 @@ enum Command {
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
         /// Built-in scene (character, demo, dam-break, drop, resting-block, walker, giraffe,
-        /// union, morph, two-groups, orbits) or a TOML scene file
+        /// union, morph, two-groups, orbits; particle systems: fountain, smoke) or a TOML
+        /// scene file
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: String,
         /// Frames to play (default: the scene's own count)
@@ -184,6 +185,18 @@ enum BenchWhat {
         #[command(flatten)]
         emission: fluidform::config::EmissionArgs,
     },
+    /// Particle systems (seed 003): update, sort and draw ms at 64K, 256K and 1M sprites
+    /// (or --particles), per integrator and sort (or --integrator, --sort)
+    Particles {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        sorting: SortArgs,
+        #[command(flatten)]
+        particle: fluidform::config::ParticleArgs,
+    },
     /// The metaball renderer on a resting blob, per list (or --list)
     Render {
         #[command(flatten)]
@@ -311,6 +324,21 @@ impl BenchWhat {
                 },
             ),
             BenchWhat::Stability(a) => ("stability", a.switches()),
+            BenchWhat::Particles {
+                common,
+                frame,
+                sorting,
+                particle,
+            } => (
+                "particles",
+                Switches {
+                    common,
+                    frame,
+                    sorting,
+                    particle,
+                    ..d()
+                },
+            ),
             BenchWhat::Render {
                 common,
                 frame,

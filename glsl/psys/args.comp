@@ -1,7 +1,7 @@
 #version 450
 // One invocation. mode 0 (before the update): the update's indirect dispatch over the
 // alive list it reads, and the other list emptied. mode 1 (after): the draw's instance
-// count from the list the update wrote.
+// vertex count from the list the update wrote.
 #include "common/index.glsl"
 #include "state.glsl"
 void main() {
@@ -12,8 +12,8 @@ void main() {
         c.update_args[2] = 1u;
         c.alive[1u - pc.cur] = 0u;
     } else if (pc.mode == 1u) {
-        c.draw_args[1] = c.alive[1u - pc.cur];
+        c.draw_args[0] = c.verts * c.alive[1u - pc.cur];
     } else {
-        c.draw_args[1] = 0u;
+        c.draw_args[0] = 0u;
     }
 }

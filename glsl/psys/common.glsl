@@ -63,9 +63,11 @@ struct SystemParams {
 struct Counters {
     int dead_count;     // free slots on the dead stack (stateful)
     uint alive[2];      // alive-list lengths (ping-pong)
-    uint pad0;
+    uint verts;         // vertices per particle of the draw
     uint update_args[4];  // VkDispatchIndirectCommand over the alive list (+ pad)
-    uint draw_args[4];    // VkDrawIndirectCommand: vertices, instances, first vertex, first
+    // VkDrawIndirectCommand: verts x drawn vertices in one instance (llvmpipe runs
+    // instances one by one, so particles are not instances)
+    uint draw_args[4];
     uint births;
     uint refused;       // births refused: no free slot (the budget)
     uint died_life;
@@ -89,28 +91,35 @@ float srnd(inout uint s) { return 2.0 * rnd(s) - 1.0; }
 vec3 srnd3(inout uint s) { return vec3(srnd(s), srnd(s), srnd(s)); }
 vec4 srnd4(inout uint s) { return vec4(srnd(s), srnd(s), srnd(s), srnd(s)); }
 
-// Piecewise-linear keyframes (x: life fraction, y: value); 1 without keys.
-float curve1(vec4 keys[MAX_KEYS], uint n, float u) {
-    if (n == 0u) return 1.0;
-    if (u <= keys[0].x) return keys[0].y;
-    for (uint k = 1u; k < n; k++) {
-        if (u <= keys[k].x) {
-            float t = (u - keys[k - 1u].x) / max(keys[k].x - keys[k - 1u].x, 1e-6);
-            return mix(keys[k - 1u].y, keys[k].y, t);
-        }
-    }
-    return keys[n - 1u].y;
+// Piecewise-linear keyframes over life, read in place from the parameter block `sp`
+// (passing the arrays to a function would copy them per vertex). CURVE1: keys with x the
+// life fraction, y the value; CURVE3: rgb with w the life fraction. 1 without keys.
+#define CURVE1(keys, n, u, out_v) {                                                    \
+    out_v = 1.0;                                                                       \
+    if (n > 0u) {                                                                      \
+        out_v = keys[n - 1u].y;                                                        \
+        if (u <= keys[0].x) out_v = keys[0].y;                                         \
+        else for (uint k_ = 1u; k_ < n; k_++) {                                        \
+            if (u <= keys[k_].x) {                                                     \
+                float t_ = (u - keys[k_ - 1u].x) / max(keys[k_].x - keys[k_ - 1u].x, 1e-6); \
+                out_v = mix(keys[k_ - 1u].y, keys[k_].y, t_);                           \
+                break;                                                                 \
+            }                                                                          \
+        }                                                                              \
+    }                                                                                  \
 }
-// Colour keys: rgb, w life fraction.
-vec3 curve3(vec4 keys[MAX_KEYS], uint n, float u) {
-    if (n == 0u) return vec3(1.0);
-    if (u <= keys[0].w) return keys[0].xyz;
-    for (uint k = 1u; k < n; k++) {
-        if (u <= keys[k].w) {
-            float t = (u - keys[k - 1u].w) / max(keys[k].w - keys[k - 1u].w, 1e-6);
-            return mix(keys[k - 1u].xyz, keys[k].xyz, t);
-        }
-    }
-    return keys[n - 1u].xyz;
+#define CURVE3(keys, n, u, out_v) {                                                    \
+    out_v = vec3(1.0);                                                                 \
+    if (n > 0u) {                                                                      \
+        out_v = keys[n - 1u].xyz;                                                      \
+        if (u <= keys[0].w) out_v = keys[0].xyz;                                       \
+        else for (uint k_ = 1u; k_ < n; k_++) {                                        \
+            if (u <= keys[k_].w) {                                                     \
+                float t_ = (u - keys[k_ - 1u].w) / max(keys[k_].w - keys[k_ - 1u].w, 1e-6); \
+                out_v = mix(keys[k_ - 1u].xyz, keys[k_].xyz, t_);                       \
+                break;                                                                 \
+            }                                                                          \
+        }                                                                              \
+    }                                                                                  \
 }
 #endif

@@ -2,7 +2,9 @@
 // Points: round, opaque. Streaks: the colour, alpha-blended. Sprites: the texture's
 // coverage times the particle's opacity, alpha-blended back to front.
 #include "draw.glsl"
+#if MODE != 0
 layout(location = 0) in vec2 uv;
+#endif
 layout(location = 1) in vec4 col;
 layout(location = 0) out vec4 out_color;
 float texel(ivec2 t) {
@@ -12,6 +14,7 @@ float texel(ivec2 t) {
 }
 void main() {
 #if MODE == 0
+    vec2 uv = gl_PointCoord * 2.0 - 1.0;
     if (dot(uv, uv) > 1.0) discard;
     out_color = vec4(col.rgb, 1.0);
 #elif MODE == 1

@@ -3,7 +3,7 @@
 // depth's float bits reversed, the counting sort a cell on a log scale between near and
 // far (relative resolution ln(far / near) / cells). Entries past the alive particles get
 // the largest key and NO_SLOT, so they sort last. Closed form: every slot is tested
-// (age within its life) and the drawn ones counted into the draw's instance count.
+// (age within its life) and the drawn ones counted into the draw's vertex count.
 #include "common/index.glsl"
 #include "state.glsl"
 #include "closed.glsl"
@@ -18,7 +18,7 @@ void main() {
         if (P.w >= 0.0 && age >= 0.0 && age < V.w) {
             slot = i;
             p = closed_pos(P.xyz, V.xyz, sp.gravity.xyz, age);
-            atomicAdd(c.draw_args[1], 1u);
+            atomicAdd(c.draw_args[0], c.verts);
         }
     } else if (i < c.alive[1u - pc.cur]) {
         slot = alive[(1u - pc.cur) * pc.capacity + i];

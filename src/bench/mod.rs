@@ -3,6 +3,7 @@
 //! (sweep.csv + sweep.md) when several configurations run.
 pub mod control;
 pub mod emission;
+pub mod particles;
 pub mod plot;
 pub mod primitives;
 pub mod render;
@@ -66,6 +67,7 @@ pub const WHATS: &[&str] = &[
     "skin",
     "control",
     "emission",
+    "particles",
 ];
 
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
@@ -146,6 +148,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
                 &[Group::Sort, Group::Neighbors, Group::Fluid, Group::Emission],
             )?;
             emission::emission(&ctx, opts)?
+        }
+        "particles" => {
+            sw.reject_unused("bench particles", &[Group::Sort, Group::Particles])?;
+            particles::particles(&ctx, opts)?
         }
         other => {
             return Err(Error::Param(format!(

@@ -337,6 +337,7 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
                 }
             }
         }
+        "particles" => out.extend(super::particles::notes(rows)),
         "sort" => {
             if let (Some(o), Some(c)) = (ms("odd-even", 64 << 10), ms("counting", 64 << 10)) {
                 out.push(format!(

@@ -340,7 +340,8 @@ fn open_device(
     let features = vk::PhysicalDeviceFeatures::default()
         .fragment_stores_and_atomics(true)
         .vertex_pipeline_stores_and_atomics(info.vertex_stores)
-        .shader_int64(info.int64);
+        .shader_int64(info.int64)
+        .large_points(info.max_point_size > 1.0);
     let create = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
         .enabled_extension_names(&exts)

@@ -37,6 +37,9 @@ pub struct DeviceInfo {
     pub vertex_stores: bool,
     #[serde(skip)]
     pub int64: bool,
+    /// Points larger than one pixel (largePoints) up to this size.
+    #[serde(skip)]
+    pub max_point_size: f32,
     #[serde(skip)]
     pub type_rank: u32,
 }
@@ -176,6 +179,10 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
         queue_family,
         vertex_stores: f.vertex_pipeline_stores_and_atomics == vk::TRUE,
         int64: f.shader_int64 == vk::TRUE,
+        max_point_size: match f.large_points == vk::TRUE {
+            true => props.limits.point_size_range[1],
+            false => 1.0,
+        },
         type_rank: kind.1,
     }
 }

@@ -50,7 +50,7 @@ const _: () =
 pub struct Counters {
     pub dead_count: i32,
     pub alive: [u32; 2],
-    pub pad0: u32,
+    pub verts: u32,
     pub update_args: [u32; 4],
     pub draw_args: [u32; 4],
     pub births: u32,
@@ -218,7 +218,7 @@ crate::gpu_interface! {
 /// The draw mode's shader define and primitive topology.
 pub fn draw_mode(mode: SpriteMode) -> (u32, vk::PrimitiveTopology, bool) {
     match mode {
-        SpriteMode::Points => (0, vk::PrimitiveTopology::TRIANGLE_LIST, false),
+        SpriteMode::Points => (0, vk::PrimitiveTopology::POINT_LIST, false),
         SpriteMode::Streaks => (1, vk::PrimitiveTopology::LINE_LIST, true),
         SpriteMode::Sprites => (2, vk::PrimitiveTopology::TRIANGLE_LIST, true),
     }
@@ -227,8 +227,9 @@ pub fn draw_mode(mode: SpriteMode) -> (u32, vk::PrimitiveTopology, bool) {
 /// Vertices per particle of a draw mode.
 pub fn vertices(mode: SpriteMode) -> u32 {
     match mode {
+        SpriteMode::Points => 1,
         SpriteMode::Streaks => 2,
-        _ => 6,
+        SpriteMode::Sprites => 6,
     }
 }
 

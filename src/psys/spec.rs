@@ -412,6 +412,9 @@ impl SystemSpec {
                 return stateful("death by distance or view (a state change)");
             }
         }
+        if !(self.point_px >= 1.0 && self.point_px <= 64.0) {
+            return bad("point_px must be in [1, 64]".into());
+        }
         if self.draw() == SpriteMode::Points && matches!(self.sort, Some(s) if s != SortAlgo::None)
         {
             return bad("points are opaque and depth-tested: they take no sort".into());

@@ -99,6 +99,13 @@ impl ParticleSystem {
         seed: u64,
     ) -> Result<Self> {
         spec.validate()?;
+        let max_px = ctx.info.max_point_size;
+        if spec.draw() == SpriteMode::Points && spec.point_px > max_px {
+            return Err(Error::Unsupported(format!(
+                "system '{}': points of {} px, but the device draws points of at most {max_px} px",
+                spec.name, spec.point_px
+            )));
+        }
         let cap = spec.capacity as u64;
         let bytes = cap * 16;
         let need = bytes * 4
@@ -157,7 +164,8 @@ impl ParticleSystem {
         ctx.upload(&mut dead, 0, &free)?;
         let c = Counters {
             dead_count: spec.capacity as i32,
-            draw_args: [vertices(spec.draw()), 0, 0, 0],
+            verts: vertices(spec.draw()),
+            draw_args: [0, 1, 0, 0],
             ..Counters::zeroed()
         };
         ctx.upload(&mut counters, 0, &[c])?;
@@ -459,7 +467,7 @@ impl ParticleSystem {
         };
         passes.pipeline(self.mode).bind(ctx, cmd, &bufs, &push);
         if identity == 1 {
-            ctx.draw(cmd, vertices(self.mode), self.capacity);
+            ctx.draw(cmd, vertices(self.mode) * self.capacity, 1);
         } else {
             ctx.draw_indirect(cmd, &self.counters, Counters::DRAW_ARGS);
         }
