@@ -39,13 +39,15 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::render::mesh::MeshIo>("render/mesh.frag", &[]),
     ];
     use crate::psys::gpu::{DrawIo, PsysIo};
-    for f in [
-        "psys/emit.comp",
-        "psys/args.comp",
-        "psys/update.comp",
-        "psys/keys.comp",
-    ] {
+    for f in ["psys/emit.comp", "psys/args.comp", "psys/keys.comp"] {
         v.push(with::<PsysIo>(f, &[]));
+    }
+    for sub in [false, true] {
+        let d: Vec<(String, String)> = crate::psys::Passes::update_defines(sub)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        v.push(with::<PsysIo>("psys/update.comp", &d));
     }
     for mode in 0..3 {
         for f in ["psys/draw.vert", "psys/draw.frag"] {

@@ -402,7 +402,15 @@ fn sprites_are_back_to_front_after_every_sort() {
 #[test]
 fn no_particle_passes_a_collider_and_the_lists_partition_the_slots() {
     let ctx = common::ctx();
-    let passes = Passes::new(&ctx).unwrap();
+    // The subgroup-aggregated appends where the device has them, and the plain ones.
+    for subgroups in [false, ctx.info.subgroup_arithmetic] {
+        colliders_and_lists(&ctx, subgroups);
+    }
+    finish(&ctx);
+}
+
+fn colliders_and_lists(ctx: &Context, subgroups: bool) {
+    let passes = Passes::with_subgroups(ctx, subgroups).unwrap();
     let cam = cam();
     let plane = ColliderSpec {
         kind: ColliderKind::Plane,
@@ -481,11 +489,10 @@ fn no_particle_passes_a_collider_and_the_lists_partition_the_slots() {
             c.died_life > 0 && c.died_collision > 0 && c.died_distance > 0,
             "{integrator:?}: {c:?}"
         );
-        s.destroy(&ctx);
+        s.destroy(ctx);
     }
     let mut passes = passes;
-    passes.destroy(&ctx);
-    finish(&ctx);
+    passes.destroy(ctx);
 }
 
 #[test]

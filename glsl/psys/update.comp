@@ -5,6 +5,28 @@
 #include "common/index.glsl"
 #include "state.glsl"
 #include "noise.glsl"
+#ifdef SUBGROUP
+#extension GL_KHR_shader_subgroup_ballot : require
+#endif
+
+// Reserve `n` entries (n = 1 or 0 per invocation) at counter `which` (0, 1: the alive
+// lists; 2: the dead stack) for every invocation calling it; the first index of each.
+// With subgroups one atomic per subgroup instead of one per particle: a million appends
+// to one address serialise otherwise.
+uint reserve(uint which, bool take) {
+#ifdef SUBGROUP
+    uvec4 ballot = subgroupBallot(take);
+    uint total = subgroupBallotBitCount(ballot);
+    uint base = 0u;
+    if (subgroupElect() && total > 0u) {
+        base = which == 2u ? uint(atomicAdd(c.dead_count, int(total))) : atomicAdd(c.alive[which], total);
+    }
+    return subgroupBroadcastFirst(base) + subgroupBallotExclusiveBitCount(ballot);
+#else
+    if (!take) return 0u;
+    return which == 2u ? uint(atomicAdd(c.dead_count, 1)) : atomicAdd(c.alive[which], 1u);
+#endif
+}
 
 // Acceleration at p moving with v, at time t.
 vec3 accel(vec3 p, vec3 v, float t) {
@@ -125,6 +147,9 @@ void main() {
         vec4 clip = pc.view_proj * vec4(p, 1.0);
         if (clip.w <= 0.0 || any(greaterThan(abs(clip.xy), vec2(clip.w * 1.1)))) cause = 2u;
     }
+    // Every invocation reaches both reservations (subgroup operations).
+    uint d = reserve(2u, cause != 0u);
+    uint a = reserve(1u - pc.cur, cause == 0u);
     if (cause != 0u) {
         pos[slot] = vec4(p, -1.0);
         vel[slot] = vec4(0.0);
@@ -132,12 +157,10 @@ void main() {
         else if (cause == 2u) atomicAdd(c.died_view, 1u);
         else if (cause == 3u) atomicAdd(c.died_distance, 1u);
         else atomicAdd(c.died_collision, 1u);
-        int d = atomicAdd(c.dead_count, 1);
         dead[d] = slot;
         return;
     }
     pos[slot] = vec4(p, age);
     vel[slot] = vec4(sp.counts2.y == I_VERLET ? p - v * dt : v, V.w);
-    uint a = atomicAdd(c.alive[1u - pc.cur], 1u);
     alive[(1u - pc.cur) * pc.capacity + a] = slot;
 }

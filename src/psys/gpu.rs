@@ -254,14 +254,25 @@ impl Passes {
     pub const DRAW: &'static str = "draw";
 
     pub fn new(ctx: &Context) -> Result<Self> {
-        let c = |name, shader, ls| {
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &[], ls))
+        Self::with_subgroups(ctx, ctx.info.subgroup_arithmetic)
+    }
+
+    /// `subgroups`: aggregate the update's list appends per subgroup (the device must
+    /// have subgroup ballot); off, one atomic per particle (the plain variant).
+    pub fn with_subgroups(ctx: &Context, subgroups: bool) -> Result<Self> {
+        let c = |name, shader, ls, defines: &[(&str, String)]| {
+            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, defines, ls))
                 .map(|p| Guard::new(ctx, p))
         };
-        let emit = c("psys emit", "psys/emit.comp", 256)?;
-        let args = c("psys args", "psys/args.comp", 1)?;
-        let update = c("psys update", "psys/update.comp", 256)?;
-        let keys = c("psys keys", "psys/keys.comp", 256)?;
+        let emit = c("psys emit", "psys/emit.comp", 256, &[])?;
+        let args = c("psys args", "psys/args.comp", 1, &[])?;
+        let update = c(
+            "psys update",
+            "psys/update.comp",
+            256,
+            &Self::update_defines(subgroups),
+        )?;
+        let keys = c("psys keys", "psys/keys.comp", 256, &[])?;
         let mut draw = Guard::new(ctx, Vec::new());
         for mode in [SpriteMode::Points, SpriteMode::Streaks, SpriteMode::Sprites] {
             let (m, topology, blend) = draw_mode(mode);
@@ -294,6 +305,14 @@ impl Passes {
             keys: keys.take(),
             draw: draw.take(),
         })
+    }
+
+    /// SUBGROUP: appends to the lists aggregated per subgroup (ballot).
+    pub fn update_defines(subgroups: bool) -> Vec<(&'static str, String)> {
+        match subgroups {
+            true => vec![("SUBGROUP", "1".into())],
+            false => vec![],
+        }
     }
 
     pub fn pipeline(&self, mode: SpriteMode) -> &GraphicsPipeline<DrawIo> {
