@@ -75,6 +75,7 @@ fn ballistic(integrator: Integrator, capacity: u32) -> SystemSpec {
 }
 
 /// Record `steps` steps (births only in the first) in one command buffer.
+#[allow(clippy::too_many_arguments)]
 fn steps(
     ctx: &Context,
     passes: &Passes,
@@ -111,7 +112,7 @@ fn closed_form_equals_verlet_and_euler_with_a_tiny_step() {
         let k = (t_end / dt).round() as u64;
         steps(&ctx, &passes, &mut s, &cam, dt, 0, k, n);
         let d = s.read(&ctx).unwrap();
-        let colors: Vec<[f32; 4]> = ctx.readback(&s.color_buffer(), 0, n as usize).unwrap();
+        let colors: Vec<[f32; 4]> = ctx.readback(s.color_buffer(), 0, n as usize).unwrap();
         s.destroy(&ctx);
         (d, colors)
     };
@@ -412,21 +413,7 @@ fn no_particle_passes_a_collider_and_the_lists_partition_the_slots() {
 fn colliders_and_lists(ctx: &Context, subgroups: bool) {
     let passes = Passes::with_subgroups(ctx, subgroups).unwrap();
     let cam = cam();
-    let plane = ColliderSpec {
-        kind: ColliderKind::Plane,
-        normal: [0.0, 1.0, 0.0],
-        offset: 0.0,
-        centre: [0.0; 3],
-        radius: 0.0,
-        min: [0.0; 3],
-        max: [0.0; 3],
-        a: [0.0; 3],
-        b: [0.0; 3],
-        restitution: 0.5,
-        friction: 0.2,
-        inside: false,
-        kill: false,
-    };
+    let plane = ColliderSpec::ground(0.0, 0.5, 0.2);
     let container = ColliderSpec {
         kind: ColliderKind::Sphere,
         centre: [0.0, 1.0, 0.0],
@@ -457,16 +444,16 @@ fn colliders_and_lists(ctx: &Context, subgroups: bool) {
         };
         spec.collider = vec![plane.clone(), container.clone(), ball.clone()];
         spec.death.max_distance = Some(1.4);
-        let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 5).unwrap();
+        let mut s = ParticleSystem::new(ctx, &passes, &spec, 0, 5).unwrap();
         let dt = 1.0 / 60.0;
         for chunk in 0..12 {
             ctx.one_shot(|cmd| {
                 for k in chunk * 10..chunk * 10 + 10 {
-                    s.record_step(&ctx, cmd, &mut Labels, &passes, &frame(&cam, k, dt));
+                    s.record_step(ctx, cmd, &mut Labels, &passes, &frame(&cam, k, dt));
                 }
             })
             .unwrap();
-            let d = s.read(&ctx).unwrap();
+            let d = s.read(ctx).unwrap();
             partitions(&d.alive, &d.dead, 700)
                 .unwrap_or_else(|e| panic!("{integrator:?} frame {}: {e}", chunk * 10 + 9));
             for &slot in &d.alive {
@@ -480,7 +467,7 @@ fn colliders_and_lists(ctx: &Context, subgroups: bool) {
             let c = d.counters;
             assert_eq!(c.births as u64 - c.deaths(), d.alive.len() as u64);
         }
-        let c = s.read_counters(&ctx).unwrap();
+        let c = s.read_counters(ctx).unwrap();
         assert!(
             c.refused > 0,
             "{integrator:?}: the budget of 700 was reached"
@@ -498,21 +485,7 @@ fn colliders_and_lists(ctx: &Context, subgroups: bool) {
 #[test]
 fn bad_systems_are_clear_errors() {
     let mut s = ballistic(Integrator::Closed, 64);
-    s.collider.push(ColliderSpec {
-        kind: ColliderKind::Plane,
-        normal: [0.0, 1.0, 0.0],
-        offset: 0.0,
-        centre: [0.0; 3],
-        radius: 0.0,
-        min: [0.0; 3],
-        max: [0.0; 3],
-        a: [0.0; 3],
-        b: [0.0; 3],
-        restitution: 0.5,
-        friction: 0.2,
-        inside: false,
-        kill: false,
-    });
+    s.collider.push(ColliderSpec::ground(0.0, 0.5, 0.2));
     let e = s.validate().unwrap_err().to_string();
     assert!(e.contains("closed") && e.contains("collider"), "{e}");
     let mut s = ballistic(Integrator::Euler, 64);

@@ -6,7 +6,7 @@ use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{ColorTarget, Context, Guard};
 use crate::psys::scenes::{base_system, emitter};
-use crate::psys::spec::{ColliderKind, ColliderSpec, ParticleSpec, Shape, SystemSpec, Vary};
+use crate::psys::spec::{ColliderSpec, ParticleSpec, Shape, SystemSpec, Vary};
 use crate::psys::system::FrameInfo;
 use crate::psys::{ParticleSystem, Passes};
 use crate::render::Camera;
@@ -61,21 +61,7 @@ pub fn system(n: u32, integrator: Integrator, sort: SortAlgo, draw: SpriteMode) 
         variance: 0.0,
     });
     if integrator != Integrator::Closed {
-        s.collider.push(ColliderSpec {
-            kind: ColliderKind::Plane,
-            normal: [0.0, 1.0, 0.0],
-            offset: 0.0,
-            centre: [0.0; 3],
-            radius: 0.0,
-            min: [0.0; 3],
-            max: [0.0; 3],
-            a: [0.0; 3],
-            b: [0.0; 3],
-            restitution: 0.4,
-            friction: 0.1,
-            inside: false,
-            kill: false,
-        });
+        s.collider.push(ColliderSpec::ground(0.0, 0.4, 0.1));
     }
     s
 }

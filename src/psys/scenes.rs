@@ -44,24 +44,6 @@ fn vary(mean: f32, variance: f32) -> Scalar {
     Vary { mean, variance }
 }
 
-fn plane(y: f32, restitution: f32, friction: f32) -> ColliderSpec {
-    ColliderSpec {
-        kind: ColliderKind::Plane,
-        normal: [0.0, 1.0, 0.0],
-        offset: y,
-        centre: [0.0; 3],
-        radius: 0.0,
-        min: [0.0; 3],
-        max: [0.0; 3],
-        a: [0.0; 3],
-        b: [0.0; 3],
-        restitution,
-        friction,
-        inside: false,
-        kill: false,
-    }
-}
-
 /// A system with no forces, colliders or curves: the built-ins start from it.
 pub fn base_system(
     name: &str,
@@ -128,7 +110,7 @@ impl ParticleScene {
                 );
                 water.over_life.opacity = vec![[0.0, 1.0], [0.75, 0.9], [1.0, 0.0]];
                 water.over_life.color = vec![[0.0, 0.9, 0.95, 1.0], [1.0, 0.55, 0.7, 1.0]];
-                water.collider.push(plane(0.0, 0.35, 0.25));
+                water.collider.push(ColliderSpec::ground(0.0, 0.35, 0.25));
                 water.damping = 0.05;
                 let mut spray = base_system(
                     "spray",
@@ -147,7 +129,7 @@ impl ParticleScene {
                     },
                 );
                 spray.draw = Some(SpriteMode::Streaks);
-                spray.collider.push(plane(0.0, 0.2, 0.5));
+                spray.collider.push(ColliderSpec::ground(0.0, 0.2, 0.5));
                 spray.over_life.opacity = vec![[0.0, 1.0], [1.0, 0.0]];
                 Self {
                     name: name.into(),

@@ -1,6 +1,8 @@
 //! A particle system as declared in a scene file's `[[system]]` table (seed 003): the
 //! emitter, every attribute as mean + rand x variance (rand uniform in [-1, 1)),
 //! attributes over life as keyframe curves, forces, colliders and death rules.
+// Checks are written `!(x > 0.0)` on purpose: NaN fails them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -183,6 +185,27 @@ pub struct ColliderSpec {
 
 fn default_restitution() -> f32 {
     0.3
+}
+
+impl ColliderSpec {
+    /// The plane y = `y` (free above it).
+    pub fn ground(y: f32, restitution: f32, friction: f32) -> Self {
+        Self {
+            kind: ColliderKind::Plane,
+            normal: [0.0, 1.0, 0.0],
+            offset: y,
+            centre: [0.0; 3],
+            radius: 0.0,
+            min: [0.0; 3],
+            max: [0.0; 3],
+            a: [0.0; 3],
+            b: [0.0; 3],
+            restitution,
+            friction,
+            inside: false,
+            kill: false,
+        }
+    }
 }
 
 /// Death besides the end of life (always on) and the budget (the capacity).
