@@ -21,14 +21,7 @@ fn cam() -> Camera {
 }
 
 fn frame(cam: &Camera, k: u64, dt: f32) -> FrameInfo<'_> {
-    FrameInfo {
-        cam,
-        time: k as f64 * dt as f64,
-        dt,
-        frame: k,
-        width: 256,
-        height: 256,
-    }
+    fluidform::psys::run::frame_info(cam, dt, k, 256, 256)
 }
 
 /// A spec with colourful, distinct particles (their colour identifies them across systems
@@ -265,7 +258,8 @@ fn emitted_counts_match_mean_and_variance() {
     .unwrap();
     let c = s.read_counters(&ctx).unwrap();
     assert_eq!(
-        c.births as u64, s.births_asked,
+        c.births as u64,
+        s.births_asked(),
         "the GPU bore every birth drawn"
     );
     assert_eq!(c.refused, 0);
@@ -366,12 +360,7 @@ fn sprites_are_back_to_front_after_every_sort() {
         // The drawn set is exactly the live particles.
         let mut a: Vec<u32> = drawn.clone();
         let mut b: Vec<u32> = match integrator {
-            Integrator::Closed => (0..3000u32)
-                .filter(|&i| {
-                    d.pos[i as usize][3] >= 0.0
-                        && t - (d.pos[i as usize][3] as f64) < d.vel[i as usize][3] as f64
-                })
-                .collect(),
+            Integrator::Closed => d.live_closed(t),
             _ => d.alive.clone(),
         };
         a.sort();

@@ -86,7 +86,7 @@ fn v3(a: [f32; 3], w: f32) -> V4 {
 }
 
 impl SystemParams {
-    /// The block for `spec` (validated) with its emitter at `centre`.
+    /// The block for `spec` (validated); `type_id` tells systems apart in the shaders.
     pub fn new(spec: &SystemSpec, type_id: u32) -> Self {
         let mut p = Self::zeroed();
         let e = &spec.emitter;

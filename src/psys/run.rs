@@ -4,7 +4,7 @@ use super::scenes::ParticleScene;
 use super::system::{FrameInfo, ParticleSystem};
 use crate::config::{Group, Integrator, SortAlgo, SpriteMode};
 use crate::error::Result;
-use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler};
+use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
 use crate::render::Camera;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
 use crate::session::{camera_with_switches, open, play, SLOTS};
@@ -50,7 +50,7 @@ impl SystemStats {
         let frames = s.frames.max(1) as f64;
         let mean = s.births_sum.0 / frames;
         let alive = match s.closed() {
-            true => s.read(ctx)?.alive_closed(s.time_now()),
+            true => s.read(ctx)?.live_closed(s.time_now()).len() as u64,
             false => c.alive[s.drawn() as usize] as u64,
         };
         Ok(Self {
@@ -114,42 +114,19 @@ impl SceneSystems {
     }
 
     pub fn frame(&self, frame: u64) -> FrameInfo<'_> {
-        FrameInfo {
-            cam: &self.cam,
-            time: frame as f64 * self.dt as f64,
-            dt: self.dt,
-            frame,
-            width: self.width,
-            height: self.height,
-        }
+        frame_info(&self.cam, self.dt, frame, self.width, self.height)
     }
 
-    /// Record every system's step and sort; their writes made visible to the draw.
+    /// Record every system's step and sort (see `record_simulation`).
     pub fn record_simulation(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        prof: &mut dyn crate::gpu::Scopes,
+        prof: &mut dyn Scopes,
         frame: u64,
     ) -> Result<()> {
-        let cam = self.cam;
-        let f = FrameInfo {
-            cam: &cam,
-            ..self.frame(frame)
-        };
-        for s in &mut self.systems {
-            s.record_step(ctx, cmd, prof, &self.passes, &f);
-        }
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-        for s in &mut self.systems {
-            s.record_sort(ctx, cmd, prof, &self.passes, &f)?;
-        }
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::GRAPHICS_READ | sync::INDIRECT_READ,
-        );
-        Ok(())
+        let f = frame_info(&self.cam, self.dt, frame, self.width, self.height);
+        record_simulation(ctx, cmd, prof, &self.passes, &mut self.systems, &f)
     }
 
     /// Record every system's draw (inside a rendering scope).
@@ -168,6 +145,43 @@ impl SceneSystems {
     }
 }
 crate::impl_destroy!(SceneSystems);
+
+/// Frame `frame` of a scene stepping `dt` per frame, drawn `width` x `height` by `cam`.
+pub fn frame_info(cam: &Camera, dt: f32, frame: u64, width: u32, height: u32) -> FrameInfo<'_> {
+    FrameInfo {
+        cam,
+        time: frame as f64 * dt as f64,
+        dt,
+        frame,
+        width,
+        height,
+    }
+}
+
+/// Record the systems' steps, then their depth sorts; their writes made visible to the
+/// draws (vertex shaders and indirect arguments). `run` and `bench particles` share it.
+pub fn record_simulation(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    prof: &mut dyn Scopes,
+    passes: &Passes,
+    systems: &mut [ParticleSystem],
+    f: &FrameInfo,
+) -> Result<()> {
+    for s in systems.iter_mut() {
+        s.record_step(ctx, cmd, prof, passes, f);
+    }
+    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    for s in systems.iter_mut() {
+        s.record_sort(ctx, cmd, prof, passes, f)?;
+    }
+    ctx.barrier(
+        cmd,
+        sync::COMPUTE_WRITE,
+        sync::GRAPHICS_READ | sync::INDIRECT_READ,
+    );
+    Ok(())
+}
 
 struct ParticleWork<'a> {
     scene: SceneSystems,

@@ -207,12 +207,8 @@ impl ParticleScene {
         if !is_particles {
             return Ok(None);
         }
-        let mut s: Self = toml::from_str(&text).map_err(|e| {
-            Error::Param(format!(
-                "scene file {name_or_path}: {}",
-                e.message().trim().replace('\n', " ")
-            ))
-        })?;
+        let mut s: Self = toml::from_str(&text)
+            .map_err(|e| crate::sph::scene::toml_error(name_or_path, &text, &e))?;
         if s.name.is_empty() {
             s.name = path
                 .file_stem()

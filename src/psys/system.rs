@@ -67,9 +67,7 @@ pub struct ParticleSystem {
     head: u32,
     rng: rand_pcg::Pcg32,
     seed: u64,
-    /// Births drawn on the CPU (closed form: more than the capacity in one frame are
-    /// refused here).
-    pub births_asked: u64,
+    /// Closed form: births past the capacity in one frame, refused on the CPU.
     pub refused_cpu: u64,
     /// Sum and sum of squares of the births drawn per frame.
     pub births_sum: (f64, f64),
@@ -79,13 +77,14 @@ pub struct ParticleSystem {
 }
 
 impl StateDump {
-    /// Closed form: slots born within their life at time `t`.
-    pub fn alive_closed(&self, t: f64) -> u64 {
-        self.pos
-            .iter()
-            .zip(&self.vel)
-            .filter(|(p, v)| p[3] >= 0.0 && t - (p[3] as f64) < v[3] as f64)
-            .count() as u64
+    /// Closed form: the slots born within their life at time `t` (what is drawn).
+    pub fn live_closed(&self, t: f64) -> Vec<u32> {
+        (0..self.pos.len() as u32)
+            .filter(|&i| {
+                let (p, v) = (self.pos[i as usize], self.vel[i as usize]);
+                p[3] >= 0.0 && t - (p[3] as f64) < v[3] as f64
+            })
+            .collect()
     }
 }
 
@@ -169,9 +168,11 @@ impl ParticleSystem {
             ..Counters::zeroed()
         };
         ctx.upload(&mut counters, 0, &[c])?;
-        // Closed form: birth time -1 marks a slot never born.
-        let unborn = vec![[0.0f32, 0.0, 0.0, -1.0]; spec.capacity as usize];
-        ctx.upload(&mut pos, 0, &unborn)?;
+        if spec.integrator() == Integrator::Closed {
+            // Birth time -1 marks a slot never born (the others read slots via lists).
+            let unborn = vec![[0.0f32, 0.0, 0.0, -1.0]; spec.capacity as usize];
+            ctx.upload(&mut pos, 0, &unborn)?;
+        }
         Ok(Self {
             spec: spec.clone(),
             capacity: spec.capacity,
@@ -194,7 +195,6 @@ impl ParticleSystem {
             head: 0,
             rng: rand_pcg::Pcg32::seed_from_u64(seed ^ (type_id as u64).wrapping_mul(0x9e37_79b9)),
             seed,
-            births_asked: 0,
             refused_cpu: 0,
             births_sum: (0.0, 0.0),
             frames: 0,
@@ -210,6 +210,11 @@ impl ParticleSystem {
     /// Scene time after the last recorded step (s).
     pub fn time_now(&self) -> f64 {
         self.last_time
+    }
+
+    /// Births drawn on the CPU so far.
+    pub fn births_asked(&self) -> u64 {
+        self.births_sum.0 as u64
     }
 
     pub fn closed(&self) -> bool {
@@ -257,7 +262,6 @@ impl ParticleSystem {
         let n = (x.max(0.0) + self.rng.random_range(0.0f32..1.0)).floor() as u64;
         self.births_sum.0 += n as f64;
         self.births_sum.1 += (n * n) as f64;
-        self.births_asked += n;
         let cap = if self.closed() {
             self.capacity as u64
         } else {
@@ -545,21 +549,20 @@ struct DepthSort {
 
 impl DepthSort {
     fn new(ctx: &Context, passes: &Passes, name: &str, cap: u64) -> Result<Self> {
-        let mut cells = CountingBuffers::new(ctx, &passes.scan, cap, DEPTH_CELLS)?;
-        let keys = ctx.storage_buffer(&format!("{name} sorted keys"), cap * 4);
-        let vals = ctx.storage_buffer(&format!("{name} sorted values"), cap * 4);
-        match (keys, vals) {
-            (Ok(keys), Ok(vals)) => Ok(Self { cells, keys, vals }),
-            (k, v) => {
-                cells.destroy(ctx);
-                for mut b in [k.ok(), v.ok()].into_iter().flatten() {
-                    ctx.destroy_buffer(&mut b);
-                }
-                Err(Error::Param(format!(
-                    "{name}: out of device memory for the depth sort"
-                )))
-            }
-        }
+        let cells = Guard::new(
+            ctx,
+            CountingBuffers::new(ctx, &passes.scan, cap, DEPTH_CELLS)?,
+        );
+        let buf = |what: &str| {
+            ctx.storage_buffer(&format!("{name} sorted {what}"), cap * 4)
+                .map(|b| Guard::new(ctx, b))
+        };
+        let (keys, vals) = (buf("keys")?, buf("values")?);
+        Ok(Self {
+            cells: cells.take(),
+            keys: keys.take(),
+            vals: vals.take(),
+        })
     }
 
     fn destroy(&mut self, ctx: &Context) {

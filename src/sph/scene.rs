@@ -407,6 +407,22 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
     }
 }
 
+/// A scene file's parse error as one line: where, then what (the parser's own text draws
+/// the line).
+pub fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> Error {
+    let at = e.span().map(|r| {
+        let before = &text[..r.start.min(text.len())];
+        let line = before.matches('\n').count() + 1;
+        let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+        format!(" line {line} column {col}:")
+    });
+    Error::Param(format!(
+        "scene file {file}:{} {}",
+        at.unwrap_or_default(),
+        e.message().trim().replace('\n', " ")
+    ))
+}
+
 impl Scene {
     pub fn built_in(name: &str) -> Option<Self> {
         let blue = [0.2, 0.45, 1.0];
@@ -666,20 +682,8 @@ impl Scene {
             path: name_or_path.into(),
             source: e,
         })?;
-        let mut s: Scene = toml::from_str(&text).map_err(|e| {
-            // One line: where, then what (the parser's own text draws the line).
-            let at = e.span().map(|r| {
-                let before = &text[..r.start.min(text.len())];
-                let line = before.matches('\n').count() + 1;
-                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-                format!(" line {line} column {col}:")
-            });
-            Error::Param(format!(
-                "scene file {name_or_path}:{} {}",
-                at.unwrap_or_default(),
-                e.message().trim().replace('\n', " ")
-            ))
-        })?;
+        let mut s: Scene =
+            toml::from_str(&text).map_err(|e| toml_error(name_or_path, &text, &e))?;
         // A character file is named relative to the scene file.
         let dir = path.parent().unwrap_or(Path::new("."));
         let chars = s.character.iter_mut();
