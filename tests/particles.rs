@@ -554,7 +554,14 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
         }
         assert!(out.join("frame_0003.png").exists());
     }
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[camera]\neye = [0, 1, 4]\ntarget = [0, 1, 0]\n[[system]]\nname = \"a\"\ncapacity = 0x\n",
+    )
+    .unwrap();
     for (args, says) in [
+        (vec!["--scene", bad.to_str().unwrap()], "bad.toml: line 6"),
         (
             vec!["--scene", "smoke", "--integrator", "closed"],
             "no closed form",

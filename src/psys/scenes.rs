@@ -203,7 +203,14 @@ impl ParticleScene {
             source: e,
         })?;
         // Only files with [[system]] are particle scenes.
-        let is_particles = matches!(text.parse::<toml::Table>(), Ok(t) if t.contains_key("system"));
+        // A file too malformed to parse is still one when it declares [[system]], so its
+        // error is the particle scene's, not the SPH loader's.
+        let is_particles = match text.parse::<toml::Table>() {
+            Ok(t) => t.contains_key("system"),
+            Err(_) => text
+                .lines()
+                .any(|l| l.trim_start().starts_with("[[system]]")),
+        };
         if !is_particles {
             return Ok(None);
         }
