@@ -491,7 +491,32 @@ fn bad_systems_are_clear_errors() {
     s.draw = Some(SpriteMode::Points);
     s.sort = Some(SortAlgo::Bitonic);
     assert!(s.validate().unwrap_err().to_string().contains("no sort"));
-    // Scenes: --sort for points only, closed with forces.
+    // Events: a collision event needs a collider; none with the closed form.
+    let mut s = ballistic(Integrator::Euler, 64);
+    s.event.push(EventSpec {
+        on: EventKind::Collision,
+        spawn: "x".into(),
+        count: Vary {
+            mean: 1.0,
+            variance: 0.0,
+        },
+        inherit: 0.0,
+        keep_parent: false,
+        along_normal: true,
+    });
+    assert!(s.validate().unwrap_err().to_string().contains("collider"));
+    s.event[0].on = EventKind::Death;
+    s.event[0].count.mean = 100.0;
+    assert!(s.validate().unwrap_err().to_string().contains("count"));
+    s.event[0].count.mean = 2.0;
+    s.integrator = Some(Integrator::Closed);
+    assert!(s.validate().unwrap_err().to_string().contains("event"));
+    // Scenes: --sort for points only, closed with forces, spawns of unknown systems.
+    let fw = format!("{}/tests/scenes/fireworks.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut scene = ParticleScene::find(&fw).unwrap().unwrap();
+    scene.system[0].event[0].spawn = "nothing".into();
+    let e = scene.validate().unwrap_err().to_string();
+    assert!(e.contains("'nothing'"), "{e}");
     let smoke = ParticleScene::built_in("smoke").unwrap();
     let e = smoke
         .with_switches(Some(Integrator::Closed), None, None, None)
@@ -504,6 +529,7 @@ fn bad_systems_are_clear_errors() {
 fn particle_scenes_run_with_every_integrator_sort_and_draw() {
     let dir = tempfile::tempdir().unwrap();
     let file = format!("{}/tests/scenes/sparks.toml", env!("CARGO_MANIFEST_DIR"));
+    let fireworks = format!("{}/tests/scenes/fireworks.toml", env!("CARGO_MANIFEST_DIR"));
     for args in [
         vec!["--scene", "fountain"],
         vec![
@@ -526,12 +552,16 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
             "odd-even",
         ],
         vec!["--scene", file.as_str(), "--draw", "points"],
+        vec!["--scene", fireworks.as_str(), "--frames", "90"],
     ] {
         let out = dir.path().join("run");
+        let frames = if args.contains(&"--frames") {
+            vec![]
+        } else {
+            vec!["--frames", "4"]
+        };
         let mut all = vec![
             "run",
-            "--frames",
-            "4",
             "--save-every",
             "3",
             "--validation",
@@ -542,6 +572,7 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
             "--quiet",
         ];
         all.extend(&args);
+        all.extend(&frames);
         all.extend(["--out", out.to_str().unwrap()]);
         let o = fluidform(&all);
         assert!(o.status.success(), "{args:?}: {}", text(&o));
@@ -549,9 +580,11 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
         let systems = sum["stats"]["systems"].as_array().unwrap();
-        for s in systems {
-            assert!(s["births"].as_u64().unwrap() > 0, "{args:?}: {s}");
-        }
+        // (Sub-systems are born by events only: the first system has an emitter.)
+        assert!(
+            systems[0]["births"].as_u64().unwrap() > 0,
+            "{args:?}: {systems:?}"
+        );
         assert!(out.join("frame_0003.png").exists());
     }
     let bad = dir.path().join("bad.toml");
@@ -597,4 +630,147 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
             "{args:?}: {t}"
         );
     }
+}
+
+/// A system with no emitter births, to be spawned by events.
+fn child(name: &str, capacity: u32, life: f32) -> SystemSpec {
+    let mut s = ballistic(Integrator::Euler, capacity);
+    s.name = name.into();
+    s.particle.velocity = Vary {
+        mean: [0.0, 1.5, 0.0],
+        variance: [0.0, 0.3, 0.0],
+    };
+    s.particle.spread = 40.0;
+    s.particle.life = Vary {
+        mean: life,
+        variance: 0.5 * life,
+    };
+    s
+}
+
+#[test]
+fn type_changes_conserve_the_budget() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let ground = ColliderSpec::ground(0.0, 0.3, 0.2);
+    let mut rain = ballistic(Integrator::Euler, 2048);
+    rain.name = "rain".into();
+    rain.emitter = emitter(
+        Shape::Box,
+        [0.0, 1.2, 0.0],
+        0.5,
+        Vary {
+            mean: 40.0,
+            variance: 10.0,
+        },
+    );
+    rain.particle.velocity = Vary {
+        mean: [0.0, -2.0, 0.0],
+        variance: [0.2, 0.2, 0.2],
+    };
+    rain.collider = vec![ground.clone()];
+    // On the ground a drop becomes a splash (one child, the parent dies).
+    rain.event = vec![EventSpec {
+        on: EventKind::Collision,
+        spawn: "splash".into(),
+        count: Vary {
+            mean: 1.0,
+            variance: 0.0,
+        },
+        inherit: 0.2,
+        keep_parent: false,
+        along_normal: true,
+    }];
+    // Splashes (too few slots for every drop: refused children are counted) burst into
+    // mist at death: mean 2 children, variance 1.
+    let mut splash = child("splash", 96, 0.3);
+    splash.collider = vec![ground];
+    splash.event = vec![EventSpec {
+        on: EventKind::Death,
+        spawn: "mist".into(),
+        count: Vary {
+            mean: 2.0,
+            variance: 1.0,
+        },
+        inherit: 0.0,
+        keep_parent: false,
+        along_normal: true,
+    }];
+    let mist = child("mist", 8192, 0.2);
+    for s in [&mut splash, &mut rain] {
+        s.validate().unwrap();
+    }
+    let specs = [rain, splash, mist];
+    let mut systems: Vec<ParticleSystem> = specs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| ParticleSystem::new(&ctx, &passes, s, i as u32, 11).unwrap())
+        .collect();
+    let dt = 1.0 / 60.0;
+    for chunk in 0..10 {
+        ctx.one_shot(|cmd| {
+            for k in chunk * 12..chunk * 12 + 12 {
+                let f = frame(&cam, k, dt);
+                fluidform::psys::run::record_simulation(
+                    &ctx,
+                    cmd,
+                    &mut Labels,
+                    &passes,
+                    &mut systems,
+                    &f,
+                )
+                .unwrap();
+            }
+        })
+        .unwrap();
+        let d: Vec<_> = systems.iter().map(|s| s.read(&ctx).unwrap()).collect();
+        for (s, d) in systems.iter().zip(&d) {
+            partitions(&d.alive, &d.dead, s.capacity)
+                .unwrap_or_else(|e| panic!("{}: {e}", s.spec.name));
+            let c = d.counters;
+            assert_eq!(
+                (c.births + c.spawned) as u64 - c.deaths(),
+                d.alive.len() as u64,
+                "{}: births + children - deaths = alive ({c:?})",
+                s.spec.name
+            );
+            assert_eq!(c.events_dropped, 0, "{}", s.spec.name);
+        }
+        let (r, sp, m) = (d[0].counters, d[1].counters, d[2].counters);
+        // Every drop that left the rain arrived as a splash or was refused for want of a
+        // slot: the type change creates and loses nothing.
+        assert_eq!(
+            r.died_life + r.died_collision,
+            0,
+            "drops die only by changing"
+        );
+        assert_eq!(r.changed, sp.spawned + sp.spawn_refused);
+        assert_eq!(sp.births + m.births, 0, "children come from events alone");
+        // Each splash that died of age spawned 0..=3 mist children.
+        let asked = (m.spawned + m.spawn_refused) as u64;
+        assert!(
+            asked <= 3 * sp.died_life as u64,
+            "{asked} > 3 x {}",
+            sp.died_life
+        );
+        // Children are born where their parent hit the ground: never below it.
+        for &slot in &d[1].alive {
+            assert!(d[1].pos[slot as usize][1] >= -1e-5);
+        }
+    }
+    let sp = systems[1].read_counters(&ctx).unwrap();
+    let m = systems[2].read_counters(&ctx).unwrap();
+    assert!(sp.spawned > 100 && sp.spawn_refused > 0, "{sp:?}");
+    let per = (m.spawned + m.spawn_refused) as f64 / sp.died_life as f64;
+    assert!(
+        (per - 2.0).abs() < 0.25,
+        "mist children per splash death {per:.3}, mean 2"
+    );
+    for s in &mut systems {
+        s.destroy(&ctx);
+    }
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
 }

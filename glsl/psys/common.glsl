@@ -23,6 +23,12 @@
 #define I_EULER 0
 #define I_VERLET 1
 #define I_CLOSED 2
+// Event flags (counts2.z) and kinds (Event.p.w).
+#define EV_COLLISION 1u
+#define EV_KEEP_PARENT 2u
+#define EV_DEATH 4u
+#define KIND_COLLISION 1u
+#define KIND_DEATH 2u
 // Slot of a free or culled entry in an order list.
 #define NO_SLOT 0xFFFFFFFFu
 
@@ -53,7 +59,7 @@ struct SystemParams {
     vec4 death;         // x damping per second, y max distance from the source (0: off),
                         // z die out of view (1), w type id
     uvec4 counts;       // x forces, y colliders, z size keys, w colour keys
-    uvec4 counts2;      // x opacity keys, y integrator, z -, w -
+    uvec4 counts2;      // x opacity keys, y integrator, z event flags (EV_*), w -
     vec4 size_keys[MAX_KEYS];     // x life fraction, y factor
     vec4 color_keys[MAX_KEYS];    // rgb factor, w life fraction
     vec4 opacity_keys[MAX_KEYS];  // x life fraction, y factor
@@ -75,7 +81,17 @@ struct Counters {
     uint died_distance;
     uint died_collision;
     uint overwritten;   // closed form: live particles overwritten by the ring (the budget)
-    uint pad1;
+    uint changed;       // parents that died by a collision event (changed type)
+    uint spawned;       // births from events
+    uint spawn_refused; // children refused: no free slot
+    uint events_dropped;  // events lost: the event list was full
+    uint pad;
+};
+// An event record: xyz where, w kind | xyz the parent's velocity | xyz contact normal.
+struct Event {
+    vec4 p;
+    vec4 v;
+    vec4 n;
 };
 
 // PCG hash (Jarzynski & Olano 2020): a uniform u32 per input.

@@ -1,5 +1,6 @@
 #version 450
-// Births: one invocation per new particle. Euler and Verlet pop a free slot from the dead
+// Births: one invocation per new particle (mode 0), or per event of a parent system
+// (mode = the event kind: its children). Euler and Verlet pop a free slot from the dead
 // stack (none left: the birth is refused and counted) and append it to the alive list the
 // update reads; closed form writes the ring's next slots (a live particle there is
 // overwritten and counted). Every attribute is mean + rand * variance, rand in [-1, 1).
@@ -34,51 +35,90 @@ vec3 shape_point(inout uint s) {
     return vec3(0.0);
 }
 
-void main() {
-    uint i = global_id();
-    if (i >= pc.births) return;
-    uint slot;
-    uint integrator = sp.counts2.y;
-    if (integrator == I_CLOSED) {
-        slot = (pc.head + i) % pc.capacity;
-        vec4 old = pos[slot];
-        if (old.w >= 0.0 && pc.source.w - old.w < vel[slot].w) atomicAdd(c.overwritten, 1u);
-    } else {
-        int d = atomicAdd(c.dead_count, -1) - 1;
-        if (d < 0) {  // no free slot: the budget is spent
-            atomicAdd(c.dead_count, 1);
-            atomicAdd(c.refused, 1u);
-            return;
-        }
-        slot = dead[d];
-    }
-    uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
-    vec3 p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+// An orthonormal basis (t, n, b) about unit n.
+void basis(vec3 n, out vec3 t, out vec3 b) {
+    t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
+    b = cross(n, t);
+}
+
+// The particle's own velocity: mean + rand x variance, its direction spread in a cone.
+vec3 own_velocity(inout uint s) {
     vec3 v = sp.vel_mean.xyz + srnd3(s) * sp.vel_var.xyz;
     float spread = sp.vel_mean.w;  // cone half-angle (rad) about the mean direction
     if (spread > 0.0 && dot(sp.vel_mean.xyz, sp.vel_mean.xyz) > 0.0) {
-        vec3 a = normalize(sp.vel_mean.xyz);
-        vec3 t = normalize(abs(a.y) < 0.9 ? cross(a, vec3(0, 1, 0)) : cross(a, vec3(1, 0, 0)));
-        vec3 b = cross(a, t);
+        vec3 a = normalize(sp.vel_mean.xyz), t, b;
+        basis(a, t, b);
         float z = mix(cos(spread), 1.0, rnd(s)), phi = 6.2831853 * rnd(s);  // uniform on the cap
         float r = sqrt(max(1.0 - z * z, 0.0));
         v = length(v) * (z * a + r * (cos(phi) * t + sin(phi) * b));
     }
+    return v;
+}
+
+// A stateful birth at p moving with v: pop a free slot (none: refused, counted) and
+// append it to the alive list the next update reads (or, after it, the one drawn).
+void born(vec3 p, vec3 v, inout uint s, bool spawned) {
+    int d = atomicAdd(c.dead_count, -1) - 1;
+    if (d < 0) {  // no free slot: the budget is spent
+        atomicAdd(c.dead_count, 1);
+        if (spawned) atomicAdd(c.spawn_refused, 1u);
+        else atomicAdd(c.refused, 1u);
+        return;
+    }
+    uint slot = dead[d];
     vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
     float size = max(sl.x, 0.0), life = max(sl.y, 1e-4);
-    vec4 col = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
-    if (integrator == I_CLOSED) {
-        pos[slot] = vec4(p, pc.source.w);  // birth time
-        vel[slot] = vec4(v, life);
-    } else {
-        pos[slot] = vec4(p, 0.0);
-        // Verlet keeps the previous position: a Taylor step back, exact for gravity.
-        vec3 back = p - v * pc.dt + 0.5 * sp.gravity.xyz * pc.dt * pc.dt;
-        vel[slot] = vec4(integrator == I_VERLET ? back : v, life);
-        uint a = atomicAdd(c.alive[pc.cur], 1u);
-        alive[pc.cur * pc.capacity + a] = slot;
-    }
+    pos[slot] = vec4(p, 0.0);
+    // Verlet keeps the previous position: a Taylor step back, exact for gravity.
+    vec3 back = p - v * pc.dt + 0.5 * sp.gravity.xyz * pc.dt * pc.dt;
+    vel[slot] = vec4(sp.counts2.y == I_VERLET ? back : v, life);
     prev[slot] = vec4(p, size);
-    color[slot] = col;
+    color[slot] = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
+    uint a = atomicAdd(c.alive[pc.cur], 1u);
+    alive[pc.cur * pc.capacity + a] = slot;
+    if (spawned) atomicAdd(c.spawned, 1u);
+    else atomicAdd(c.births, 1u);
+}
+
+// Children of one event of the parent system (its list is bound as `ev`).
+void spawn(uint i) {
+    if (i >= min(ev_count, uint(ev.length()))) return;
+    Event e = ev[i];
+    if (uint(e.p.w) != pc.mode) return;
+    uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
+    uint n = uint(max(pc.source.x + srnd(s) * pc.source.y + rnd(s), 0.0));
+    vec3 normal = e.n.xyz, t, b;
+    bool along = pc.births == 1u && dot(normal, normal) > 0.5;
+    if (along) basis(normal, t, b);
+    for (uint k = 0u; k < n; k++) {
+        vec3 v = own_velocity(s);
+        if (along) v = v.x * t + v.y * normal + v.z * b;  // +y onto the normal
+        vec3 p = e.p.xyz + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+        born(p, v + pc.source.z * e.v.xyz, s, true);
+    }
+}
+
+void main() {
+    uint i = global_id();
+    if (pc.mode != 0u) {
+        spawn(i);
+        return;
+    }
+    if (i >= pc.births) return;
+    uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
+    vec3 p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+    vec3 v = own_velocity(s);
+    if (sp.counts2.y != I_CLOSED) {
+        born(p, v, s, false);
+        return;
+    }
+    uint slot = (pc.head + i) % pc.capacity;
+    vec4 old = pos[slot];
+    if (old.w >= 0.0 && pc.source.w - old.w < vel[slot].w) atomicAdd(c.overwritten, 1u);
+    vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
+    pos[slot] = vec4(p, pc.source.w);  // birth time
+    vel[slot] = vec4(v, max(sl.y, 1e-4));
+    prev[slot] = vec4(p, max(sl.x, 0.0));
+    color[slot] = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
     atomicAdd(c.births, 1u);
 }

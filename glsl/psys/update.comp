@@ -1,6 +1,6 @@
 #version 450
 // The state-preserving step (Euler or Verlet) over the alive list: forces, integration,
-// collisions and death. A survivor is appended to the other alive list, a dead particle
+// collisions, events and death. A survivor is appended to the other alive list, a dead particle
 // pushed on the dead stack: the lists stay compact with no CPU read-back.
 #include "common/index.glsl"
 #include "state.glsl"
@@ -26,6 +26,13 @@ uint reserve(uint which, bool take) {
     if (!take) return 0u;
     return which == 2u ? uint(atomicAdd(c.dead_count, 1)) : atomicAdd(c.alive[which], 1u);
 #endif
+}
+
+// Record an event for the spawn pass (a full list drops it, counted).
+void record_event(vec3 p, vec3 v, vec3 n, uint kind) {
+    uint k = atomicAdd(ev_count, 1u);
+    if (k < uint(ev.length())) ev[k] = Event(vec4(p, float(kind)), vec4(v, 0.0), vec4(n, 0.0));
+    else atomicAdd(c.events_dropped, 1u);
 }
 
 // Acceleration at p moving with v, at time t.
@@ -122,11 +129,14 @@ void main() {
         v *= keep;
         p += v * dt;
     }
-    bool killed = false;
+    bool killed = false, hit = false;
+    vec3 hit_n = vec3(0.0);
     for (uint k = 0u; k < sp.counts.y; k++) {
         Collider col = sp.colliders[k];
         vec3 n;
         if (contact(col, p, n)) {
+            hit = true;
+            hit_n = n;
             if (col.c.w > 0.5) killed = true;
             // Split the velocity: the normal part bounces with restitution e, the
             // tangential part loses the friction fraction.
@@ -139,14 +149,18 @@ void main() {
     }
     float age = P.w + dt;
     prev[slot].xyz = P.xyz;
-    uint cause = 0u;
-    if (killed) cause = 4u;
+    uint cause = 0u, events = sp.counts2.z;
+    bool hit_event = hit && (events & EV_COLLISION) != 0u;
+    if (hit_event) record_event(p, v, hit_n, KIND_COLLISION);
+    if (hit_event && (events & EV_KEEP_PARENT) == 0u) cause = 5u;  // its type changed
+    else if (killed) cause = 4u;
     else if (age >= V.w) cause = 1u;
     else if (sp.death.y > 0.0 && distance(p, pc.source.xyz) > sp.death.y) cause = 3u;
     else if (sp.death.z > 0.5) {
         vec4 clip = pc.view_proj * vec4(p, 1.0);
         if (clip.w <= 0.0 || any(greaterThan(abs(clip.xy), vec2(clip.w * 1.1)))) cause = 2u;
     }
+    if (cause == 1u && (events & EV_DEATH) != 0u) record_event(p, v, vec3(0.0), KIND_DEATH);
     // Every invocation reaches both reservations (subgroup operations).
     uint d = reserve(2u, cause != 0u);
     uint a = reserve(1u - pc.cur, cause == 0u);
@@ -156,7 +170,8 @@ void main() {
         if (cause == 1u) atomicAdd(c.died_life, 1u);
         else if (cause == 2u) atomicAdd(c.died_view, 1u);
         else if (cause == 3u) atomicAdd(c.died_distance, 1u);
-        else atomicAdd(c.died_collision, 1u);
+        else if (cause == 4u) atomicAdd(c.died_collision, 1u);
+        else atomicAdd(c.changed, 1u);
         dead[d] = slot;
         return;
     }

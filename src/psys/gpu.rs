@@ -1,7 +1,7 @@
 //! The GPU side of a particle system: the parameter block and counters (mirrored in
 //! glsl/psys/common.glsl), the passes' interfaces and pipelines (size-independent).
 use super::spec::{
-    ColliderKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES, MAX_KEYS,
+    ColliderKind, EventKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES, MAX_KEYS,
 };
 use crate::config::{Integrator, SpriteMode};
 use crate::error::Result;
@@ -60,20 +60,30 @@ pub struct Counters {
     pub died_distance: u32,
     pub died_collision: u32,
     pub overwritten: u32,
-    pub pad1: u32,
+    /// Parents that died by a collision event (their type changed).
+    pub changed: u32,
+    /// Births from other systems' events.
+    pub spawned: u32,
+    /// Children refused: no free slot.
+    pub spawn_refused: u32,
+    /// Events lost: the event list was full.
+    pub events_dropped: u32,
+    pub pad: u32,
 }
-const _: () = assert!(std::mem::size_of::<Counters>() == 80);
+const _: () = assert!(std::mem::size_of::<Counters>() == 96);
 
 impl Counters {
     pub const UPDATE_ARGS: u64 = std::mem::offset_of!(Counters, update_args) as u64;
     pub const DRAW_ARGS: u64 = std::mem::offset_of!(Counters, draw_args) as u64;
 
+    /// Particles that left the system: every death and type change.
     pub fn deaths(&self) -> u64 {
         [
             self.died_life,
             self.died_view,
             self.died_distance,
             self.died_collision,
+            self.changed,
         ]
         .iter()
         .map(|&d| d as u64)
@@ -131,7 +141,15 @@ impl SystemParams {
             Integrator::Verlet => 1,
             Integrator::Closed => 2,
         };
-        p.counts2 = [o.opacity.len() as u32, integrator, 0, 0];
+        let mut events = 0;
+        for e in &spec.event {
+            events |= match (e.on, e.keep_parent) {
+                (EventKind::Collision, false) => EV_COLLISION,
+                (EventKind::Collision, true) => EV_COLLISION | EV_KEEP_PARENT,
+                (EventKind::Death, _) => EV_DEATH,
+            };
+        }
+        p.counts2 = [o.opacity.len() as u32, integrator, events, 0];
         for (k, s) in o.size.iter().enumerate() {
             p.size_keys[k] = [s[0], s[1], 0.0, 0.0];
         }
@@ -165,6 +183,18 @@ impl SystemParams {
         p
     }
 }
+
+/// Event flags of `SystemParams::counts2.z` (glsl/psys/common.glsl).
+pub const EV_COLLISION: u32 = 1;
+pub const EV_KEEP_PARENT: u32 = 2;
+pub const EV_DEATH: u32 = 4;
+
+/// The header of an event list (`Events` in glsl/psys/state.glsl): the count, then the
+/// spawn's indirect dispatch; the records follow.
+pub const EVENTS_HEADER: u64 = 16;
+pub const EVENTS_ARGS: u64 = 4;
+/// Bytes of one event record: position (w kind), velocity, contact normal.
+pub const EVENT_BYTES: u64 = 48;
 
 /// Per-frame push constants of the compute passes (`Push` in glsl/psys/state.glsl).
 #[repr(C)]
@@ -204,7 +234,7 @@ crate::gpu_interface! {
     /// glsl/psys/emit.comp, args.comp, update.comp, keys.comp (glsl/psys/state.glsl)
     pub PsysIo / PsysBufs: "PSYS", push StepPush {
         params = 0, counters = 1, dead = 2, alive = 3, pos = 4, vel = 5, prev = 6, color = 7,
-        keys = 8, vals = 9,
+        keys = 8, vals = 9, events = 10,
     }
 }
 
@@ -250,6 +280,7 @@ pub struct Passes {
 impl Passes {
     pub const EMIT: &'static str = "emit";
     pub const UPDATE: &'static str = "update";
+    pub const EVENTS: &'static str = "events";
     pub const SORT: &'static str = "sort";
     pub const DRAW: &'static str = "draw";
 

@@ -3,7 +3,7 @@ use super::gpu::Passes;
 use super::scenes::ParticleScene;
 use super::system::{FrameInfo, ParticleSystem};
 use crate::config::{Group, Integrator, SortAlgo, SpriteMode};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
 use crate::render::Camera;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
@@ -33,6 +33,13 @@ pub struct SystemStats {
     pub died_view: u64,
     pub died_distance: u64,
     pub died_collision: u64,
+    /// Parents that died by a collision event (changed type).
+    pub changed: u64,
+    /// Births from other systems' events, and those refused (no free slot).
+    pub spawned: u64,
+    pub spawn_refused: u64,
+    /// Events lost: the event list was full.
+    pub events_dropped: u64,
     /// Alive after the last frame (closed form: born within a life, not overwritten).
     pub alive: u64,
 }
@@ -68,6 +75,10 @@ impl SystemStats {
             died_view: c.died_view as u64,
             died_distance: c.died_distance as u64,
             died_collision: c.died_collision as u64,
+            changed: c.changed as u64,
+            spawned: c.spawned as u64,
+            spawn_refused: c.spawn_refused as u64,
+            events_dropped: c.events_dropped as u64,
             alive,
         })
     }
@@ -172,6 +183,7 @@ pub fn record_simulation(
         s.record_step(ctx, cmd, prof, passes, f);
     }
     ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    record_events(ctx, cmd, prof, passes, systems, f)?;
     for s in systems.iter_mut() {
         s.record_sort(ctx, cmd, prof, passes, f)?;
     }
@@ -180,6 +192,61 @@ pub fn record_simulation(
         sync::COMPUTE_WRITE,
         sync::GRAPHICS_READ | sync::INDIRECT_READ,
     );
+    Ok(())
+}
+
+/// Record the children of every event the steps recorded: each parent's spawn dispatch,
+/// then the children born into their systems' drawn lists, then those draws' counts.
+fn record_events(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    prof: &mut dyn Scopes,
+    passes: &Passes,
+    systems: &[ParticleSystem],
+    f: &FrameInfo,
+) -> Result<()> {
+    let mut links = Vec::new();
+    for (i, s) in systems.iter().enumerate() {
+        for e in &s.spec.event {
+            let j = systems
+                .iter()
+                .position(|t| t.spec.name == e.spawn)
+                .ok_or_else(|| {
+                    Error::Param(format!(
+                        "system '{}' spawns '{}', which is not among the scene's systems",
+                        s.spec.name, e.spawn
+                    ))
+                })?;
+            links.push((i, j, e));
+        }
+    }
+    if links.is_empty() {
+        return Ok(());
+    }
+    prof.begin(ctx, cmd, Passes::EVENTS);
+    for (i, s) in systems.iter().enumerate() {
+        if links.iter().any(|l| l.0 == i) {
+            s.record_event_args(ctx, cmd, passes, f);
+        }
+    }
+    ctx.barrier(
+        cmd,
+        sync::COMPUTE_WRITE,
+        sync::COMPUTE_READ | sync::INDIRECT_READ,
+    );
+    for &(i, j, e) in &links {
+        systems[j].record_spawn(ctx, cmd, passes, f, &systems[i], e);
+        // Spawns into one system pop its dead stack and append to its list in turn.
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    }
+    let mut targets: Vec<usize> = links.iter().map(|l| l.1).collect();
+    targets.sort_unstable();
+    targets.dedup();
+    for j in targets {
+        systems[j].record_draw_count(ctx, cmd, passes, f);
+    }
+    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    prof.end(ctx, cmd);
     Ok(())
 }
 

@@ -68,6 +68,7 @@ pub fn base_system(
         force: vec![],
         collider: vec![],
         death: DeathSpec::default(),
+        event: vec![],
     }
 }
 
@@ -244,6 +245,20 @@ impl ParticleScene {
                 )));
             }
             s.validate()?;
+            for ev in &s.event {
+                let Some(t) = self.system.iter().find(|t| t.name == ev.spawn) else {
+                    return Err(Error::Param(format!(
+                        "scene {}: system '{}' spawns '{}', which is not a [[system]] of it",
+                        self.name, s.name, ev.spawn
+                    )));
+                };
+                if t.integrator() == Integrator::Closed {
+                    return Err(Error::Unsupported(format!(
+                        "scene {}: '{}' is spawned by events, so it needs state: --integrator euler or verlet, not closed",
+                        self.name, t.name
+                    )));
+                }
+            }
         }
         Ok(())
     }

@@ -208,6 +208,51 @@ impl ColliderSpec {
     }
 }
 
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum EventKind {
+    /// A contact with any collider.
+    Collision,
+    /// The end of the particle's life.
+    Death,
+}
+
+/// An event: on a collision or at death a particle spawns `count` particles of the
+/// system `spawn` where it is (a sub-system). On a collision the parent dies unless
+/// `keep_parent`, so `count = 1` changes its type (rain -> splash) and keeps the budget.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EventSpec {
+    pub on: EventKind,
+    /// The system the children belong to (its particle attributes, forces, draw).
+    pub spawn: String,
+    /// Children per event: mean + rand x variance, rounded stochastically.
+    #[serde(default = "one_child")]
+    pub count: Scalar,
+    /// Fraction of the parent's velocity (after the bounce) added to the children's own.
+    #[serde(default)]
+    pub inherit: f32,
+    /// Collision: the parent lives on.
+    #[serde(default)]
+    pub keep_parent: bool,
+    /// Collision: the children's own velocity turned from +y onto the contact normal.
+    #[serde(default = "yes")]
+    pub along_normal: bool,
+}
+
+fn one_child() -> Scalar {
+    Vary {
+        mean: 1.0,
+        variance: 0.0,
+    }
+}
+fn yes() -> bool {
+    true
+}
+
+/// Most children one event spawns.
+pub const MAX_CHILDREN: f32 = 64.0;
+
 /// Death besides the end of life (always on) and the budget (the capacity).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -258,6 +303,9 @@ pub struct SystemSpec {
     pub collider: Vec<ColliderSpec>,
     #[serde(default)]
     pub death: DeathSpec,
+    /// Sub-systems spawned on a collision or at death (at most one event of each kind).
+    #[serde(default)]
+    pub event: Vec<EventSpec>,
 }
 
 fn default_point() -> f32 {
@@ -415,6 +463,28 @@ impl SystemSpec {
                 return bad("death.max_distance must be positive".into());
             }
         }
+        for (k, ev) in self.event.iter().enumerate() {
+            let c = ev.count;
+            if !(c.mean >= 0.0 && c.variance >= 0.0 && c.mean + c.variance <= MAX_CHILDREN) {
+                return bad(format!(
+                    "event on {:?}: count mean and variance >= 0, mean + variance <= {MAX_CHILDREN}",
+                    ev.on
+                )
+                .to_lowercase());
+            }
+            if !ev.inherit.is_finite() {
+                return bad("event: inherit must be finite".into());
+            }
+            if self.event[..k].iter().any(|o| o.on == ev.on) {
+                return bad(format!("two events on {:?}", ev.on).to_lowercase());
+            }
+            if ev.on == EventKind::Collision && self.collider.is_empty() {
+                return bad("an event on collision needs a [[system.collider]]".into());
+            }
+            if ev.on == EventKind::Death && ev.keep_parent {
+                return bad("keep_parent applies to collision events only".into());
+            }
+        }
         if self.integrator() == Integrator::Closed {
             let stateful = |what: &str| {
                 Err(Error::Unsupported(format!(
@@ -430,6 +500,9 @@ impl SystemSpec {
             }
             if self.wind[3] != 0.0 || self.damping != 0.0 {
                 return stateful("wind drag or damping");
+            }
+            if !self.event.is_empty() {
+                return stateful("an event (collision or death)");
             }
             if self.death.max_distance.is_some() || self.death.out_of_view {
                 return stateful("death by distance or view (a state change)");

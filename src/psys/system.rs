@@ -3,8 +3,10 @@
 //! the alive list), sort by view depth, draw (indirect). The CPU draws only the number of
 //! births per frame; nothing is read back per frame.
 use super::gpu::{
-    vertices, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams,
+    vertices, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams, EVENTS_ARGS,
+    EVENTS_HEADER, EVENT_BYTES,
 };
+use super::spec::{EventKind, EventSpec};
 use super::spec::{Shape, SystemSpec};
 use super::sprite;
 use crate::config::{Integrator, SortAlgo, SpriteMode};
@@ -58,6 +60,8 @@ pub struct ParticleSystem {
     color: Buffer,
     keys: Buffer,
     vals: Buffer,
+    /// Events the update records (header + records; one record when it has none).
+    events: Buffer,
     counting: Option<DepthSort>,
     sprite: Buffer,
     sprite_side: u32,
@@ -109,6 +113,7 @@ impl ParticleSystem {
         let bytes = cap * 16;
         let need = bytes * 4
             + cap * 4 * 5
+            + cap * spec.event.len() as u64 * EVENT_BYTES
             + if spec.sort() == SortAlgo::Counting {
                 cap * 12
             } else {
@@ -142,6 +147,14 @@ impl ParticleSystem {
         let vel = buf("velocities", bytes)?;
         let prev = buf("previous positions", bytes)?;
         let color = buf("colours", bytes)?;
+        let records = (cap * spec.event.len() as u64).max(1);
+        let events = Guard::new(
+            ctx,
+            ctx.indirect_buffer(
+                &format!("{name} events"),
+                EVENTS_HEADER + records * EVENT_BYTES,
+            )?,
+        );
         let keys = buf("sort keys", cap * 4)?;
         let vals = buf("sort values", cap * 4)?;
         let counting = Guard::new(
@@ -188,6 +201,7 @@ impl ParticleSystem {
             color: color.take(),
             keys: keys.take(),
             vals: vals.take(),
+            events: events.take(),
             counting: counting.take(),
             sprite: sprite_buf.take(),
             sprite_side: side,
@@ -285,6 +299,7 @@ impl ParticleSystem {
             color: &self.color,
             keys: &self.keys,
             vals: &self.vals,
+            events: &self.events,
         }
     }
 
@@ -369,6 +384,69 @@ impl ParticleSystem {
         passes.args.dispatch_groups(ctx, cmd, &bufs, &after, 1);
         scopes.end(ctx, cmd);
         self.drawn = 1 - self.drawn;
+    }
+
+    /// Record the spawn's indirect dispatch over the events this frame's step recorded
+    /// (after the step's writes are visible).
+    pub fn record_event_args(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let push = StepPush {
+            mode: 3,
+            ..self.push(f, f.time, 0)
+        };
+        passes
+            .args
+            .dispatch_groups(ctx, cmd, &self.bufs(), &push, 1);
+    }
+
+    /// Record the children of `parent`'s events of `event`'s kind, born into this system's
+    /// list that is drawn (after `record_event_args` of the parent, visible to indirect
+    /// reads). `record_draw_count` afterwards counts them into the draw.
+    pub fn record_spawn(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+        parent: &ParticleSystem,
+        event: &EventSpec,
+    ) {
+        let kind = match event.on {
+            EventKind::Collision => 1,
+            EventKind::Death => 2,
+        };
+        let mut push = self.push(f, f.time, event.along_normal as u32);
+        push.source = [event.count.mean, event.count.variance, event.inherit, 0.0];
+        push.mode = kind;
+        push.seed ^= (crate::psys::hash64(parent.seed ^ kind as u64) & 0xffff_ffff) as u32;
+        let bufs = PsysBufs {
+            events: &parent.events,
+            ..self.bufs()
+        };
+        passes
+            .emit
+            .dispatch_indirect(ctx, cmd, &bufs, &push, &parent.events, EVENTS_ARGS);
+    }
+
+    /// Record the draw's vertex count from the list that is drawn (after spawns into it).
+    pub fn record_draw_count(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let mut push = self.push(f, f.time, 0);
+        push.cur = 1 - self.drawn;
+        push.mode = 1;
+        passes
+            .args
+            .dispatch_groups(ctx, cmd, &self.bufs(), &push, 1);
     }
 
     /// Record the depth sort of what is drawn (nothing with --sort none). The step's
@@ -530,6 +608,7 @@ impl ParticleSystem {
             &mut self.color,
             &mut self.keys,
             &mut self.vals,
+            &mut self.events,
             &mut self.sprite,
         ] {
             ctx.destroy_buffer(b);
