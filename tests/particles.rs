@@ -523,6 +523,12 @@ fn bad_systems_are_clear_errors() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("force"), "{e}");
+    let flock = ParticleScene::built_in("flock").unwrap();
+    let e = flock
+        .with_switches(Some(Integrator::Closed), None, None, None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("closed"), "{e}");
 }
 
 #[test]
@@ -553,6 +559,14 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
         ],
         vec!["--scene", file.as_str(), "--draw", "points"],
         vec!["--scene", fireworks.as_str(), "--frames", "90"],
+        vec![
+            "--scene",
+            "flock",
+            "--particles",
+            "512",
+            "--integrator",
+            "verlet",
+        ],
     ] {
         let out = dir.path().join("run");
         let frames = if args.contains(&"--frames") {
@@ -770,6 +784,142 @@ fn type_changes_conserve_the_budget() {
     for s in &mut systems {
         s.destroy(&ctx);
     }
+    let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+/// Boids' steering on the CPU, brute force over the alive slots (boids.comp's rules).
+fn cpu_steer(spec: &SystemSpec, d: &fluidform::psys::system::StateDump, slot: u32) -> (Vec3, u32) {
+    let b = spec.boids.as_ref().unwrap();
+    let p = Vec3::from_slice(&d.pos[slot as usize][..3]);
+    let v = Vec3::from_slice(&d.vel[slot as usize][..3]);
+    let (mut sep, mut mv, mut mp, mut n) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0u32);
+    for &o in &d.alive {
+        let q = Vec3::from_slice(&d.pos[o as usize][..3]);
+        let dd = p - q;
+        let d2 = dd.length_squared();
+        if o == slot || d2 > b.radius * b.radius {
+            continue;
+        }
+        n += 1;
+        mv += Vec3::from_slice(&d.vel[o as usize][..3]);
+        mp += q;
+        if d2 < b.separation_radius * b.separation_radius {
+            sep += dd / d2.max(1e-8);
+        }
+    }
+    let mut a = b.separation * sep;
+    if n > 0 {
+        a += b.alignment * (mv / n as f32 - v) + b.cohesion * (mp / n as f32 - p);
+    }
+    // Avoidance of the room (a container) and the pillar (a capsule) ahead.
+    let ahead = p + v * b.look_ahead;
+    for c in &spec.collider {
+        let n = match c.kind {
+            ColliderKind::Box => {
+                let q = ahead.clamp(Vec3::from(c.min), Vec3::from(c.max));
+                (q != ahead).then(|| (q - ahead).normalize())
+            }
+            ColliderKind::Capsule => {
+                let (a0, a1) = (Vec3::from(c.a), Vec3::from(c.b));
+                let h = ((ahead - a0).dot(a1 - a0) / (a1 - a0).length_squared()).clamp(0.0, 1.0);
+                let d = ahead - (a0 + h * (a1 - a0));
+                (d.length() < c.radius).then(|| d.normalize())
+            }
+            _ => unreachable!("the flock has a room and a pillar"),
+        };
+        if let Some(n) = n {
+            a += b.avoidance * n;
+        }
+    }
+    if a.length() > b.max_steer {
+        a *= b.max_steer / a.length();
+    }
+    (a, n)
+}
+
+#[test]
+fn boids_keep_their_count_and_the_speed_limit() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let scene = ParticleScene::built_in("flock")
+        .unwrap()
+        .with_switches(None, None, None, Some(1024))
+        .unwrap();
+    let spec = scene.system[0].clone();
+    let b = spec.boids.clone().unwrap();
+    let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 3).unwrap();
+    let dt = scene.dt;
+    let polarisation = |d: &fluidform::psys::system::StateDump| {
+        let vs: Vec<Vec3> = d
+            .alive
+            .iter()
+            .map(|&i| Vec3::from_slice(&d.vel[i as usize][..3]))
+            .collect();
+        let sum: Vec3 = vs.iter().sum();
+        sum.length() / vs.iter().map(|v| v.length()).sum::<f32>()
+    };
+    let mut first = None;
+    for chunk in 0..8u64 {
+        ctx.one_shot(|cmd| {
+            for k in chunk * 30..chunk * 30 + 30 {
+                s.record_step(&ctx, cmd, &mut Labels, &passes, &frame(&cam, k, dt));
+            }
+        })
+        .unwrap();
+        let d = s.read(&ctx).unwrap();
+        assert_eq!(d.alive.len(), 1024, "the flock keeps its count");
+        assert_eq!(d.counters.deaths(), 0);
+        partitions(&d.alive, &d.dead, 1024).unwrap();
+        for &i in &d.alive {
+            let (p, v) = (d.pos[i as usize], Vec3::from_slice(&d.vel[i as usize][..3]));
+            let speed = v.length();
+            assert!(
+                speed <= b.max_speed * 1.0001 && speed >= b.min_speed * 0.9999,
+                "speed {speed} outside [{}, {}]",
+                b.min_speed,
+                b.max_speed
+            );
+            for k in 0..3 {
+                assert!(
+                    p[k] >= b.bounds[0][k] - 1e-4 && p[k] <= b.bounds[1][k] + 1e-4,
+                    "{p:?} left the room"
+                );
+            }
+        }
+        let pol = polarisation(&d);
+        eprintln!("frame {}: polarisation {pol:.3}", chunk * 30 + 29);
+        first.get_or_insert(pol);
+    }
+    // Alignment orders the flock: velocities started random (polarisation ~0).
+    let last = polarisation(&s.read(&ctx).unwrap());
+    assert!(
+        last > first.unwrap() + 0.15,
+        "polarisation {:.3} -> {last:.3}: the boids do not align",
+        first.unwrap()
+    );
+    // The GPU's steering against the CPU's from the same state.
+    let d = s.read(&ctx).unwrap();
+    ctx.one_shot(|cmd| s.record_step(&ctx, cmd, &mut Labels, &passes, &frame(&cam, 240, dt)))
+        .unwrap();
+    let steer = s.read_steer(&ctx).unwrap();
+    let mut worst = 0.0f32;
+    let mut count_mismatch = 0;
+    for &i in &d.alive {
+        let (a, n) = cpu_steer(&spec, &d, i);
+        let g = steer[i as usize];
+        count_mismatch += (g[3] as u32 != n) as u32;
+        worst = worst.max((Vec3::from_slice(&g[..3]) - a).length() / (1.0 + a.length()));
+    }
+    // Neighbours exactly at the radius may round either way.
+    assert!(
+        count_mismatch <= 2,
+        "{count_mismatch} boids saw other flockmates"
+    );
+    assert!(worst < 2e-3, "steering differs from the CPU's by {worst}");
+    s.destroy(&ctx);
     let mut passes = passes;
     passes.destroy(&ctx);
     finish(&ctx);

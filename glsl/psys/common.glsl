@@ -65,6 +65,12 @@ struct SystemParams {
     vec4 opacity_keys[MAX_KEYS];  // x life fraction, y factor
     Force forces[MAX_FORCES];
     Collider colliders[MAX_COLLIDERS];
+    // Boids (grid_dims.w = 1): [0] x perception radius, y separation radius, z max speed,
+    // w max steering acceleration | [1] weights: x separation, y alignment, z cohesion,
+    // w avoidance | [2] the neighbour grid's origin xyz, cell w | [3] x look-ahead (s),
+    // y min speed
+    vec4 boids[4];
+    uvec4 grid_dims;    // xyz cells, w boids on (1)
 };
 struct Counters {
     int dead_count;     // free slots on the dead stack (stateful)

@@ -16,30 +16,13 @@ layout(std430, binding = PSYS_B_COLOR) buffer Color { vec4 color[]; };  // rgba 
 // keys.comp: sort keys and values (alive slots; NO_SLOT past them).
 layout(std430, binding = PSYS_B_KEYS) buffer Keys { uint keys[]; };
 layout(std430, binding = PSYS_B_VALS) buffer Vals { uint vals[]; };
+// Boids: the steering acceleration of each alive slot (boids.comp), one entry otherwise.
+layout(std430, binding = PSYS_B_STEER) buffer Steer { vec4 steer[]; };
 // Events the update recorded (its own list; the spawn reads the parent system's).
 layout(std430, binding = PSYS_B_EVENTS) buffer Events {
     uint ev_count;    // recorded this frame (may pass the list's length: the rest dropped)
     uint ev_args[3];  // the spawn's VkDispatchIndirectCommand
     Event ev[];
 };
-layout(push_constant) uniform Push {
-    mat4 view_proj;  // out-of-view death
-    vec4 source;     // xyz the emitter's centre this frame, w time (s)
-    uint births;     // emit: births this frame
-    uint seed;       // frame seed
-    uint cur;        // the alive list this frame reads (0 or 1)
-    uint head;       // closed: the ring's next slot
-    float dt;
-    uint capacity;
-    uint mode;       // args: 0 before the update, 1 after, 2 zero the draw count,
-                     // 3 the spawn's dispatch | keys: 0 network keys, 1 counting-sort
-                     // cells | emit: 0 the emitter's births, else spawn on events of
-                     // this kind (source: x count mean, y variance, z inherit; births:
-                     // 1 children's velocity along the contact normal)
-    uint cells;      // keys: counting-sort cells
-    float near;      // keys: the depth range the counting sort quantises (log scale)
-    float far;
-    uint pad1;
-    uint pad2;
-} pc;
+#include "push.glsl"
 #endif

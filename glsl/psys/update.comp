@@ -5,6 +5,7 @@
 #include "common/index.glsl"
 #include "state.glsl"
 #include "noise.glsl"
+#include "collide.glsl"
 #ifdef SUBGROUP
 #extension GL_KHR_shader_subgroup_ballot : require
 #endif
@@ -36,8 +37,9 @@ void record_event(vec3 p, vec3 v, vec3 n, uint kind) {
 }
 
 // Acceleration at p moving with v, at time t.
-vec3 accel(vec3 p, vec3 v, float t) {
+vec3 accel(vec3 p, vec3 v, float t, uint slot) {
     vec3 a = sp.gravity.xyz + sp.wind.w * (sp.wind.xyz - v);
+    if (sp.grid_dims.w == 1u) a += steer[slot].xyz;
     for (uint k = 0u; k < sp.counts.x; k++) {
         Force f = sp.forces[k];
         uint kind = uint(f.a.w);
@@ -59,55 +61,13 @@ vec3 accel(vec3 p, vec3 v, float t) {
     return a;
 }
 
-// Push p out of (or back into) collider k; true on contact, with the surface normal.
-bool contact(Collider k, inout vec3 p, out vec3 n) {
-    uint kind = uint(k.a.w);
-    bool inside = k.c.z > 0.5;
-    n = vec3(0.0);
-    if (kind == C_PLANE) {
-        n = normalize(k.a.xyz);
-        float s = dot(n, p) - k.b.x;
-        if (s >= 0.0) return false;
-        p -= s * n;
-        return true;
-    }
-    if (kind == C_SPHERE || kind == C_CAPSULE) {
-        vec3 centre = k.a.xyz;
-        float r = k.b.x;
-        if (kind == C_CAPSULE) {
-            vec3 ab = k.b.xyz - k.a.xyz;
-            float h = clamp(dot(p - k.a.xyz, ab) / max(dot(ab, ab), 1e-12), 0.0, 1.0);
-            centre = k.a.xyz + h * ab;
-            r = k.b.w;
-        }
-        vec3 d = p - centre;
-        float l = length(d);
-        vec3 dir = l > 1e-9 ? d / l : vec3(0, 1, 0);
-        if (!inside && l < r) { n = dir; p = centre + dir * r; return true; }
-        if (inside && l > r) { n = -dir; p = centre + dir * r; return true; }
-        return false;
-    }
-    if (kind == C_BOX) {
-        vec3 lo = k.a.xyz, hi = k.b.xyz;
-        if (inside) {
-            vec3 q = clamp(p, lo, hi);
-            if (q == p) return false;
-            n = normalize(q - p);
-            p = q;
-            return true;
-        }
-        if (any(lessThan(p, lo)) || any(greaterThan(p, hi))) return false;
-        // Out through the nearest face.
-        vec3 dlo = p - lo, dhi = hi - p;
-        float best = 1e30;
-        for (int ax = 0; ax < 3; ax++) {
-            if (dlo[ax] < best) { best = dlo[ax]; n = vec3(0.0); n[ax] = -1.0; }
-            if (dhi[ax] < best) { best = dhi[ax]; n = vec3(0.0); n[ax] = 1.0; }
-        }
-        p += n * best;
-        return true;
-    }
-    return false;
+// Boids: the speed kept within [min, max].
+vec3 limit_speed(vec3 v) {
+    if (sp.grid_dims.w != 1u) return v;
+    float s = length(v), lo = sp.boids[3].y, hi = sp.boids[0].z;
+    if (s > hi) return v * (hi / s);
+    if (s < lo) return s > 1e-9 ? v * (lo / s) : vec3(lo, 0.0, 0.0);
+    return v;
 }
 
 void main() {
@@ -121,12 +81,12 @@ void main() {
     vec3 v;
     if (sp.counts2.y == I_VERLET) {
         vec3 vel_est = (p - V.xyz) / dt;
-        vec3 next = p + (p - V.xyz) * keep + accel(p, vel_est, t) * dt * dt;
-        v = (next - p) / dt;
-        p = next;
+        vec3 next = p + (p - V.xyz) * keep + accel(p, vel_est, t, slot) * dt * dt;
+        v = limit_speed((next - p) / dt);
+        p += v * dt;
     } else {
-        v = V.xyz + accel(p, V.xyz, t) * dt;
-        v *= keep;
+        v = V.xyz + accel(p, V.xyz, t, slot) * dt;
+        v = limit_speed(v * keep);
         p += v * dt;
     }
     bool killed = false, hit = false;

@@ -1,13 +1,16 @@
 //! The GPU side of a particle system: the parameter block and counters (mirrored in
 //! glsl/psys/common.glsl), the passes' interfaces and pipelines (size-independent).
 use super::spec::{
-    ColliderKind, EventKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES, MAX_KEYS,
+    BoidsSpec, ColliderKind, EventKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES,
+    MAX_KEYS,
 };
-use crate::config::{Integrator, SpriteMode};
+use crate::config::Neighbors;
+use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::Result;
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::{ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard};
 use crate::primitives::counting::CountingSort;
+use crate::primitives::neighbors::{GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanPass, ScanVariant};
 use crate::primitives::sort::{Network, NetworkSort};
 use ash::vk;
@@ -40,9 +43,11 @@ pub struct SystemParams {
     pub opacity_keys: [V4; MAX_KEYS],
     pub forces: [[V4; 2]; MAX_FORCES],
     pub colliders: [[V4; 3]; MAX_COLLIDERS],
+    pub boids: [V4; 4],
+    pub grid_dims: [u32; 4],
 }
 const _: () =
-    assert!(std::mem::size_of::<SystemParams>() == 16 * 16 + 3 * 8 * 16 + 8 * 32 + 8 * 48);
+    assert!(std::mem::size_of::<SystemParams>() == 16 * 16 + 3 * 8 * 16 + 8 * 32 + 8 * 48 + 5 * 16);
 
 /// `Counters` of glsl/psys/common.glsl.
 #[repr(C)]
@@ -180,7 +185,25 @@ impl SystemParams {
                 ColliderKind::Capsule => [v3(c.a, 4.0), v3(c.b, c.radius), resp],
             };
         }
+        if let Some(b) = &spec.boids {
+            let g = b.grid();
+            p.boids = [
+                [b.radius, b.separation_radius, b.max_speed, b.max_steer],
+                [b.separation, b.alignment, b.cohesion, b.avoidance],
+                v3(g.origin, g.cell),
+                [b.look_ahead, b.min_speed, 0.0, 0.0],
+            ];
+            p.grid_dims = [g.dims[0], g.dims[1], g.dims[2], 1];
+        }
         p
+    }
+}
+
+impl BoidsSpec {
+    /// The neighbour grid: cells of the perception radius over the bounds (validated).
+    pub fn grid(&self) -> GridSpec {
+        GridSpec::covering(self.bounds[0], self.bounds[1], self.radius)
+            .expect("validated boids bounds")
     }
 }
 
@@ -234,7 +257,15 @@ crate::gpu_interface! {
     /// glsl/psys/emit.comp, args.comp, update.comp, keys.comp (glsl/psys/state.glsl)
     pub PsysIo / PsysBufs: "PSYS", push StepPush {
         params = 0, counters = 1, dead = 2, alive = 3, pos = 4, vel = 5, prev = 6, color = 7,
-        keys = 8, vals = 9, events = 10,
+        keys = 8, vals = 9, events = 10, steer = 11,
+    }
+}
+
+crate::gpu_interface! {
+    /// glsl/psys/boids.comp (the nb_* bindings are the neighbour grid's cells)
+    pub BoidsIo / BoidsBufs: "BOIDS", push StepPush {
+        params = 0, counters = 1, alive = 2, pos = 3, vel = 4, steer = 5, perm = 6,
+        nb_keys = 7, nb_start = 8, nb_end = 9, nb_box = 10,
     }
 }
 
@@ -269,6 +300,9 @@ pub struct Passes {
     pub args: ComputePipeline<PsysIo>,
     pub update: ComputePipeline<PsysIo>,
     pub keys: ComputePipeline<PsysIo>,
+    pub boids: ComputePipeline<BoidsIo>,
+    /// The boids' neighbour grid (counting sort).
+    pub grid: NeighborSearch,
     /// Points, streaks, sprites.
     pub draw: Vec<GraphicsPipeline<DrawIo>>,
     pub odd_even: NetworkSort,
@@ -281,6 +315,7 @@ impl Passes {
     pub const EMIT: &'static str = "emit";
     pub const UPDATE: &'static str = "update";
     pub const EVENTS: &'static str = "events";
+    pub const BOIDS: &'static str = "boids";
     pub const SORT: &'static str = "sort";
     pub const DRAW: &'static str = "draw";
 
@@ -304,6 +339,15 @@ impl Passes {
             &Self::update_defines(subgroups),
         )?;
         let keys = c("psys keys", "psys/keys.comp", 256, &[])?;
+        let grid = Guard::new(
+            ctx,
+            NeighborSearch::new(ctx, Neighbors::Grid, Some(SortAlgo::Counting))?,
+        );
+        let boids = ComputePipeline::new(
+            ctx,
+            &ComputeDesc::plain("psys boids", "psys/boids.comp", &grid.defines(), 256),
+        )
+        .map(|p| Guard::new(ctx, p))?;
         let mut draw = Guard::new(ctx, Vec::new());
         for mode in [SpriteMode::Points, SpriteMode::Streaks, SpriteMode::Sprites] {
             let (m, topology, blend) = draw_mode(mode);
@@ -334,6 +378,8 @@ impl Passes {
             args: args.take(),
             update: update.take(),
             keys: keys.take(),
+            boids: boids.take(),
+            grid: grid.take(),
             draw: draw.take(),
         })
     }
@@ -355,6 +401,8 @@ impl Passes {
         self.args.destroy(ctx);
         self.update.destroy(ctx);
         self.keys.destroy(ctx);
+        self.boids.destroy(ctx);
+        self.grid.destroy(ctx);
         for d in &mut self.draw {
             d.destroy(ctx);
         }

@@ -1,4 +1,4 @@
-//! Particle-system scenes: built-ins (`fountain`, `smoke`) and TOML files holding
+//! Particle-system scenes: built-ins (`fountain`, `smoke`, `flock`) and TOML files holding
 //! `[[system]]` tables (see tests/scenes/). Built-ins use no asset files.
 use super::spec::*;
 use crate::config::{Integrator, SortAlgo, SpriteMode};
@@ -7,7 +7,7 @@ use crate::sph::scene::CameraDesc;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-pub const BUILT_IN: &[&str] = &["fountain", "smoke"];
+pub const BUILT_IN: &[&str] = &["fountain", "smoke", "flock"];
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -69,6 +69,7 @@ pub fn base_system(
         collider: vec![],
         death: DeathSpec::default(),
         event: vec![],
+        boids: None,
     }
 }
 
@@ -83,6 +84,7 @@ pub fn emitter(shape: Shape, centre: [f32; 3], radius: f32, rate: Scalar) -> Emi
         rate: Some(rate),
         per_area: None,
         orbit: None,
+        burst: 0,
     }
 }
 
@@ -183,6 +185,69 @@ impl ParticleScene {
                     camera: camera([0.0, 1.4, 4.6], [0.0, 1.2, 0.0], 45.0),
                     background: [0.16, 0.2, 0.28],
                     system: vec![smoke],
+                }
+            }
+            // Boids in a room with a pillar: flocking on the neighbour grid, avoiding the
+            // walls and the pillar ahead of them.
+            "flock" => {
+                let lo = [-3.0, 0.0, -2.0];
+                let hi = [3.0, 3.0, 2.0];
+                let mut birds = base_system(
+                    "boids",
+                    4096,
+                    emitter(Shape::Sphere, [0.0, 1.5, 0.0], 1.2, vary(0.0, 0.0)),
+                    ParticleSpec {
+                        offset: vary3([0.0; 3], [0.0; 3]),
+                        velocity: vary3([0.0; 3], [1.2, 0.6, 1.2]),
+                        spread: 0.0,
+                        size: vary(0.06, 0.01),
+                        life: vary(1.0e6, 0.0),
+                        color: Vary {
+                            mean: [0.95, 0.75, 0.35, 1.0],
+                            variance: [0.05, 0.15, 0.1, 0.0],
+                        },
+                    },
+                );
+                birds.emitter.rate = None;
+                birds.emitter.burst = 4096;
+                birds.gravity = [0.0; 3];
+                let room = ColliderSpec {
+                    kind: ColliderKind::Box,
+                    min: lo,
+                    max: hi,
+                    inside: true,
+                    restitution: 1.0,
+                    ..ColliderSpec::ground(0.0, 1.0, 0.0)
+                };
+                let pillar = ColliderSpec {
+                    kind: ColliderKind::Capsule,
+                    a: [0.0, -1.0, 0.0],
+                    b: [0.0, 4.0, 0.0],
+                    radius: 0.35,
+                    restitution: 1.0,
+                    ..ColliderSpec::ground(0.0, 1.0, 0.0)
+                };
+                birds.collider = vec![room, pillar];
+                birds.boids = Some(BoidsSpec {
+                    radius: 0.5,
+                    separation_radius: 0.15,
+                    separation: 0.01,
+                    alignment: 4.0,
+                    cohesion: 1.0,
+                    avoidance: 8.0,
+                    look_ahead: 0.5,
+                    max_speed: 2.0,
+                    min_speed: 0.6,
+                    max_steer: 6.0,
+                    bounds: [lo, hi],
+                });
+                Self {
+                    name: name.into(),
+                    frames: 300,
+                    dt: 1.0 / 60.0,
+                    camera: camera([0.0, 2.6, 6.5], [0.0, 1.3, 0.0], 50.0),
+                    background: [0.55, 0.68, 0.85],
+                    system: vec![birds],
                 }
             }
             _ => return None,
@@ -289,6 +354,7 @@ impl ParticleScene {
                 if let Some(a) = &mut s.emitter.per_area {
                     *a *= k;
                 }
+                s.emitter.burst = (s.emitter.burst as f32 * k).round() as u32;
                 s.capacity = n;
             }
         }

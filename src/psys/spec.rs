@@ -58,6 +58,37 @@ pub struct EmitterSpec {
     /// Circle the centre moves on: radius (m) and period (s); none: fixed.
     #[serde(default)]
     pub orbit: Option<[f32; 2]>,
+    /// Births in the first frame, besides the rate (a flock, an explosion).
+    #[serde(default)]
+    pub burst: u32,
+}
+
+/// Boids (Reynolds 1987) on the neighbour grid: steering from flockmates within
+/// `radius` (separation within `separation_radius`, alignment, cohesion) and away from
+/// the colliders the boid would touch `look_ahead` seconds ahead, at most `max_steer`
+/// m/s^2; speed kept within [min_speed, max_speed].
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BoidsSpec {
+    pub radius: f32,
+    pub separation_radius: f32,
+    pub separation: f32,
+    pub alignment: f32,
+    pub cohesion: f32,
+    #[serde(default)]
+    pub avoidance: f32,
+    #[serde(default = "default_look_ahead")]
+    pub look_ahead: f32,
+    pub max_speed: f32,
+    #[serde(default)]
+    pub min_speed: f32,
+    pub max_steer: f32,
+    /// The box the neighbour grid covers ([min, max]); boids outside share its border cells.
+    pub bounds: [[f32; 3]; 2],
+}
+
+fn default_look_ahead() -> f32 {
+    0.5
 }
 
 fn up() -> [f32; 3] {
@@ -306,6 +337,9 @@ pub struct SystemSpec {
     /// Sub-systems spawned on a collision or at death (at most one event of each kind).
     #[serde(default)]
     pub event: Vec<EventSpec>,
+    /// Flocking on the neighbour grid.
+    #[serde(default)]
+    pub boids: Option<BoidsSpec>,
 }
 
 fn default_point() -> f32 {
@@ -361,7 +395,10 @@ impl SystemSpec {
                 if r.mean >= 0.0 && r.variance >= 0.0 && finite(&[r.mean, r.variance]) => {}
             (None, Some(a)) if a > 0.0 && a.is_finite() => {}
             (Some(_), Some(_)) => return bad("emitter: give rate or per_area, not both".into()),
-            (None, None) => return bad("emitter: give rate = {mean, variance} or per_area".into()),
+            (None, None) if e.burst > 0 => {}
+            (None, None) => {
+                return bad("emitter: give rate = {mean, variance}, per_area or burst".into())
+            }
             _ => return bad("emitter: the rate must be finite and not negative".into()),
         }
         if e.shape == Shape::Mesh {
@@ -485,6 +522,41 @@ impl SystemSpec {
                 return bad("keep_parent applies to collision events only".into());
             }
         }
+        if e.burst > self.capacity {
+            return bad(format!(
+                "emitter: a burst of {} exceeds the capacity",
+                e.burst
+            ));
+        }
+        if let Some(b) = &self.boids {
+            let pos = [
+                b.radius,
+                b.separation_radius,
+                b.max_speed,
+                b.max_steer,
+                b.look_ahead,
+            ];
+            let weights = [
+                b.separation,
+                b.alignment,
+                b.cohesion,
+                b.avoidance,
+                b.min_speed,
+            ];
+            if !pos.iter().all(|x| *x > 0.0 && x.is_finite())
+                || !weights.iter().all(|x| *x >= 0.0 && x.is_finite())
+            {
+                return bad("boids: radii, max_speed, max_steer and look_ahead positive; weights and min_speed >= 0".into());
+            }
+            if b.separation_radius > b.radius || b.min_speed > b.max_speed {
+                return bad("boids: separation_radius <= radius and min_speed <= max_speed".into());
+            }
+            crate::primitives::neighbors::GridSpec::covering(b.bounds[0], b.bounds[1], b.radius)
+                .map_err(|e| Error::Param(format!("system '{}': boids bounds: {e}", self.name)))?;
+            if !(0..3).all(|k| b.bounds[0][k] < b.bounds[1][k]) {
+                return bad("boids: bounds = [min, max] with min < max".into());
+            }
+        }
         if self.integrator() == Integrator::Closed {
             let stateful = |what: &str| {
                 Err(Error::Unsupported(format!(
@@ -503,6 +575,9 @@ impl SystemSpec {
             }
             if !self.event.is_empty() {
                 return stateful("an event (collision or death)");
+            }
+            if self.boids.is_some() {
+                return stateful("boids' steering");
             }
             if self.death.max_distance.is_some() || self.death.out_of_view {
                 return stateful("death by distance or view (a state change)");

@@ -3,8 +3,8 @@
 //! the alive list), sort by view depth, draw (indirect). The CPU draws only the number of
 //! births per frame; nothing is read back per frame.
 use super::gpu::{
-    vertices, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams, EVENTS_ARGS,
-    EVENTS_HEADER, EVENT_BYTES,
+    vertices, BoidsBufs, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams,
+    EVENTS_ARGS, EVENTS_HEADER, EVENT_BYTES,
 };
 use super::spec::{EventKind, EventSpec};
 use super::spec::{Shape, SystemSpec};
@@ -13,6 +13,7 @@ use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
 use crate::primitives::counting::CountingBuffers;
+use crate::primitives::neighbors::NeighborBuffers;
 use crate::render::Camera;
 use ash::vk;
 use bytemuck::Zeroable;
@@ -62,6 +63,9 @@ pub struct ParticleSystem {
     vals: Buffer,
     /// Events the update records (header + records; one record when it has none).
     events: Buffer,
+    /// Boids: each slot's steering (one entry without boids) and the neighbour grid.
+    steer: Buffer,
+    flock: Option<NeighborBuffers>,
     counting: Option<DepthSort>,
     sprite: Buffer,
     sprite_side: u32,
@@ -73,8 +77,10 @@ pub struct ParticleSystem {
     seed: u64,
     /// Closed form: births past the capacity in one frame, refused on the CPU.
     pub refused_cpu: u64,
-    /// Sum and sum of squares of the births drawn per frame.
+    /// Sum and sum of squares of the births drawn per frame by the rate.
     pub births_sum: (f64, f64),
+    /// Births of the first frame's burst.
+    burst: u64,
     pub frames: u64,
     /// Scene time after the last recorded step (s).
     last_time: f64,
@@ -155,6 +161,14 @@ impl ParticleSystem {
                 EVENTS_HEADER + records * EVENT_BYTES,
             )?,
         );
+        let steer = buf("steering", if spec.boids.is_some() { cap * 16 } else { 16 })?;
+        let flock = Guard::new(
+            ctx,
+            match &spec.boids {
+                Some(b) => Some(passes.grid.buffers(ctx, cap, &b.grid(), 1)?),
+                None => None,
+            },
+        );
         let keys = buf("sort keys", cap * 4)?;
         let vals = buf("sort values", cap * 4)?;
         let counting = Guard::new(
@@ -181,8 +195,9 @@ impl ParticleSystem {
             ..Counters::zeroed()
         };
         ctx.upload(&mut counters, 0, &[c])?;
-        if spec.integrator() == Integrator::Closed {
-            // Birth time -1 marks a slot never born (the others read slots via lists).
+        // w = -1 marks a slot never born: closed form's birth time; stateful systems read
+        // slots via lists, but the boids' grid sorts every slot and skips these.
+        if spec.integrator() == Integrator::Closed || spec.boids.is_some() {
             let unborn = vec![[0.0f32, 0.0, 0.0, -1.0]; spec.capacity as usize];
             ctx.upload(&mut pos, 0, &unborn)?;
         }
@@ -202,6 +217,8 @@ impl ParticleSystem {
             keys: keys.take(),
             vals: vals.take(),
             events: events.take(),
+            steer: steer.take(),
+            flock: flock.take(),
             counting: counting.take(),
             sprite: sprite_buf.take(),
             sprite_side: side,
@@ -211,6 +228,7 @@ impl ParticleSystem {
             seed,
             refused_cpu: 0,
             births_sum: (0.0, 0.0),
+            burst: 0,
             frames: 0,
             last_time: 0.0,
         })
@@ -226,9 +244,15 @@ impl ParticleSystem {
         self.last_time
     }
 
-    /// Births drawn on the CPU so far.
+    /// Births drawn on the CPU so far (the rate's and the first frame's burst).
     pub fn births_asked(&self) -> u64 {
-        self.births_sum.0 as u64
+        self.births_sum.0 as u64 + self.burst
+    }
+
+    /// Boids: each slot's steering acceleration (xyz) and flockmates seen (w) from the
+    /// last step (tests).
+    pub fn read_steer(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
+        ctx.readback(&self.steer, 0, self.steer.size as usize / 16)
     }
 
     pub fn closed(&self) -> bool {
@@ -273,9 +297,13 @@ impl ParticleSystem {
             }
             (None, None) => 0.0,
         };
-        let n = (x.max(0.0) + self.rng.random_range(0.0f32..1.0)).floor() as u64;
+        let mut n = (x.max(0.0) + self.rng.random_range(0.0f32..1.0)).floor() as u64;
         self.births_sum.0 += n as f64;
         self.births_sum.1 += (n * n) as f64;
+        if self.frames == 0 {
+            n += e.burst as u64;
+            self.burst = e.burst as u64;
+        }
         let cap = if self.closed() {
             self.capacity as u64
         } else {
@@ -300,6 +328,7 @@ impl ParticleSystem {
             keys: &self.keys,
             vals: &self.vals,
             events: &self.events,
+            steer: &self.steer,
         }
     }
 
@@ -371,6 +400,40 @@ impl ParticleSystem {
             sync::COMPUTE_WRITE,
             sync::COMPUTE_READ | sync::INDIRECT_READ,
         );
+        if let (Some(nb), Some(b)) = (&self.flock, &self.spec.boids) {
+            // The grid over every slot (dead ones sort last), then each boid's steering.
+            scopes.begin(ctx, cmd, Passes::BOIDS);
+            let r =
+                passes
+                    .grid
+                    .record_build(ctx, cmd, scopes, nb, &self.pos, self.capacity, &b.grid());
+            debug_assert!(r.is_ok(), "the grid was sized for every slot");
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+            let (nb_start, nb_end) = nb.cell_buffers();
+            let b = BoidsBufs {
+                params: &self.params,
+                counters: &self.counters,
+                alive: &self.alive,
+                pos: &self.pos,
+                vel: &self.vel,
+                steer: &self.steer,
+                perm: &nb.perm,
+                nb_keys: &nb.sorted_keys,
+                nb_start,
+                nb_end,
+                nb_box: nb.box_buffer(),
+            };
+            passes.boids.dispatch_indirect(
+                ctx,
+                cmd,
+                &b,
+                &push,
+                &self.counters,
+                Counters::UPDATE_ARGS,
+            );
+            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+            scopes.end(ctx, cmd);
+        }
         passes.update.dispatch_indirect(
             ctx,
             cmd,
@@ -609,9 +672,13 @@ impl ParticleSystem {
             &mut self.keys,
             &mut self.vals,
             &mut self.events,
+            &mut self.steer,
             &mut self.sprite,
         ] {
             ctx.destroy_buffer(b);
+        }
+        if let Some(nb) = &mut self.flock {
+            nb.destroy(ctx);
         }
         if let Some(d) = &mut self.counting {
             d.destroy(ctx);
