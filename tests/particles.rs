@@ -481,13 +481,6 @@ fn bad_systems_are_clear_errors() {
     s.particle.life.variance = 200.0;
     assert!(s.validate().unwrap_err().to_string().contains("life"));
     let mut s = ballistic(Integrator::Euler, 64);
-    s.emitter.shape = Shape::Mesh;
-    assert!(s
-        .validate()
-        .unwrap_err()
-        .to_string()
-        .contains("not implemented yet"));
-    let mut s = ballistic(Integrator::Euler, 64);
     s.draw = Some(SpriteMode::Points);
     s.sort = Some(SortAlgo::Bitonic);
     assert!(s.validate().unwrap_err().to_string().contains("no sort"));
@@ -514,6 +507,10 @@ fn bad_systems_are_clear_errors() {
     // Scenes: --sort for points only, closed with forces, spawns of unknown systems.
     let fw = format!("{}/tests/scenes/fireworks.toml", env!("CARGO_MANIFEST_DIR"));
     let mut scene = ParticleScene::find(&fw).unwrap().unwrap();
+    let mut body = scene.clone();
+    body.system[0].emitter.shape = Shape::Mesh;
+    let e = body.validate().unwrap_err().to_string();
+    assert!(e.contains("no [character]"), "{e}");
     scene.system[0].event[0].spawn = "nothing".into();
     let e = scene.validate().unwrap_err().to_string();
     assert!(e.contains("'nothing'"), "{e}");
@@ -567,6 +564,7 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
             "--integrator",
             "verlet",
         ],
+        vec!["--scene", "rain", "--particles", "2048", "--frames", "12"],
     ] {
         let out = dir.path().join("run");
         let frames = if args.contains(&"--frames") {
@@ -921,6 +919,169 @@ fn boids_keep_their_count_and_the_speed_limit() {
     assert!(worst < 2e-3, "steering differs from the CPU's by {worst}");
     s.destroy(&ctx);
     let mut passes = passes;
+    passes.destroy(&ctx);
+    finish(&ctx);
+}
+
+/// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
+fn triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (p - a).length();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (p - (a + ab * (d1 / (d1 - d3)))).length();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (p - (a + ac * (d2 / (d2 - d6)))).length();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + (c - b) * w)).length();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    (p - (a + ab * (vb * denom) + ac * (vc * denom))).length()
+}
+
+#[test]
+fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
+    use fluidform::character::capsules;
+    use fluidform::config::{ShowMesh, Skinning};
+    use fluidform::psys::character::CharacterLink;
+    use fluidform::scene::character::{CharacterDesc, SceneCharacter};
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let desc = CharacterDesc::new("builtin:walker");
+    let ch = SceneCharacter::new(&ctx, &desc, Skinning::Lbs, ShowMesh::Shaded).unwrap();
+    let link = CharacterLink::new(&ctx, &ch).unwrap();
+    let mats = ch.matrices(0.0);
+    ctx.one_shot(|cmd| {
+        ch.record(&ctx, cmd, &mut Labels, 0.0).unwrap();
+        link.record(&ctx, cmd, &mats);
+    })
+    .unwrap();
+    // Births on the skin: a mesh emitter at rest, no gravity.
+    let mut skin = ballistic(Integrator::Euler, 600);
+    skin.emitter.shape = Shape::Mesh;
+    skin.particle.velocity = Vary {
+        mean: [0.0; 3],
+        variance: [0.0; 3],
+    };
+    skin.gravity = [0.0; 3];
+    skin.emitter.burst = 600;
+    // Rain from above onto the body alone: it must rest on it, never inside a capsule.
+    let mut rain = ballistic(Integrator::Euler, 4000);
+    rain.name = "rain".into();
+    rain.emitter = emitter(
+        Shape::Box,
+        [0.0, 2.2, 0.0],
+        0.35,
+        Vary {
+            mean: 60.0,
+            variance: 0.0,
+        },
+    );
+    rain.particle.velocity = Vary {
+        mean: [0.0, -3.0, 0.0],
+        variance: [0.0; 3],
+    };
+    rain.collider = vec![ColliderSpec {
+        kind: ColliderKind::Character,
+        ..ColliderSpec::ground(0.0, 0.0, 1.0)
+    }];
+    let mut systems = vec![
+        ParticleSystem::new(&ctx, &passes, &skin, 0, 1).unwrap(),
+        ParticleSystem::new(&ctx, &passes, &rain, 1, 2).unwrap(),
+    ];
+    let dt = 1.0 / 60.0;
+    ctx.one_shot(|cmd| {
+        for k in 0..60 {
+            let f = FrameInfo {
+                character: Some(link.bufs(&ch)),
+                ..frame(&cam, k, dt)
+            };
+            fluidform::psys::run::record_simulation(
+                &ctx,
+                cmd,
+                &mut Labels,
+                &passes,
+                &mut systems,
+                &f,
+            )
+            .unwrap();
+        }
+    })
+    .unwrap();
+    let (p, _) = ch.ch.skinned_at(&mats, Skinning::Lbs).unwrap();
+    let tris: Vec<[Vec3; 3]> = ch
+        .ch
+        .mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]])
+        .collect();
+    let (lo_y, hi_y) = p
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(v.y), h.max(v.y)));
+    let d = systems[0].read(&ctx).unwrap();
+    assert_eq!(d.alive.len(), 600, "the skin emitter's births");
+    let (mut ymin, mut ymax) = (f32::MAX, f32::MIN);
+    for &i in &d.alive {
+        let q = Vec3::from_slice(&d.pos[i as usize][..3]);
+        let dist = tris
+            .iter()
+            .map(|t| triangle_distance(q, t[0], t[1], t[2]))
+            .fold(f32::MAX, f32::min);
+        assert!(dist < 1e-3, "a birth {dist} m off the skin at {q}");
+        ymin = ymin.min(q.y);
+        ymax = ymax.max(q.y);
+    }
+    assert!(
+        ymax - ymin > 0.8 * (hi_y - lo_y),
+        "births cover {ymin}..{ymax} of {lo_y}..{hi_y}"
+    );
+    let posed: Vec<_> = capsules::of(&ch.ch)
+        .iter()
+        .map(|c| c.posed(&mats))
+        .collect();
+    let d = systems[1].read(&ctx).unwrap();
+    let mut resting = 0;
+    for &i in &d.alive {
+        let q = Vec3::from_slice(&d.pos[i as usize][..3]);
+        for c in &posed {
+            let ab = c.b - c.a;
+            let h = ((q - c.a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+            let r = (q - (c.a + h * ab)).length();
+            assert!(
+                r >= c.r - 1e-4,
+                "a drop {r} m from a capsule's axis of radius {}",
+                c.r
+            );
+            resting += (r < c.r + 0.01) as u32;
+        }
+    }
+    assert!(resting > 20, "only {resting} drops rest on the body");
+    for s in &mut systems {
+        s.destroy(&ctx);
+    }
+    let (mut ch, mut link, mut passes) = (ch, link, passes);
+    link.destroy(&ctx);
+    ch.destroy(&ctx);
     passes.destroy(&ctx);
     finish(&ctx);
 }

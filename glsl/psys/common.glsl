@@ -14,11 +14,13 @@
 #define C_SPHERE 2
 #define C_BOX 3
 #define C_CAPSULE 4
+#define C_CHARACTER 5  // the scene character's capsules (update.comp)
 // Emitter shapes (emitter.w).
 #define E_POINT 0
 #define E_BOX 1
 #define E_SPHERE 2
 #define E_DISC 3
+#define E_MESH 4
 // Integrators.
 #define I_EULER 0
 #define I_VERLET 1

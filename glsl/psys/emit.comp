@@ -7,6 +7,23 @@
 #include "common/index.glsl"
 #include "state.glsl"
 
+// A point on the character's skinned surface: a triangle by bind-pose area (binary
+// search of the CDF), uniform within it; its unit normal in `n`.
+vec3 mesh_point(inout uint s, out vec3 n) {
+    float u = rnd(s);
+    uint lo = 0u, hi = pc.triangles - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1;
+        if (mesh_cdf[mid] < u) lo = mid + 1u; else hi = mid;
+    }
+    vec3 a = mesh_pos[mesh_idx[3u * lo]].xyz, b = mesh_pos[mesh_idx[3u * lo + 1u]].xyz,
+         c = mesh_pos[mesh_idx[3u * lo + 2u]].xyz;
+    vec3 cr = cross(b - a, c - a);
+    n = dot(cr, cr) > 1e-20 ? normalize(cr) : vec3(0.0, 1.0, 0.0);
+    float r1 = sqrt(rnd(s)), r2 = rnd(s);
+    return (1.0 - r1) * a + r1 * (1.0 - r2) * b + r1 * r2 * c;
+}
+
 vec3 shape_point(inout uint s) {
     uint shape = uint(sp.emitter.w);
     vec3 e = sp.extent.xyz;
@@ -106,8 +123,18 @@ void main() {
     }
     if (i >= pc.births) return;
     uint s = pcg(pc.seed ^ pcg(i + 0x9e3779b9u));
-    vec3 p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
-    vec3 v = own_velocity(s);
+    vec3 p, v;
+    if (uint(sp.emitter.w) == E_MESH) {
+        if (pc.triangles == 0u) return;  // no character bound (the scene validates this)
+        vec3 n, t, b;
+        p = mesh_point(s, n) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+        basis(n, t, b);
+        v = own_velocity(s);
+        v = v.x * t + v.y * n + v.z * b;  // +y onto the surface normal
+    } else {
+        p = pc.source.xyz + shape_point(s) + sp.offset_mean.xyz + srnd3(s) * sp.offset_var.xyz;
+        v = own_velocity(s);
+    }
     if (sp.counts2.y != I_CLOSED) {
         born(p, v, s, false);
         return;

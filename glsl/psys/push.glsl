@@ -19,7 +19,7 @@ layout(push_constant) uniform Push {
     uint cells;      // keys: counting-sort cells
     float near;      // keys: the depth range the counting sort quantises (log scale)
     float far;
-    uint pad1;
-    uint pad2;
+    uint capsules;   // the scene character's capsules (0: none)
+    uint triangles;  // its triangles
 } pc;
 #endif

@@ -18,6 +18,12 @@ layout(std430, binding = PSYS_B_KEYS) buffer Keys { uint keys[]; };
 layout(std430, binding = PSYS_B_VALS) buffer Vals { uint vals[]; };
 // Boids: the steering acceleration of each alive slot (boids.comp), one entry otherwise.
 layout(std430, binding = PSYS_B_STEER) buffer Steer { vec4 steer[]; };
+// The scene character (a 16-byte stand-in without one): posed capsules, vec4 (a, r) and
+// vec4 (b, -) each; skinned positions, triangle indices, cumulative bind-pose areas.
+layout(std430, binding = PSYS_B_CAPSULES) readonly buffer Capsules { vec4 capsules[]; };
+layout(std430, binding = PSYS_B_MESH_POS) readonly buffer MeshPos { vec4 mesh_pos[]; };
+layout(std430, binding = PSYS_B_MESH_IDX) readonly buffer MeshIdx { uint mesh_idx[]; };
+layout(std430, binding = PSYS_B_MESH_CDF) readonly buffer MeshCdf { float mesh_cdf[]; };
 // Events the update recorded (its own list; the spawn reads the parent system's).
 layout(std430, binding = PSYS_B_EVENTS) buffer Events {
     uint ev_count;    // recorded this frame (may pass the list's length: the rest dropped)

@@ -92,7 +92,13 @@ void main() {
     bool killed = false, hit = false;
     vec3 hit_n = vec3(0.0);
     for (uint k = 0u; k < sp.counts.y; k++) {
+      bool body = uint(sp.colliders[k].a.w) == C_CHARACTER;
+      for (uint q = 0u; q < (body ? pc.capsules : 1u); q++) {
         Collider col = sp.colliders[k];
+        if (body) {  // one of the character's capsules, with the collider's response
+            col.a = vec4(capsules[2u * q].xyz, float(C_CAPSULE));
+            col.b = vec4(capsules[2u * q + 1u].xyz, capsules[2u * q].w);
+        }
         vec3 n;
         if (contact(col, p, n)) {
             hit = true;
@@ -106,6 +112,7 @@ void main() {
                 v = -col.c.x * vn * n + (1.0 - col.c.y) * vt;
             }
         }
+      }
     }
     float age = P.w + dt;
     prev[slot].xyz = P.xyz;

@@ -8,7 +8,9 @@ use crate::config::Neighbors;
 use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::Result;
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
-use crate::gpu::{ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard};
+use crate::gpu::{
+    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
+};
 use crate::primitives::counting::CountingSort;
 use crate::primitives::neighbors::{GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanPass, ScanVariant};
@@ -106,10 +108,11 @@ impl SystemParams {
         let mut p = Self::zeroed();
         let e = &spec.emitter;
         let shape = match e.shape {
-            Shape::Point | Shape::Mesh => 0.0,
+            Shape::Point => 0.0,
             Shape::Box => 1.0,
             Shape::Sphere => 2.0,
             Shape::Disc => 3.0,
+            Shape::Mesh => 4.0,
         };
         p.emitter = v3(e.centre, shape);
         p.extent = match e.shape {
@@ -183,6 +186,7 @@ impl SystemParams {
                 ColliderKind::Sphere => [v3(c.centre, 2.0), [c.radius, 0.0, 0.0, 0.0], resp],
                 ColliderKind::Box => [v3(c.min, 3.0), v3(c.max, 0.0), resp],
                 ColliderKind::Capsule => [v3(c.a, 4.0), v3(c.b, c.radius), resp],
+                ColliderKind::Character => [[0.0, 0.0, 0.0, 5.0], [0.0; 4], resp],
             };
         }
         if let Some(b) = &spec.boids {
@@ -235,7 +239,9 @@ pub struct StepPush {
     pub cells: u32,
     pub near: f32,
     pub far: f32,
-    pub pad: [u32; 2],
+    /// The scene character's capsules and triangles (0 without one).
+    pub capsules: u32,
+    pub triangles: u32,
 }
 const _: () = assert!(std::mem::size_of::<StepPush>() == 128);
 
@@ -257,7 +263,8 @@ crate::gpu_interface! {
     /// glsl/psys/emit.comp, args.comp, update.comp, keys.comp (glsl/psys/state.glsl)
     pub PsysIo / PsysBufs: "PSYS", push StepPush {
         params = 0, counters = 1, dead = 2, alive = 3, pos = 4, vel = 5, prev = 6, color = 7,
-        keys = 8, vals = 9, events = 10, steer = 11,
+        keys = 8, vals = 9, events = 10, steer = 11, capsules = 12, mesh_pos = 13,
+        mesh_idx = 14, mesh_cdf = 15,
     }
 }
 
@@ -309,6 +316,8 @@ pub struct Passes {
     pub bitonic: NetworkSort,
     pub counting: CountingSort,
     pub scan: ScanPass,
+    /// Bound where a system has no scene character (16 bytes).
+    pub dummy: Buffer,
 }
 
 impl Passes {
@@ -368,12 +377,14 @@ impl Passes {
         let odd_even = Guard::new(ctx, NetworkSort::new(ctx, Network::OddEven)?);
         let bitonic = Guard::new(ctx, NetworkSort::new(ctx, Network::Bitonic)?);
         let counting = Guard::new(ctx, CountingSort::new(ctx)?);
-        let scan = ScanPass::new(ctx, ScanVariant::Auto)?;
+        let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
+        let dummy = ctx.storage_buffer("psys no character", 16)?;
         Ok(Self {
             odd_even: odd_even.take(),
             bitonic: bitonic.take(),
             counting: counting.take(),
-            scan,
+            scan: scan.take(),
+            dummy,
             emit: emit.take(),
             args: args.take(),
             update: update.take(),
@@ -410,6 +421,7 @@ impl Passes {
         self.bitonic.destroy(ctx);
         self.counting.destroy(ctx);
         self.scan.destroy(ctx);
+        ctx.destroy_buffer(&mut self.dummy);
     }
 }
 crate::impl_destroy!(Passes);

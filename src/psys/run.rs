@@ -1,12 +1,15 @@
 //! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
+use super::character::{CharacterBufs, CharacterLink};
 use super::gpu::Passes;
 use super::scenes::ParticleScene;
 use super::system::{FrameInfo, ParticleSystem};
-use crate::config::{Group, Integrator, SortAlgo, SpriteMode};
+use crate::config::{Group, Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
+use crate::render::mesh::MeshView;
 use crate::render::Camera;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
+use crate::scene::character::SceneCharacter;
 use crate::session::{camera_with_switches, open, play, SLOTS};
 use crate::viewer::Picture;
 use ash::vk;
@@ -128,15 +131,20 @@ impl SceneSystems {
         frame_info(&self.cam, self.dt, frame, self.width, self.height)
     }
 
-    /// Record every system's step and sort (see `record_simulation`).
+    /// Record every system's step and sort (see `record_simulation`), with the scene
+    /// character's buffers when it has one.
     pub fn record_simulation(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         prof: &mut dyn Scopes,
         frame: u64,
+        character: Option<CharacterBufs>,
     ) -> Result<()> {
-        let f = frame_info(&self.cam, self.dt, frame, self.width, self.height);
+        let f = FrameInfo {
+            character,
+            ..frame_info(&self.cam, self.dt, frame, self.width, self.height)
+        };
         record_simulation(ctx, cmd, prof, &self.passes, &mut self.systems, &f)
     }
 
@@ -166,6 +174,7 @@ pub fn frame_info(cam: &Camera, dt: f32, frame: u64, width: u32, height: u32) ->
         frame,
         width,
         height,
+        character: None,
     }
 }
 
@@ -250,7 +259,28 @@ fn record_events(
     Ok(())
 }
 
+/// The scene character: skinned each frame, its capsules posed for the colliders, its
+/// mesh drawn (unless --show-mesh off) before the particles, so they are depth-tested
+/// against it.
+struct Body {
+    ch: SceneCharacter,
+    link: CharacterLink,
+    view: Option<MeshView>,
+}
+
+impl Body {
+    fn destroy(&mut self, ctx: &Context) {
+        self.ch.destroy(ctx);
+        self.link.destroy(ctx);
+        if let Some(v) = &mut self.view {
+            v.destroy(ctx);
+        }
+    }
+}
+crate::impl_destroy!(Body);
+
 struct ParticleWork<'a> {
+    body: Option<Body>,
     scene: SceneSystems,
     target: ColorTarget,
     background: [f32; 3],
@@ -266,11 +296,24 @@ impl FrameWork for ParticleWork<'_> {
         frame: u64,
         slot: usize,
     ) -> Result<()> {
-        self.scene.record_simulation(ctx, cmd, prof, frame)?;
+        if let Some(body) = &self.body {
+            let t = frame as f64 * self.scene.dt as f64;
+            body.ch.record(ctx, cmd, prof, t)?;
+            body.link.record(ctx, cmd, &body.ch.matrices(t));
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+        }
+        let bufs = self.body.as_ref().map(|b| b.link.bufs(&b.ch));
+        self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
         prof.begin(ctx, cmd, Passes::DRAW);
         let b = self.background;
         self.target
             .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);
+        if let Some(Body {
+            ch, view: Some(v), ..
+        }) = &self.body
+        {
+            v.draw(ctx, cmd, &ch.surface());
+        }
         self.scene.record_draws(ctx, cmd, frame);
         self.target.end_rendering(ctx, cmd);
         prof.end(ctx, cmd);
@@ -294,10 +337,11 @@ impl FrameWork for ParticleWork<'_> {
 
 pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
     let sw = &opts.switches;
-    sw.reject_unused(
-        &format!("particle-system scene {}", scene.name),
-        &[Group::Particles, Group::Sort, Group::Camera],
-    )?;
+    let mut groups = vec![Group::Particles, Group::Sort, Group::Camera];
+    if scene.character.is_some() {
+        groups.push(Group::Character);
+    }
+    sw.reject_unused(&format!("particle-system scene {}", scene.name), &groups)?;
     let scene = scene.with_switches(
         sw.particle.integrator,
         sw.particle.draw,
@@ -316,8 +360,28 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
         &ctx,
         SceneSystems::new(&ctx, &scene, cam, w, h, sw.common.seed)?,
     );
+    let body = match &scene.character {
+        Some(desc) => {
+            let show = sw.character.show_mesh.unwrap_or(ShowMesh::Shaded);
+            let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
+            let ch = Guard::new(&ctx, SceneCharacter::new(&ctx, desc, method, show)?);
+            let link = Guard::new(&ctx, CharacterLink::new(&ctx, &ch)?);
+            let view = match show {
+                ShowMesh::Off => None,
+                s => Some(MeshView::new(&ctx, &cam, s)?),
+            };
+            Some(Body {
+                ch: ch.take(),
+                link: link.take(),
+                view,
+            })
+        }
+        None => None,
+    };
+    let body = Guard::new(&ctx, body);
     let target = ColorTarget::new(&ctx, w, h, SLOTS)?;
     let mut work = ParticleWork {
+        body: body.take(),
         scene: systems.take(),
         target,
         background: scene.background,
@@ -337,6 +401,9 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
     let particles = work.scene.systems.iter().map(|s| s.capacity as u64).sum();
     work.scene.destroy(&ctx);
     work.target.destroy(&ctx);
+    if let Some(b) = &mut work.body {
+        b.destroy(&ctx);
+    }
     let timings = timings?;
     finish_fluidless(
         &ctx,

@@ -1,13 +1,14 @@
-//! Particle-system scenes: built-ins (`fountain`, `smoke`, `flock`) and TOML files holding
+//! Particle-system scenes: built-ins (`fountain`, `smoke`, `flock`, `rain`) and TOML files holding
 //! `[[system]]` tables (see tests/scenes/). Built-ins use no asset files.
 use super::spec::*;
 use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
+use crate::scene::character::CharacterDesc;
 use crate::sph::scene::CameraDesc;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-pub const BUILT_IN: &[&str] = &["fountain", "smoke", "flock"];
+pub const BUILT_IN: &[&str] = &["fountain", "smoke", "flock", "rain"];
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -25,6 +26,10 @@ pub struct ParticleScene {
     #[serde(default = "default_sky")]
     pub background: [f32; 3],
     pub system: Vec<SystemSpec>,
+    /// An animated character the systems emit from (`mesh`) or collide with
+    /// (`character`), drawn with them, depth-tested.
+    #[serde(default)]
+    pub character: Option<CharacterDesc>,
 }
 
 fn default_frames() -> u64 {
@@ -141,6 +146,7 @@ impl ParticleScene {
                     camera: camera([0.0, 1.7, 5.2], [0.0, 1.1, 0.0], 40.0),
                     background: default_sky(),
                     system: vec![water, spray],
+                    character: None,
                 }
             }
             // Smoke rising from a sphere, pushed by wind and stirred by curl noise,
@@ -185,6 +191,7 @@ impl ParticleScene {
                     camera: camera([0.0, 1.4, 4.6], [0.0, 1.2, 0.0], 45.0),
                     background: [0.16, 0.2, 0.28],
                     system: vec![smoke],
+                    character: None,
                 }
             }
             // Boids in a room with a pillar: flocking on the neighbour grid, avoiding the
@@ -248,8 +255,13 @@ impl ParticleScene {
                     camera: camera([0.0, 2.6, 6.5], [0.0, 1.3, 0.0], 50.0),
                     background: [0.55, 0.68, 0.85],
                     system: vec![birds],
+                    character: None,
                 }
             }
+            // Rain on a walking character: drops become splashes where they hit the
+            // ground or the body's capsules (a type change), and the wet skin drips (a
+            // mesh emitter).
+            "rain" => rain(),
             _ => return None,
         })
     }
@@ -293,6 +305,16 @@ impl ParticleScene {
     }
 
     pub fn validate(&self) -> Result<()> {
+        match (&self.character, self.system.iter().find(|s| s.uses_character())) {
+            (None, Some(s)) => {
+                return Err(Error::Param(format!(
+                    "scene {}: system '{}' emits from or collides with the character, but the scene has no [character]",
+                    self.name, s.name
+                )))
+            }
+            (Some(c), _) => c.validate(&self.name)?,
+            _ => {}
+        }
         if self.system.is_empty() {
             return Err(Error::Param(format!("scene {}: no [[system]]", self.name)));
         }
@@ -377,5 +399,105 @@ impl ParticleScene {
         }
         self.validate()?;
         Ok(self)
+    }
+}
+
+/// The `rain` scene: the built-in walker on a square path under rain.
+fn rain() -> ParticleScene {
+    let ground = ColliderSpec::ground(0.0, 0.0, 0.6);
+    let body = ColliderSpec {
+        kind: ColliderKind::Character,
+        ..ColliderSpec::ground(0.0, 0.1, 0.3)
+    };
+    let mut drops = base_system(
+        "rain",
+        1 << 15,
+        emitter(Shape::Box, [0.0, 4.5, 0.0], 2.5, vary(500.0, 60.0)),
+        ParticleSpec {
+            offset: vary3([0.0; 3], [0.0; 3]),
+            velocity: vary3([0.4, -7.0, 0.0], [0.05, 0.6, 0.05]),
+            spread: 0.0,
+            size: vary(0.01, 0.0),
+            life: vary(3.0, 0.0),
+            color: Vary {
+                mean: [0.7, 0.8, 1.0, 0.5],
+                variance: [0.05, 0.05, 0.0, 0.15],
+            },
+        },
+    );
+    drops.emitter.half = [2.5, 0.1, 2.5];
+    drops.draw = Some(SpriteMode::Streaks);
+    drops.collider = vec![ground.clone(), body.clone()];
+    drops.event = vec![EventSpec {
+        on: EventKind::Collision,
+        spawn: "splash".into(),
+        count: vary(1.0, 0.0),
+        inherit: 0.15,
+        keep_parent: false,
+        along_normal: true,
+    }];
+    let mut splash = base_system(
+        "splash",
+        1 << 14,
+        emitter(Shape::Point, [0.0; 3], 0.0, vary(0.0, 0.0)),
+        ParticleSpec {
+            offset: vary3([0.0, 0.01, 0.0], [0.0; 3]),
+            velocity: vary3([0.0, 1.3, 0.0], [0.0, 0.5, 0.0]),
+            spread: 55.0,
+            size: vary(0.03, 0.01),
+            life: vary(0.35, 0.1),
+            color: Vary {
+                mean: [0.8, 0.88, 1.0, 0.8],
+                variance: [0.0, 0.0, 0.0, 0.1],
+            },
+        },
+    );
+    splash.collider = vec![ground.clone(), body.clone()];
+    splash.over_life.opacity = vec![[0.0, 1.0], [1.0, 0.0]];
+    // The wet skin drips: drops born on the skinned surface fall and die on the ground.
+    let mut drips = base_system(
+        "drips",
+        1 << 12,
+        emitter(Shape::Mesh, [0.0; 3], 0.0, vary(6.0, 3.0)),
+        ParticleSpec {
+            offset: vary3([0.0; 3], [0.0; 3]),
+            velocity: vary3([0.0, 0.1, 0.0], [0.02, 0.05, 0.02]),
+            spread: 0.0,
+            size: vary(0.025, 0.005),
+            life: vary(1.5, 0.3),
+            color: Vary {
+                mean: [0.55, 0.75, 1.0, 0.9],
+                variance: [0.0; 4],
+            },
+        },
+    );
+    drips.collider = vec![ColliderSpec {
+        kill: true,
+        ..ground
+    }];
+    let speed = 0.6;
+    ParticleScene {
+        name: "rain".into(),
+        frames: 180,
+        dt: 1.0 / 60.0,
+        camera: CameraDesc {
+            eye: [0.0, 2.0, 5.5],
+            target: [0.0, 0.9, 0.0],
+            fov: 45.0,
+        },
+        background: [0.12, 0.14, 0.18],
+        system: vec![drops, splash, drips],
+        character: Some(CharacterDesc {
+            // The walk cycle's stride (about 0.8 m a cycle) matched to the path speed.
+            speed: speed / 0.8,
+            path: vec![
+                [-1.0, 0.0, 0.8],
+                [1.0, 0.0, 0.8],
+                [1.0, 0.0, -0.8],
+                [-1.0, 0.0, -0.8],
+            ],
+            path_speed: speed,
+            ..CharacterDesc::new("builtin:walker")
+        }),
     }
 }

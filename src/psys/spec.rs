@@ -27,7 +27,8 @@ pub enum Shape {
     Box,
     Sphere,
     Disc,
-    /// The skinned character's surface: needs a scene character.
+    /// The scene character's skinned triangles, picked by bind-pose area; the velocity's
+    /// +y turned onto the surface normal.
     Mesh,
 }
 
@@ -176,8 +177,10 @@ pub enum ColliderKind {
     Plane,
     Sphere,
     Box,
-    /// The segment a-b swept by radius: the character's capsules are these.
+    /// The segment a-b swept by radius.
     Capsule,
+    /// The scene character's capsules (one per bone), posed every frame.
+    Character,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -366,6 +369,15 @@ fn finite(v: &[f32]) -> bool {
 }
 
 impl SystemSpec {
+    /// Whether it emits from or collides with the scene character.
+    pub fn uses_character(&self) -> bool {
+        self.emitter.shape == Shape::Mesh
+            || self
+                .collider
+                .iter()
+                .any(|c| c.kind == ColliderKind::Character)
+    }
+
     /// The integrator after `--integrator`.
     pub fn integrator(&self) -> Integrator {
         self.integrator.unwrap_or(Integrator::Euler)
@@ -400,12 +412,6 @@ impl SystemSpec {
                 return bad("emitter: give rate = {mean, variance}, per_area or burst".into())
             }
             _ => return bad("emitter: the rate must be finite and not negative".into()),
-        }
-        if e.shape == Shape::Mesh {
-            return Err(Error::Unsupported(format!(
-                "system '{}': emitter shape 'mesh' (the character's surface) is not implemented yet: use point, box, sphere or disc",
-                self.name
-            )));
         }
         if matches!(e.shape, Shape::Sphere | Shape::Disc) && !(e.radius > 0.0) {
             return bad(format!("emitter: a {:?} needs a positive radius", e.shape).to_lowercase());
@@ -487,6 +493,7 @@ impl SystemSpec {
                 ColliderKind::Sphere => c.radius > 0.0,
                 ColliderKind::Box => (0..3).all(|k| c.min[k] < c.max[k]),
                 ColliderKind::Capsule => c.radius > 0.0,
+                ColliderKind::Character => true,
             };
             if !ok {
                 return bad(format!("collider {:?}: a plane needs a normal, a sphere or capsule a radius, a box min < max", c.kind).to_lowercase());

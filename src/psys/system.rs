@@ -2,6 +2,7 @@
 //! buffers and sprite texture, and how a frame is recorded: emit, update (indirect over
 //! the alive list), sort by view depth, draw (indirect). The CPU draws only the number of
 //! births per frame; nothing is read back per frame.
+use super::character::CharacterBufs;
 use super::gpu::{
     vertices, BoidsBufs, Counters, DrawBufs, DrawPush, Passes, PsysBufs, StepPush, SystemParams,
     EVENTS_ARGS, EVENTS_HEADER, EVENT_BYTES,
@@ -24,7 +25,7 @@ use rand::{Rng, SeedableRng};
 pub const DEPTH_CELLS: u32 = 1 << 18;
 
 /// The frame a system steps to and is drawn in.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub struct FrameInfo<'a> {
     pub cam: &'a Camera,
     /// Scene time at the start of the frame (s).
@@ -33,6 +34,8 @@ pub struct FrameInfo<'a> {
     pub frame: u64,
     pub width: u32,
     pub height: u32,
+    /// The scene character (mesh emitters, character colliders).
+    pub character: Option<CharacterBufs<'a>>,
 }
 
 /// The state read back (tests, summaries).
@@ -315,7 +318,10 @@ impl ParticleSystem {
         n.min(cap) as u32
     }
 
-    fn bufs(&self) -> PsysBufs<'_> {
+    /// The system's buffers, with the frame's character (or the stand-in).
+    fn bufs<'a>(&'a self, passes: &'a Passes, f: &FrameInfo<'a>) -> PsysBufs<'a> {
+        let d = &passes.dummy;
+        let ch = f.character;
         PsysBufs {
             params: &self.params,
             counters: &self.counters,
@@ -329,6 +335,10 @@ impl ParticleSystem {
             vals: &self.vals,
             events: &self.events,
             steer: &self.steer,
+            capsules: ch.map_or(d, |c| c.capsules),
+            mesh_pos: ch.map_or(d, |c| c.pos),
+            mesh_idx: ch.map_or(d, |c| c.indices),
+            mesh_cdf: ch.map_or(d, |c| c.cdf),
         }
     }
 
@@ -348,7 +358,8 @@ impl ParticleSystem {
             cells: DEPTH_CELLS,
             near: f.cam.near,
             far: f.cam.far,
-            pad: [0; 2],
+            capsules: f.character.map_or(0, |c| c.capsule_count),
+            triangles: f.character.map_or(0, |c| c.triangles),
         }
     }
 
@@ -384,7 +395,7 @@ impl ParticleSystem {
         self.frames += 1;
         self.last_time = f.time + f.dt as f64;
         let push = self.push(f, f.time, births);
-        let bufs = self.bufs();
+        let bufs = self.bufs(passes, f);
         scopes.begin(ctx, cmd, Passes::EMIT);
         passes.emit.dispatch(ctx, cmd, &bufs, &push, births as u64);
         scopes.end(ctx, cmd);
@@ -464,7 +475,7 @@ impl ParticleSystem {
         };
         passes
             .args
-            .dispatch_groups(ctx, cmd, &self.bufs(), &push, 1);
+            .dispatch_groups(ctx, cmd, &self.bufs(passes, f), &push, 1);
     }
 
     /// Record the children of `parent`'s events of `event`'s kind, born into this system's
@@ -489,7 +500,7 @@ impl ParticleSystem {
         push.seed ^= (crate::psys::hash64(parent.seed ^ kind as u64) & 0xffff_ffff) as u32;
         let bufs = PsysBufs {
             events: &parent.events,
-            ..self.bufs()
+            ..self.bufs(passes, f)
         };
         passes
             .emit
@@ -509,7 +520,7 @@ impl ParticleSystem {
         push.mode = 1;
         passes
             .args
-            .dispatch_groups(ctx, cmd, &self.bufs(), &push, 1);
+            .dispatch_groups(ctx, cmd, &self.bufs(passes, f), &push, 1);
     }
 
     /// Record the depth sort of what is drawn (nothing with --sort none). The step's
@@ -530,7 +541,7 @@ impl ParticleSystem {
         // Keys read the list the step wrote: the shader reads alive[1 - cur].
         push.cur = 1 - self.drawn;
         push.mode = (self.sort == SortAlgo::Counting) as u32;
-        let bufs = self.bufs();
+        let bufs = self.bufs(passes, f);
         let cap = self.capacity as u64;
         scopes.begin(ctx, cmd, Passes::SORT);
         if self.closed() {

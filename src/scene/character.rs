@@ -3,7 +3,7 @@
 use crate::character::{self, anim, skin::Skinner, Animator, Character};
 use crate::config::{ShowMesh, Skinning};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Context, Guard, Profiler};
+use crate::gpu::{sync, Context, Guard};
 use crate::render::mesh::MeshDraw;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -257,7 +257,7 @@ impl SceneCharacter {
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        prof: &mut Profiler,
+        prof: &mut dyn crate::gpu::Scopes,
         t: f64,
     ) -> Result<()> {
         let mats = self.matrices(t);
@@ -282,6 +282,17 @@ impl SceneCharacter {
             indices: &m.indices,
             triangles: m.triangles,
         })
+    }
+
+    /// The skinned mesh of the last `record`, shown or not (emitters read it).
+    pub fn surface(&self) -> MeshDraw<'_> {
+        let m = &self.skinner.mesh;
+        MeshDraw {
+            pos: &m.pos,
+            nrm: &m.nrm,
+            indices: &m.indices,
+            triangles: m.triangles,
+        }
     }
 
     pub fn stats(&self) -> Result<CharacterStats> {
