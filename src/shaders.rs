@@ -49,6 +49,12 @@ pub fn variants() -> Vec<Variant> {
             .collect();
         v.push(with::<PsysIo>("psys/update.comp", &d));
     }
+    let grid = crate::primitives::neighbors::NeighborSearch::defines_for(
+        Neighbors::Grid,
+        SortAlgo::Counting,
+    );
+    let grid: Vec<(String, String)> = grid.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+    v.push(with::<crate::psys::gpu::BoidsIo>("psys/boids.comp", &grid));
     for mode in 0..3 {
         for f in ["psys/draw.vert", "psys/draw.frag"] {
             v.push(with::<DrawIo>(f, &[kv("MODE", mode)]));
