@@ -923,40 +923,6 @@ fn boids_keep_their_count_and_the_speed_limit() {
     finish(&ctx);
 }
 
-/// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
-fn triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (p - a).length();
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return bp.length();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return (p - (a + ab * (d1 / (d1 - d3)))).length();
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return cp.length();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return (p - (a + ac * (d2 / (d2 - d6)))).length();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + (c - b) * w)).length();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    (p - (a + ab * (vb * denom) + ac * (vc * denom))).length()
-}
-
 #[test]
 fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     use fluidform::character::capsules;
@@ -1045,7 +1011,7 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
         let q = Vec3::from_slice(&d.pos[i as usize][..3]);
         let dist = tris
             .iter()
-            .map(|t| triangle_distance(q, t[0], t[1], t[2]))
+            .map(|t| common::tri_distance(q, t[0], t[1], t[2]))
             .fold(f32::MAX, f32::min);
         assert!(dist < 1e-3, "a birth {dist} m off the skin at {q}");
         ymin = ymin.min(q.y);
