@@ -72,6 +72,14 @@ vec3 own_velocity(inout uint s) {
     return v;
 }
 
+// The attributes every birth draws after its position and velocity (in this order).
+void attributes(inout uint s, out float size, out float life, out vec4 col) {
+    vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
+    size = max(sl.x, 0.0);
+    life = max(sl.y, 1e-4);
+    col = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
+}
+
 // A stateful birth at p moving with v: pop a free slot (none: refused, counted) and
 // append it to the alive list the next update reads (or, after it, the one drawn).
 void born(vec3 p, vec3 v, inout uint s, bool spawned) {
@@ -83,14 +91,15 @@ void born(vec3 p, vec3 v, inout uint s, bool spawned) {
         return;
     }
     uint slot = dead[d];
-    vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
-    float size = max(sl.x, 0.0), life = max(sl.y, 1e-4);
+    float size, life;
+    vec4 col;
+    attributes(s, size, life, col);
     pos[slot] = vec4(p, 0.0);
     // Verlet keeps the previous position: a Taylor step back, exact for gravity.
     vec3 back = p - v * pc.dt + 0.5 * sp.gravity.xyz * pc.dt * pc.dt;
     vel[slot] = vec4(sp.counts2.y == I_VERLET ? back : v, life);
     prev[slot] = vec4(p, size);
-    color[slot] = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
+    color[slot] = col;
     uint a = atomicAdd(c.alive[pc.cur], 1u);
     alive[pc.cur * pc.capacity + a] = slot;
     if (spawned) atomicAdd(c.spawned, 1u);
@@ -142,10 +151,12 @@ void main() {
     uint slot = (pc.head + i) % pc.capacity;
     vec4 old = pos[slot];
     if (old.w >= 0.0 && pc.source.w - old.w < vel[slot].w) atomicAdd(c.overwritten, 1u);
-    vec2 sl = sp.scalar_mean.xy + vec2(srnd(s), srnd(s)) * sp.scalar_var.xy;
+    float size, life;
+    vec4 col;
+    attributes(s, size, life, col);
     pos[slot] = vec4(p, pc.source.w);  // birth time
-    vel[slot] = vec4(v, max(sl.y, 1e-4));
-    prev[slot] = vec4(p, max(sl.x, 0.0));
-    color[slot] = clamp(sp.color_mean + srnd4(s) * sp.color_var, 0.0, 1.0);
+    vel[slot] = vec4(v, life);
+    prev[slot] = vec4(p, size);
+    color[slot] = col;
     atomicAdd(c.births, 1u);
 }

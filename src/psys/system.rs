@@ -454,10 +454,9 @@ impl ParticleSystem {
             Counters::UPDATE_ARGS,
         );
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ); // list length -> args
-        let after = StepPush { mode: 1, ..push };
-        passes.args.dispatch_groups(ctx, cmd, &bufs, &after, 1);
-        scopes.end(ctx, cmd);
         self.drawn = 1 - self.drawn;
+        self.record_draw_count(ctx, cmd, passes, f);
+        scopes.end(ctx, cmd);
     }
 
     /// Record the spawn's indirect dispatch over the events this frame's step recorded
