@@ -188,12 +188,12 @@ impl FrameWork for OrbitsWork<'_> {
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
         let (s, save) = (&self.scene, self.frames.save(frame));
         self.view
-            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, None, slot, save)
+            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, Default::default(), slot, save)
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         let save = self.frames.save(frame);
-        let pic = self.view.retire(ctx, slot, self.scene.n, save)?;
+        let pic = self.view.retire(ctx, slot, self.scene.n, save, None)?;
         self.frames.store(frame, pic)
     }
 }
@@ -252,6 +252,8 @@ struct SphWork<'a> {
     frames: Frames<'a>,
     export: Option<crate::export::ParticleExport>,
     targets: crate::scene::targets::SceneTargets,
+    /// The scene's particle systems, stepped once per frame after the fluid.
+    systems: Option<crate::psys::run::SceneSystems>,
 }
 
 impl FrameWork for SphWork<'_> {
@@ -284,20 +286,19 @@ impl FrameWork for SphWork<'_> {
         if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
             e.record(ctx, cmd, &self.st, slot, self.stepper.sim_time);
         }
+        if let Some(s) = &mut self.systems {
+            s.record_simulation(ctx, cmd, prof, frame, None)?;
+        }
         let save = self.frames.save(frame);
         let st = &self.st;
         let mesh = self.targets.draw();
-        self.view.record(
-            ctx,
-            cmd,
-            prof,
-            st.pos(),
-            st.attr(),
-            st.n,
-            mesh.as_ref(),
-            slot,
-            save,
-        )
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let layers = crate::viewer::Layers {
+            mesh: mesh.as_ref(),
+            overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
+        };
+        self.view
+            .record(ctx, cmd, prof, st.pos(), st.attr(), st.n, layers, slot, save)
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
@@ -307,7 +308,9 @@ impl FrameWork for SphWork<'_> {
             e.retire(frame, slot)?;
         }
         let save = self.frames.save(frame);
-        let pic = self.view.retire(ctx, slot, self.st.n, save)?;
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
+        let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
         self.frames.store(frame, pic)
     }
 }
@@ -319,6 +322,9 @@ impl SphWork<'_> {
             e.destroy(ctx);
         }
         self.view.destroy(ctx);
+        if let Some(s) = &mut self.systems {
+            s.destroy(ctx);
+        }
         self.targets.destroy(ctx);
         self.st.destroy(ctx);
         self.solver.destroy(ctx);
@@ -356,12 +362,20 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     if scene.emission.is_some() {
         uses.push(Group::Emission);
     }
+    if !scene.system.is_empty() {
+        uses.push(Group::Particles);
+    }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
     use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
     let sw = &scene.look.apply(sw);
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
+    crate::psys::scenes::set_integrator_draw(
+        &mut scene.system,
+        sw.particle.integrator,
+        sw.particle.draw,
+    );
     // Refused before any particle or buffer is made (the count is estimated, not built).
     scene.validate()?;
     scene.check_size(MAX_PARTICLES, BYTES_PER_PARTICLE, 0)?;
@@ -417,7 +431,10 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
                 .tank
                 .unwrap_or(true)
                 .then_some([scene.domain.min, scene.domain.max]);
-            Box::new(MetaballViewer::new(&ctx, sw, cam, st.n, SLOTS, tank, show)?)
+            let overlay = !scene.system.is_empty();
+            Box::new(MetaballViewer::new(
+                &ctx, sw, cam, st.n, SLOTS, tank, show, overlay,
+            )?)
         }
         // Spheres of half the rest spacing.
         RenderKind::Points => Box::new(PointsViewer::new(
@@ -431,6 +448,19 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     };
     let view = Guard::new(&ctx, view);
     let stepper = Guard::new(&ctx, Stepper::new(&ctx, &st, SLOTS)?);
+    let systems = match scene.system.is_empty() {
+        true => None,
+        false => Some(crate::psys::run::SceneSystems::new(
+            &ctx,
+            &scene.system,
+            stepper.frame_time as f32,
+            cam,
+            sw.frame.width(),
+            sw.frame.height(),
+            sw.common.seed,
+        )?),
+    };
+    let systems = Guard::new(&ctx, systems);
     let every = sw.export.export_every.unwrap_or(1);
     let export = sw
         .export
@@ -445,6 +475,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         frames: Frames::new(&opts.out, opts.save_every, frame_count),
         export,
         targets: targets.take(),
+        systems: systems.take(),
     };
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let memory = ctx.memory_bytes();
@@ -461,6 +492,14 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
             .targets
             .emission_summary(&ctx, simulated_seconds, &opts.out),
         Err(_) => Ok(None),
+    };
+    let particle_systems = match (&timings, &work.systems) {
+        (Ok(_), Some(s)) => s
+            .systems
+            .iter()
+            .map(|s| crate::psys::run::SystemStats::of(&ctx, s))
+            .collect::<Result<Vec<_>>>(),
+        _ => Ok(Vec::new()),
     };
     let sort = work.solver.search.sort;
     let exports = work
@@ -479,6 +518,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         character: character_stats?,
         control: control_stats?,
         emission: emission_stats?,
+        particle_systems: particle_systems?,
     };
     let config = RunConfig {
         command: "run".into(),
@@ -554,13 +594,17 @@ impl FrameWork for CharacterWork<'_> {
                 "a character scene with its mesh hidden".into(),
             ));
         };
+        let layers = crate::viewer::Layers {
+            mesh: m.as_ref(),
+            overlay: None,
+        };
         self.view
-            .record(ctx, cmd, prof, pos, pos, 0, m.as_ref(), slot, save)
+            .record(ctx, cmd, prof, pos, pos, 0, layers, slot, save)
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         let save = self.frames.save(frame);
-        let pic = self.view.retire(ctx, slot, 0, save)?;
+        let pic = self.view.retire(ctx, slot, 0, save, None)?;
         self.frames.store(frame, pic)
     }
 }

@@ -1,20 +1,38 @@
 //! How `run` shows particles: ray-marched metaballs with per-pixel lists, or the
 //! sphere-impostor particle view, behind one `View` trait; either draws a character's
-//! skinned mesh with them, depth-tested. Both write one PNG per saved frame.
+//! skinned mesh with them, depth-tested, and an overlay (particle systems): its opaque
+//! draws with the mesh, its blended ones over the finished picture, depth-tested against
+//! the fluid and the mesh. Both write one PNG per saved frame.
 use crate::config::{ShowMesh, Switches};
 use crate::error::Result;
-use crate::gpu::{sync, Buffer, ColorTarget, Context, Guard, Profiler};
+use crate::gpu::{sync, Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
 use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FrameStats, MetaballBuffers, MetaballRenderer, MetaballSettings};
 use crate::render::{points::PointsPush, Camera, PointsView};
 use ash::vk;
 use serde::{Deserialize, Serialize};
 
+/// Draws shown with a view's particles (particle systems), inside its rendering scopes:
+/// the opaque ones write depth; the blended ones only test it, drawn after everything
+/// opaque (the fluid included).
+pub trait Overlay {
+    fn draw_opaque(&self, ctx: &Context, cmd: vk::CommandBuffer);
+    fn draw_blended(&self, ctx: &Context, cmd: vk::CommandBuffer);
+    fn has_blended(&self) -> bool;
+}
+
+/// What a frame shows besides the particles.
+#[derive(Clone, Copy, Default)]
+pub struct Layers<'a> {
+    /// The character's mesh (a view made with a mesh view needs one each frame).
+    pub mesh: Option<&'a MeshDraw<'a>>,
+    pub overlay: Option<&'a dyn Overlay>,
+}
+
 /// A picture of `n` particles per frame.
 pub trait View {
-    /// Record the frame's picture of the particles at `pos` (colours in `attr`) and the
-    /// mesh, if any (a view made with a mesh view needs one each frame), whose writes the
-    /// caller made visible to compute, vertex shaders and copies.
+    /// Record the frame's picture of the particles at `pos` (colours in `attr`) and its
+    /// layers, whose writes the caller made visible to compute, vertex shaders and copies.
     #[allow(clippy::too_many_arguments)]
     fn record(
         &mut self,
@@ -24,18 +42,20 @@ pub trait View {
         pos: &Buffer,
         attr: &Buffer,
         n: u32,
-        mesh: Option<&MeshDraw>,
+        layers: Layers,
         slot: usize,
         save: bool,
     ) -> Result<()>;
     /// After the slot's fence: check the frame; its picture when `save` (it was recorded
-    /// with `save`).
+    /// with `save`). A frame redone here (a metaball list overflowed) draws `overlay` as
+    /// it is now.
     fn retire(
         &mut self,
         ctx: &Context,
         slot: usize,
         n: u32,
         save: bool,
+        overlay: Option<&dyn Overlay>,
     ) -> Result<Option<Picture<'_>>>;
     fn stats(&self) -> RenderSummary;
     fn destroy(&mut self, ctx: &Context);
@@ -115,18 +135,22 @@ impl View for PointsViewer {
         pos: &Buffer,
         attr: &Buffer,
         n: u32,
-        mesh: Option<&MeshDraw>,
+        layers: Layers,
         slot: usize,
         save: bool,
     ) -> Result<()> {
         prof.begin(ctx, cmd, PointsView::NAME);
         self.target
             .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-        if let (Some(v), Some(m)) = (&self.mesh, mesh) {
+        if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
             v.draw(ctx, cmd, m);
         }
         if n > 0 {
             self.view.draw(ctx, cmd, pos, attr, n, &self.push);
+        }
+        if let Some(o) = layers.overlay {
+            o.draw_opaque(ctx, cmd);
+            o.draw_blended(ctx, cmd);
         }
         self.target.end_rendering(ctx, cmd);
         prof.end(ctx, cmd);
@@ -144,6 +168,7 @@ impl View for PointsViewer {
         slot: usize,
         _: u32,
         save: bool,
+        _: Option<&dyn Overlay>,
     ) -> Result<Option<Picture<'_>>> {
         Ok(save.then(|| Picture {
             rgba: self.target.pixels(slot),
@@ -171,9 +196,12 @@ impl View for PointsViewer {
 pub struct MetaballViewer {
     renderer: MetaballRenderer,
     buffers: MetaballBuffers,
-    /// The mesh view and its colour + depth target, copied into the renderer's opaque
-    /// layer each frame.
-    mesh: Option<(MeshView, ColorTarget)>,
+    /// The mesh view, if the mesh is shown.
+    mesh: Option<MeshView>,
+    /// The colour + depth target of the opaque layer (the mesh and the overlay's opaque
+    /// draws), copied into the renderer's opaque layer each frame; the overlay's blended
+    /// draws go over the finished picture in it.
+    target: Option<ColorTarget>,
     /// Per-slot copies of the particle positions, so a frame can be redone.
     centers: Vec<Buffer>,
     cam: Camera,
@@ -181,7 +209,9 @@ pub struct MetaballViewer {
 }
 
 impl MetaballViewer {
-    /// `tank`: the container to draw around the fluid (min, max), if any.
+    /// `tank`: the container to draw around the fluid (min, max), if any; `overlay`:
+    /// frames come with an overlay.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
         sw: &Switches,
@@ -190,10 +220,11 @@ impl MetaballViewer {
         slots: usize,
         tank: Option<[[f32; 3]; 2]>,
         show: ShowMesh,
+        overlay: bool,
     ) -> Result<Self> {
         let mut settings = MetaballSettings::from_switches(sw)?;
         settings.tank = tank;
-        settings.opaque = show != ShowMesh::Off;
+        settings.opaque = show != ShowMesh::Off || overlay;
         let mesh = Guard::new(ctx, mesh_view(ctx, &cam, show)?);
         let target = match settings.opaque {
             true => Some(ColorTarget::new(ctx, settings.width, settings.height, 0)?),
@@ -214,11 +245,46 @@ impl MetaballViewer {
         Ok(Self {
             renderer: renderer.take(),
             buffers: buffers.take(),
-            mesh: mesh.take().zip(target.take()),
+            mesh: mesh.take(),
+            target: target.take(),
             centers: centers.take(),
             cam,
             totals,
         })
+    }
+}
+
+impl MetaballViewer {
+    /// After the picture: the overlay's blended draws over it (depth-tested against the
+    /// fluid and the opaque layer), then this slot's readbacks.
+    fn record_finish(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        overlay: Option<&dyn Overlay>,
+        slot: usize,
+    ) -> Result<()> {
+        // The march's pixels and depths (and stats) -> copies.
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
+        let b = &self.buffers;
+        if let Some(o) = overlay.filter(|o| o.has_blended()) {
+            let target = self.target.as_ref().ok_or_else(|| {
+                crate::Error::Param("a metaball view made without overlays was given one".into())
+            })?;
+            scopes.begin(ctx, cmd, "overlay");
+            target.load_layers(ctx, cmd, (&b.pixels, 0), (&b.scene_depth, 0));
+            target.begin_rendering_loaded(ctx, cmd);
+            o.draw_blended(ctx, cmd);
+            target.end_rendering(ctx, cmd);
+            // The load's read of the pixels -> this copy's write of them.
+            ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
+            target.copy_color_to(ctx, cmd, &b.pixels, 0);
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::TRANSFER_READ);
+            scopes.end(ctx, cmd);
+        }
+        self.renderer.record_readback(ctx, cmd, b, slot);
+        Ok(())
     }
 }
 
@@ -231,17 +297,24 @@ impl View for MetaballViewer {
         pos: &Buffer,
         _: &Buffer,
         n: u32,
-        mesh: Option<&MeshDraw>,
+        layers: Layers,
         slot: usize,
         _: bool,
     ) -> Result<()> {
-        if let Some((view, target)) = &self.mesh {
-            let m = mesh.ok_or_else(|| {
-                crate::Error::Param("a metaball view made to draw a mesh was given none".into())
-            })?;
+        if let Some(target) = &self.target {
             prof.begin(ctx, cmd, MeshView::NAME);
             target.begin_rendering(ctx, cmd, [0.0; 4]);
-            view.draw(ctx, cmd, m);
+            if let Some(view) = &self.mesh {
+                let m = layers.mesh.ok_or_else(|| {
+                    crate::Error::Param(
+                        "a metaball view made to draw a mesh was given none".into(),
+                    )
+                })?;
+                view.draw(ctx, cmd, m);
+            }
+            if let Some(o) = layers.overlay {
+                o.draw_opaque(ctx, cmd);
+            }
             target.end_rendering(ctx, cmd);
             let px = self.renderer.settings.pixels();
             target.copy_layers(ctx, cmd, &self.buffers.opaque, 0, px * 4);
@@ -255,7 +328,7 @@ impl View for MetaballViewer {
             sync::COMPUTE_READ | sync::GRAPHICS_READ,
         );
         prof.begin(ctx, cmd, "render");
-        let r = self.renderer.record(
+        let r = self.renderer.record_picture(
             ctx,
             cmd,
             prof,
@@ -263,10 +336,10 @@ impl View for MetaballViewer {
             &self.centers[slot],
             n,
             &self.cam,
-            slot,
         );
         prof.end(ctx, cmd);
-        r
+        r?;
+        self.record_finish(ctx, cmd, prof, layers.overlay, slot)
     }
 
     fn retire(
@@ -275,6 +348,7 @@ impl View for MetaballViewer {
         slot: usize,
         n: u32,
         save: bool,
+        overlay: Option<&dyn Overlay>,
     ) -> Result<Option<Picture<'_>>> {
         let mut st = self.renderer.frame_stats(&self.buffers, slot);
         if st.overflow > 0 {
@@ -292,6 +366,10 @@ impl View for MetaballViewer {
             )?;
             st = again;
             self.totals.overflow_redos += 1 + redos;
+            if overlay.is_some_and(|o| o.has_blended()) {
+                // render_sync redid the picture alone: the overlay over it again.
+                ctx.one_shot(|cmd| self.record_finish(ctx, cmd, &mut Labels, overlay, slot))??;
+            }
         }
         let t = &mut self.totals;
         t.max_fragments = t.max_fragments.max(st.fragments);
@@ -319,8 +397,10 @@ impl View for MetaballViewer {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        if let Some((v, t)) = &mut self.mesh {
+        if let Some(v) = &mut self.mesh {
             v.destroy(ctx);
+        }
+        if let Some(t) = &mut self.target {
             t.destroy(ctx);
         }
         self.buffers.destroy(ctx);

@@ -42,6 +42,7 @@ fn scene() -> Scene {
         targets: vec![],
         timeline: vec![],
         emission: None,
+        system: vec![],
     }
 }
 

@@ -787,8 +787,14 @@ fn type_changes_conserve_the_budget() {
     finish(&ctx);
 }
 
-/// Boids' steering on the CPU, brute force over the alive slots (boids.comp's rules).
-fn cpu_steer(spec: &SystemSpec, d: &fluidform::psys::system::StateDump, slot: u32) -> (Vec3, u32) {
+/// Boids' steering on the CPU, brute force over the alive slots (boids.comp's rules);
+/// `body`: the character's posed capsules (end, end, radius).
+fn cpu_steer(
+    spec: &SystemSpec,
+    d: &fluidform::psys::system::StateDump,
+    slot: u32,
+    body: &[(Vec3, Vec3, f32)],
+) -> (Vec3, u32) {
     let b = spec.boids.as_ref().unwrap();
     let p = Vec3::from_slice(&d.pos[slot as usize][..3]);
     let v = Vec3::from_slice(&d.vel[slot as usize][..3]);
@@ -811,23 +817,24 @@ fn cpu_steer(spec: &SystemSpec, d: &fluidform::psys::system::StateDump, slot: u3
     if n > 0 {
         a += b.alignment * (mv / n as f32 - v) + b.cohesion * (mp / n as f32 - p);
     }
-    // Avoidance of the room (a container) and the pillar (a capsule) ahead.
+    // Avoidance of the room (a container), a pillar or the body's capsules ahead.
     let ahead = p + v * b.look_ahead;
+    let capsule = |a0: Vec3, a1: Vec3, r: f32| {
+        let h = ((ahead - a0).dot(a1 - a0) / (a1 - a0).length_squared().max(1e-12)).clamp(0.0, 1.0);
+        let d = ahead - (a0 + h * (a1 - a0));
+        (d.length() < r).then(|| d.normalize())
+    };
     for c in &spec.collider {
-        let n = match c.kind {
+        let ns: Vec<Option<Vec3>> = match c.kind {
             ColliderKind::Box => {
                 let q = ahead.clamp(Vec3::from(c.min), Vec3::from(c.max));
-                (q != ahead).then(|| (q - ahead).normalize())
+                vec![(q != ahead).then(|| (q - ahead).normalize())]
             }
-            ColliderKind::Capsule => {
-                let (a0, a1) = (Vec3::from(c.a), Vec3::from(c.b));
-                let h = ((ahead - a0).dot(a1 - a0) / (a1 - a0).length_squared()).clamp(0.0, 1.0);
-                let d = ahead - (a0 + h * (a1 - a0));
-                (d.length() < c.radius).then(|| d.normalize())
-            }
-            _ => unreachable!("the flock has a room and a pillar"),
+            ColliderKind::Capsule => vec![capsule(Vec3::from(c.a), Vec3::from(c.b), c.radius)],
+            ColliderKind::Character => body.iter().map(|&(a0, a1, r)| capsule(a0, a1, r)).collect(),
+            _ => unreachable!("the flocks have rooms, pillars and bodies"),
         };
-        if let Some(n) = n {
+        for n in ns.into_iter().flatten() {
             a += b.avoidance * n;
         }
     }
@@ -906,7 +913,7 @@ fn boids_keep_their_count_and_the_speed_limit() {
     let mut worst = 0.0f32;
     let mut count_mismatch = 0;
     for &i in &d.alive {
-        let (a, n) = cpu_steer(&spec, &d, i);
+        let (a, n) = cpu_steer(&spec, &d, i, &[]);
         let g = steer[i as usize];
         count_mismatch += (g[3] as u32 != n) as u32;
         worst = worst.max((Vec3::from_slice(&g[..3]) - a).length() / (1.0 + a.length()));
@@ -970,29 +977,60 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
         kind: ColliderKind::Character,
         ..ColliderSpec::ground(0.0, 0.0, 1.0)
     }];
+    // Boids around the body steer away from its capsules ahead of them.
+    let mut flock = ballistic(Integrator::Euler, 1024);
+    flock.name = "flock".into();
+    flock.gravity = [0.0; 3];
+    flock.emitter.burst = 1024;
+    flock.emitter.rate = None;
+    flock.emitter.centre = [0.0, 1.0, 0.0];
+    flock.emitter.radius = 0.3;
+    flock.particle.velocity = Vary {
+        mean: [0.0; 3],
+        variance: [1.0; 3],
+    };
+    let mut boids = ParticleScene::built_in("flock").unwrap().system[0]
+        .boids
+        .clone()
+        .unwrap();
+    boids.bounds = [[-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]];
+    boids.radius = 0.15;
+    boids.separation_radius = 0.05;
+    boids.look_ahead = 0.1;
+    flock.boids = Some(boids);
+    flock.collider = rain.collider.clone();
     let mut systems = vec![
         ParticleSystem::new(&ctx, &passes, &skin, 0, 1).unwrap(),
         ParticleSystem::new(&ctx, &passes, &rain, 1, 2).unwrap(),
+        ParticleSystem::new(&ctx, &passes, &flock, 2, 3).unwrap(),
     ];
     let dt = 1.0 / 60.0;
-    ctx.one_shot(|cmd| {
-        for k in 0..60 {
-            let f = FrameInfo {
-                character: Some(link.bufs(&ch)),
-                ..frame(&cam, k, dt)
-            };
-            fluidform::psys::run::record_simulation(
-                &ctx,
-                cmd,
-                &mut Labels,
-                &passes,
-                &mut systems,
-                &f,
-            )
-            .unwrap();
-        }
-    })
-    .unwrap();
+    let step = |systems: &mut Vec<ParticleSystem>, frames: std::ops::Range<u64>| {
+        ctx.one_shot(|cmd| {
+            for k in frames {
+                let f = FrameInfo {
+                    character: Some(link.bufs(&ch)),
+                    ..frame(&cam, k, dt)
+                };
+                fluidform::psys::run::record_simulation(
+                    &ctx,
+                    cmd,
+                    &mut Labels,
+                    &passes,
+                    systems,
+                    &f,
+                )
+                .unwrap();
+            }
+        })
+        .unwrap();
+    };
+    // (The flock is checked while still around the body.)
+    step(&mut systems, 0..1);
+    let flock_state = systems[2].read(&ctx).unwrap();
+    step(&mut systems, 1..2);
+    let steer = systems[2].read_steer(&ctx).unwrap();
+    step(&mut systems, 2..60);
     let (p, _) = ch.ch.skinned_at(&mats, Skinning::Lbs).unwrap();
     let tris: Vec<[Vec3; 3]> = ch
         .ch
@@ -1042,6 +1080,22 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
         }
     }
     assert!(resting > 20, "only {resting} drops rest on the body");
+    // The flock's GPU steering against the CPU's, the body's capsules included.
+    let body: Vec<_> = posed.iter().map(|c| (c.a, c.b, c.r)).collect();
+    let (mut worst, mut avoiding, mut count_mismatch) = (0.0f32, 0, 0);
+    for &i in &flock_state.alive {
+        let (a, n) = cpu_steer(&flock, &flock_state, i, &body);
+        let (alone, _) = cpu_steer(&flock, &flock_state, i, &[]);
+        avoiding += ((a - alone).length() > 1e-3) as u32;
+        let g = steer[i as usize];
+        count_mismatch += (g[3] as u32 != n) as u32;
+        worst = worst.max((Vec3::from_slice(&g[..3]) - a).length() / (1.0 + a.length()));
+    }
+    assert_eq!(flock_state.alive.len(), 1024);
+    eprintln!("{avoiding} of 1024 boids look ahead into the body");
+    assert!(avoiding > 20, "only {avoiding} boids look ahead into the body");
+    assert!(count_mismatch <= 2, "{count_mismatch} boids saw other flockmates");
+    assert!(worst < 2e-3, "steering differs from the CPU's by {worst}");
     for s in &mut systems {
         s.destroy(&ctx);
     }
@@ -1050,4 +1104,193 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     ch.destroy(&ctx);
     passes.destroy(&ctx);
     finish(&ctx);
+}
+
+/// A fluid block at rest seen from the front, and a sheet of still particles (drawn as
+/// `draw`) across the view at depth `z` (none: no system).
+fn sheet_scene(draw: &str, z: Option<f32>) -> String {
+    let mut s = String::from(
+        r#"name = "sheet"
+frames = 1
+[domain]
+min = [0.0, 0.0, 0.0]
+max = [0.4, 0.4, 0.4]
+[fluid]
+eos = "tait"
+sound_speed = 20.0
+clamp_negative_pressure = true
+dt = 0.0005
+substeps = 2
+[[blocks]]
+min = [0.1, 0.0, 0.1]
+max = [0.3, 0.2, 0.3]
+[camera]
+eye = [0.2, 0.15, 1.6]
+target = [0.2, 0.1, 0.2]
+fov = 45.0
+[look]
+material = "phong"
+tank = false
+"#,
+    );
+    if let Some(z) = z {
+        let (sort, px) = match draw {
+            "points" => ("", "point_px = 6.0"),
+            _ => ("sort = \"counting\"", ""),
+        };
+        s += &format!(
+            r#"
+[[system]]
+name = "sheet"
+capacity = 8192
+draw = "{draw}"
+{sort}
+{px}
+gravity = [0.0, 0.0, 0.0]
+[system.emitter]
+shape = "box"
+centre = [0.2, 0.1, {z}]
+half = [0.6, 0.5, 0.0]
+burst = 6000
+[system.particle]
+size = {{ mean = 0.06, variance = 0.0 }}
+life = {{ mean = 100.0, variance = 0.0 }}
+color = {{ mean = [1.0, 0.2, 0.1, 1.0], variance = [0.0, 0.0, 0.0, 0.0] }}
+"#
+        );
+    }
+    s
+}
+
+#[test]
+fn particles_composite_with_the_metaball_fluid_by_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (96u32, 64u32);
+    let render = |name: &str, toml: String| -> image::RgbaImage {
+        let file = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&file, toml).unwrap();
+        let out = dir.path().join(name);
+        let (ws, hs) = (w.to_string(), h.to_string());
+        let o = fluidform(&[
+            "run",
+            "--scene",
+            file.to_str().unwrap(),
+            "--validation",
+            "--quiet",
+            "--width",
+            &ws,
+            "--height",
+            &hs,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", text(&o));
+        if name != "fluid" {
+            let sum = common::summary(&out);
+            let sys = &sum["stats"]["particle_systems"][0];
+            assert_eq!(sys["births"].as_u64(), Some(6000), "{name}: {sys}");
+            assert_eq!(sys["alive"].as_u64(), Some(6000), "{name}: {sys}");
+        }
+        image::open(out.join("frame_0000.png")).unwrap().to_rgba8()
+    };
+    // Pixels of a world point, as the march maps them (row 0 at NDC y = -1).
+    let cam = Camera::look_at(
+        Vec3::new(0.2, 0.15, 1.6),
+        Vec3::new(0.2, 0.1, 0.2),
+        45.0,
+        w as f32 / h as f32,
+    );
+    let pixel = |p: Vec3| {
+        let c = cam.view_proj() * p.extend(1.0);
+        let ndc = c.truncate() / c.w;
+        let x = ((ndc.x + 1.0) * 0.5 * w as f32 - 0.5).round() as i32;
+        let y = ((ndc.y + 1.0) * 0.5 * h as f32 - 0.5).round() as i32;
+        assert!(x >= 2 && y >= 2 && x < w as i32 - 2 && y < h as i32 - 2, "{p} -> {x},{y}");
+        (x, y)
+    };
+    // Mean channel difference of two frames over the 5 x 5 pixels around `at`.
+    let diff = |a: &image::RgbaImage, b: &image::RgbaImage, (x, y): (i32, i32)| {
+        let mut sum = 0.0;
+        for dy in -2..=2 {
+            for dx in -2..=2 {
+                let (pa, pb) = (
+                    a.get_pixel((x + dx) as u32, (y + dy) as u32),
+                    b.get_pixel((x + dx) as u32, (y + dy) as u32),
+                );
+                sum += (0..3)
+                    .map(|k| (pa[k] as f32 - pb[k] as f32).abs())
+                    .sum::<f32>();
+            }
+        }
+        sum / 75.0
+    };
+    let fluid = render("fluid", sheet_scene("sprites", None));
+    // The block's front face, and the sheet beside the block.
+    let (behind, front) = (-0.3, 0.9);
+    let water = pixel(Vec3::new(0.2, 0.08, 0.3));
+    let beside = pixel(Vec3::new(-0.25, 0.45, behind));
+    for draw in ["sprites", "points"] {
+        let back = render(&format!("{draw}-behind"), sheet_scene(draw, Some(behind)));
+        let over = render(&format!("{draw}-front"), sheet_scene(draw, Some(front)));
+        // Behind the water: hidden by it, seen beside it; in front: over it.
+        let (hidden, seen, covers) = (
+            diff(&back, &fluid, water),
+            diff(&back, &fluid, beside),
+            diff(&over, &fluid, water),
+        );
+        eprintln!("{draw}: behind the water {hidden:.2}, beside it {seen:.2}, in front {covers:.2}");
+        assert!(hidden < 2.0, "{draw}: the sheet behind shows through the water ({hidden})");
+        assert!(seen > 30.0, "{draw}: the sheet behind is missing beside the water ({seen})");
+        assert!(covers > 30.0, "{draw}: the sheet in front does not cover the water ({covers})");
+    }
+}
+
+#[test]
+fn sph_scenes_play_particle_systems_and_refuse_what_they_cannot() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("spray");
+    let spray = format!("{}/tests/scenes/spray.toml", env!("CARGO_MANIFEST_DIR"));
+    let o = fluidform(&[
+        "run",
+        "--scene",
+        &spray,
+        "--frames",
+        "3",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--validation",
+        "--quiet",
+        "--integrator",
+        "verlet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let sum = common::summary(&out);
+    let systems = sum["stats"]["particle_systems"].as_array().unwrap();
+    assert_eq!(systems.len(), 2);
+    assert!(systems[0]["births"].as_u64().unwrap() > 0, "{systems:?}");
+    assert_eq!(systems[1]["alive"].as_u64(), Some(300), "{systems:?}");
+    assert!(systems.iter().all(|s| s["integrator"] == "verlet"));
+    assert!(sum["stats"]["particles"].as_u64().unwrap() > 1000);
+    // A system on the character, and systems with no fluid, are refused by name.
+    let body = sheet_scene("sprites", Some(0.0))
+        + "[[system.collider]]\nkind = \"character\"\n";
+    let alone = "name = \"alone\"\n[domain]\nmin = [-1.0, 0.0, -1.0]\nmax = [1.0, 2.0, 1.0]\n\
+                 [character]\nfile = \"builtin:walker\"\n"
+        .to_string()
+        + &sheet_scene("sprites", Some(0.0))[sheet_scene("sprites", None).len()..];
+    for (name, toml, expect) in [
+        ("body", body, "do not reach yet"),
+        ("alone", alone, "without fluid"),
+    ] {
+        let file = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&file, toml).unwrap();
+        let o = fluidform(&["run", "--scene", file.to_str().unwrap(), "--quiet"]);
+        assert!(!o.status.success(), "{name} ran");
+        assert!(text(&o).contains(expect), "{name}: {}", text(&o));
+        assert_eq!(text(&o).trim().lines().count(), 1, "{}", text(&o));
+    }
 }

@@ -15,6 +15,8 @@ layout(std430, binding = BOIDS_B_POS) readonly buffer Pos { vec4 pos[]; };
 layout(std430, binding = BOIDS_B_VEL) readonly buffer Vel { vec4 vel[]; };
 layout(std430, binding = BOIDS_B_STEER) writeonly buffer Steer { vec4 steer[]; };
 layout(std430, binding = BOIDS_B_PERM) readonly buffer Perm { uint perm[]; };  // sorted -> slot
+// The scene character's posed capsules (state.glsl), for avoidance.
+layout(std430, binding = BOIDS_B_CAPSULES) readonly buffer Capsules { vec4 capsules[]; };
 #define NB_B_KEYS BOIDS_B_NB_KEYS
 #define NB_B_START BOIDS_B_NB_START
 #define NB_B_END BOIDS_B_NB_END
@@ -56,8 +58,13 @@ void main() {
     // Avoidance: the point the boid reaches in the look-ahead time, pushed off colliders.
     vec3 ahead = p + v * sp.boids[3].x;
     for (uint k = 0u; k < sp.counts.y; k++) {
-        vec3 q = ahead, nrm;
-        if (contact(sp.colliders[k], q, nrm)) a += w.w * nrm;
+        bool body = uint(sp.colliders[k].a.w) == C_CHARACTER;
+        for (uint q = 0u; q < (body ? pc.capsules : 1u); q++) {
+            Collider col = sp.colliders[k];
+            if (body) col = posed_capsule(col, capsules[2u * q], capsules[2u * q + 1u]);
+            vec3 x = ahead, nrm;
+            if (contact(col, x, nrm)) a += w.w * nrm;
+        }
     }
     float amax = sp.boids[0].w, len = length(a);
     if (len > amax) a *= amax / len;

@@ -2,6 +2,13 @@
 #ifndef PSYS_COLLIDE_GLSL
 #define PSYS_COLLIDE_GLSL
 #include "common.glsl"
+// One of the scene character's posed capsules (e0: end 0 and radius, e1: end 1), with
+// the response of its collider `col` (kind C_CHARACTER).
+Collider posed_capsule(Collider col, vec4 e0, vec4 e1) {
+    col.a = vec4(e0.xyz, float(C_CAPSULE));
+    col.b = vec4(e1.xyz, e0.w);
+    return col;
+}
 // Push p out of (or back into) collider k; true on contact, with the surface normal.
 bool contact(Collider k, inout vec3 p, out vec3 n) {
     uint kind = uint(k.a.w);

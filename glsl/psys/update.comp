@@ -95,10 +95,7 @@ void main() {
       bool body = uint(sp.colliders[k].a.w) == C_CHARACTER;
       for (uint q = 0u; q < (body ? pc.capsules : 1u); q++) {
         Collider col = sp.colliders[k];
-        if (body) {  // one of the character's capsules, with the collider's response
-            col.a = vec4(capsules[2u * q].xyz, float(C_CAPSULE));
-            col.b = vec4(capsules[2u * q + 1u].xyz, capsules[2u * q].w);
-        }
+        if (body) col = posed_capsule(col, capsules[2u * q], capsules[2u * q + 1u]);
         vec3 n;
         if (contact(col, p, n)) {
             hit = true;

@@ -46,6 +46,7 @@ impl ColorTarget {
                 COLOR_FORMAT,
                 vk::ImageUsageFlags::COLOR_ATTACHMENT
                     | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST
                     | vk::ImageUsageFlags::STORAGE,
             )?,
         );
@@ -56,7 +57,9 @@ impl ColorTarget {
                 width,
                 height,
                 DEPTH_FORMAT,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
             )?,
         );
         let mut readbacks = Guard::new(ctx, Vec::new());
@@ -85,21 +88,47 @@ impl ColorTarget {
 
     /// Begin dynamic rendering, clearing colour to `clear` and depth to 1.
     pub fn begin_rendering(&self, ctx: &Context, cmd: vk::CommandBuffer, clear: [f32; 4]) {
+        self.begin_with(ctx, cmd, Some(clear));
+    }
+
+    /// Begin dynamic rendering over the colour and depth `load_layers` just copied in.
+    pub fn begin_rendering_loaded(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        self.begin_with(ctx, cmd, None);
+    }
+
+    fn begin_with(&self, ctx: &Context, cmd: vk::CommandBuffer, clear: Option<[f32; 4]>) {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
-        // The previous frame's copy-out read the image: wait for it before overwriting.
+        // Cleared: the previous frame's copy-out read the image; wait for it before
+        // overwriting. Loaded: the copies in wrote both images.
+        let (color_src, depth_src, load) = match clear {
+            Some(_) => (
+                (
+                    S::ALL_COMMANDS,
+                    A::MEMORY_READ | A::MEMORY_WRITE,
+                    L::UNDEFINED,
+                ),
+                (
+                    S::LATE_FRAGMENT_TESTS | S::COPY,
+                    A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                    L::UNDEFINED,
+                ),
+                vk::AttachmentLoadOp::CLEAR,
+            ),
+            None => (
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+                vk::AttachmentLoadOp::LOAD,
+            ),
+        };
         image_barrier(
             ctx,
             cmd,
             self.color.raw,
             vk::ImageAspectFlags::COLOR,
-            (
-                S::ALL_COMMANDS,
-                A::MEMORY_READ | A::MEMORY_WRITE,
-                L::UNDEFINED,
-            ),
+            color_src,
             (
                 S::COLOR_ATTACHMENT_OUTPUT,
-                A::COLOR_ATTACHMENT_WRITE,
+                A::COLOR_ATTACHMENT_WRITE | A::COLOR_ATTACHMENT_READ,
                 L::COLOR_ATTACHMENT_OPTIMAL,
             ),
         );
@@ -108,21 +137,18 @@ impl ColorTarget {
             cmd,
             self.depth.raw,
             vk::ImageAspectFlags::DEPTH,
-            (
-                S::LATE_FRAGMENT_TESTS | S::COPY,
-                A::DEPTH_STENCIL_ATTACHMENT_WRITE,
-                L::UNDEFINED,
-            ),
+            depth_src,
             (
                 S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
                 A::DEPTH_STENCIL_ATTACHMENT_WRITE | A::DEPTH_STENCIL_ATTACHMENT_READ,
                 L::DEPTH_ATTACHMENT_OPTIMAL,
             ),
         );
+        let clear = clear.unwrap_or([0.0; 4]);
         let color = [vk::RenderingAttachmentInfo::default()
             .image_view(self.color.view)
             .image_layout(L::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(load)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 color: vk::ClearColorValue { float32: clear },
@@ -130,7 +156,7 @@ impl ColorTarget {
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(self.depth.view)
             .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(load)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
@@ -244,6 +270,52 @@ impl ColorTarget {
                 &[region],
             );
         }
+    }
+
+    /// The reverse of `copy_layers`: colour (RGBA8) and depth (f32, 0..1) from
+    /// (buffer, byte offset), tightly packed rows, whose writes the caller made visible to
+    /// copies; then `begin_rendering_loaded`. Waits for the images' previous uses.
+    pub fn load_layers(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        color: (&super::Buffer, u64),
+        depth: (&super::Buffer, u64),
+    ) {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        for (image, aspect, (src, at)) in [
+            (&self.color, vk::ImageAspectFlags::COLOR, color),
+            (&self.depth, vk::ImageAspectFlags::DEPTH, depth),
+        ] {
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                aspect,
+                (
+                    S::ALL_COMMANDS,
+                    A::MEMORY_READ | A::MEMORY_WRITE,
+                    L::UNDEFINED,
+                ),
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+            );
+            let region = self.region(aspect, at);
+            unsafe {
+                ctx.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    src.raw,
+                    image.raw,
+                    L::TRANSFER_DST_OPTIMAL,
+                    &[region],
+                )
+            };
+        }
+    }
+
+    /// The colour image into `dst` at byte `at` after rendering (the caller makes it
+    /// visible).
+    pub fn copy_color_to(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: &super::Buffer, at: u64) {
+        self.copy_color(ctx, cmd, dst.raw, at);
     }
 
     /// RGBA8 pixels of the frame last copied out of `slot` (valid after its fence).

@@ -272,7 +272,7 @@ crate::gpu_interface! {
     /// glsl/psys/boids.comp (the nb_* bindings are the neighbour grid's cells)
     pub BoidsIo / BoidsBufs: "BOIDS", push StepPush {
         params = 0, counters = 1, alive = 2, pos = 3, vel = 4, steer = 5, perm = 6,
-        nb_keys = 7, nb_start = 8, nb_end = 9, nb_box = 10,
+        nb_keys = 7, nb_start = 8, nb_end = 9, nb_box = 10, capsules = 11,
     }
 }
 

@@ -2,6 +2,7 @@
 use super::character::{CharacterBufs, CharacterLink};
 use super::gpu::Passes;
 use super::scenes::ParticleScene;
+use super::spec::SystemSpec;
 use super::system::{FrameInfo, ParticleSystem};
 use crate::config::{Group, Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
@@ -98,9 +99,11 @@ pub struct SceneSystems {
 }
 
 impl SceneSystems {
+    /// `specs` stepped `dt` seconds per frame.
     pub fn new(
         ctx: &Context,
-        scene: &ParticleScene,
+        specs: &[SystemSpec],
+        dt: f32,
         cam: Camera,
         width: u32,
         height: u32,
@@ -108,7 +111,7 @@ impl SceneSystems {
     ) -> Result<Self> {
         let passes = Guard::new(ctx, Passes::new(ctx)?);
         let mut systems = Guard::new(ctx, Vec::new());
-        for (i, spec) in scene.system.iter().enumerate() {
+        for (i, spec) in specs.iter().enumerate() {
             systems.push(ParticleSystem::new(
                 ctx,
                 &passes,
@@ -121,7 +124,7 @@ impl SceneSystems {
             passes: passes.take(),
             systems: systems.take(),
             cam,
-            dt: scene.dt,
+            dt,
             width,
             height,
         })
@@ -148,11 +151,20 @@ impl SceneSystems {
         record_simulation(ctx, cmd, prof, &self.passes, &mut self.systems, &f)
     }
 
-    /// Record every system's draw (inside a rendering scope).
-    pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: u64) {
+    /// Record the draws (inside a rendering scope) of the systems drawn as points
+    /// (opaque, depth-written) or of the others (alpha-blended, depth-tested only).
+    pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: u64, opaque: bool) {
         let f = self.frame(frame);
-        for s in &self.systems {
+        for s in self.systems.iter().filter(|s| s.opaque() == opaque) {
             s.record_draw(ctx, cmd, &self.passes, &f);
+        }
+    }
+
+    /// Frame `frame`'s draws as a view's overlay.
+    pub fn at(&self, frame: u64) -> SystemsFrame<'_> {
+        SystemsFrame {
+            scene: self,
+            frame,
         }
     }
 
@@ -164,6 +176,26 @@ impl SceneSystems {
     }
 }
 crate::impl_destroy!(SceneSystems);
+
+/// A scene's systems drawn at a frame, as a view's overlay.
+pub struct SystemsFrame<'a> {
+    scene: &'a SceneSystems,
+    frame: u64,
+}
+
+impl crate::viewer::Overlay for SystemsFrame<'_> {
+    fn draw_opaque(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        self.scene.record_draws(ctx, cmd, self.frame, true);
+    }
+
+    fn draw_blended(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        self.scene.record_draws(ctx, cmd, self.frame, false);
+    }
+
+    fn has_blended(&self) -> bool {
+        self.scene.systems.iter().any(|s| !s.opaque())
+    }
+}
 
 /// Frame `frame` of a scene stepping `dt` per frame, drawn `width` x `height` by `cam`.
 pub fn frame_info(cam: &Camera, dt: f32, frame: u64, width: u32, height: u32) -> FrameInfo<'_> {
@@ -314,7 +346,9 @@ impl FrameWork for ParticleWork<'_> {
         {
             v.draw(ctx, cmd, &ch.surface());
         }
-        self.scene.record_draws(ctx, cmd, frame);
+        // Opaque points first, so the blended draws after them are depth-tested against them.
+        self.scene.record_draws(ctx, cmd, frame, true);
+        self.scene.record_draws(ctx, cmd, frame, false);
         self.target.end_rendering(ctx, cmd);
         prof.end(ctx, cmd);
         if self.frames.save(frame) {
@@ -358,7 +392,7 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
     );
     let systems = Guard::new(
         &ctx,
-        SceneSystems::new(&ctx, &scene, cam, w, h, sw.common.seed)?,
+        SceneSystems::new(&ctx, &scene.system, scene.dt, cam, w, h, sw.common.seed)?,
     );
     let body = match &scene.character {
         Some(desc) => {

@@ -280,14 +280,13 @@ impl ParticleScene {
             path: name_or_path.into(),
             source: e,
         })?;
-        // Only files with [[system]] are particle scenes.
-        // A file too malformed to parse is still one when it declares [[system]], so its
-        // error is the particle scene's, not the SPH loader's.
+        // Only files with [[system]] and no fluid [domain] are particle scenes (SPH scenes
+        // may hold systems too). A file too malformed to parse is still one when it
+        // declares [[system]] and no [domain], so its error is the particle scene's.
+        let declares = |table: &str| text.lines().any(|l| l.trim_start().starts_with(table));
         let is_particles = match text.parse::<toml::Table>() {
-            Ok(t) => t.contains_key("system"),
-            Err(_) => text
-                .lines()
-                .any(|l| l.trim_start().starts_with("[[system]]")),
+            Ok(t) => t.contains_key("system") && !t.contains_key("domain"),
+            Err(_) => declares("[[system]]") && !declares("[domain]"),
         };
         if !is_particles {
             return Ok(None);
@@ -324,33 +323,10 @@ impl ParticleScene {
                 self.name
             )));
         }
-        for (i, s) in self.system.iter().enumerate() {
-            if self.system[..i].iter().any(|o| o.name == s.name) {
-                return Err(Error::Param(format!(
-                    "scene {}: two systems named '{}'",
-                    self.name, s.name
-                )));
-            }
-            s.validate()?;
-            for ev in &s.event {
-                let Some(t) = self.system.iter().find(|t| t.name == ev.spawn) else {
-                    return Err(Error::Param(format!(
-                        "scene {}: system '{}' spawns '{}', which is not a [[system]] of it",
-                        self.name, s.name, ev.spawn
-                    )));
-                };
-                if t.integrator() == Integrator::Closed {
-                    return Err(Error::Unsupported(format!(
-                        "scene {}: '{}' is spawned by events, so it needs state: --integrator euler or verlet, not closed",
-                        self.name, t.name
-                    )));
-                }
-            }
-        }
-        Ok(())
+        validate_systems(&self.name, &self.system)
     }
 
-    /// The switches applied: --integrator and --draw to every system, --sort to every
+    /// The switches applied: --integrator and --draw to every system (`set_integrator_draw`), --sort to every
     /// sorted (non-point) one, --particles as every system's capacity with its birth rate
     /// scaled to match.
     pub fn with_switches(
@@ -360,13 +336,8 @@ impl ParticleScene {
         sort: Option<SortAlgo>,
         particles: Option<u32>,
     ) -> Result<Self> {
+        set_integrator_draw(&mut self.system, integrator, draw);
         for s in &mut self.system {
-            if let Some(i) = integrator {
-                s.integrator = Some(i);
-            }
-            if let Some(d) = draw {
-                s.draw = Some(d);
-            }
             if let Some(n) = particles {
                 let k = n as f32 / s.capacity as f32;
                 if let Some(r) = &mut s.emitter.rate {
@@ -499,5 +470,50 @@ fn rain() -> ParticleScene {
             path_speed: speed,
             ..CharacterDesc::new("builtin:walker")
         }),
+    }
+}
+
+/// A scene's systems checked together: unique names, each system's spec, and the
+/// systems its events spawn (present, and with state).
+pub fn validate_systems(scene: &str, systems: &[SystemSpec]) -> Result<()> {
+    for (i, s) in systems.iter().enumerate() {
+        if systems[..i].iter().any(|o| o.name == s.name) {
+            return Err(Error::Param(format!(
+                "scene {scene}: two systems named '{}'",
+                s.name
+            )));
+        }
+        s.validate()?;
+        for ev in &s.event {
+            let Some(t) = systems.iter().find(|t| t.name == ev.spawn) else {
+                return Err(Error::Param(format!(
+                    "scene {scene}: system '{}' spawns '{}', which is not a [[system]] of it",
+                    s.name, ev.spawn
+                )));
+            };
+            if t.integrator() == Integrator::Closed {
+                return Err(Error::Unsupported(format!(
+                    "scene {scene}: '{}' is spawned by events, so it needs state: --integrator euler or verlet, not closed",
+                    t.name
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// --integrator and --draw applied to every system.
+pub fn set_integrator_draw(
+    systems: &mut [SystemSpec],
+    integrator: Option<Integrator>,
+    draw: Option<SpriteMode>,
+) {
+    for s in systems {
+        if let Some(i) = integrator {
+            s.integrator = Some(i);
+        }
+        if let Some(d) = draw {
+            s.draw = Some(d);
+        }
     }
 }

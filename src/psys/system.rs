@@ -124,9 +124,15 @@ impl ParticleSystem {
             + cap * 4 * 5
             + cap * spec.event.len() as u64 * EVENT_BYTES
             + if spec.sort() == SortAlgo::Counting {
-                cap * 12
+                cap * 12 + DEPTH_CELLS as u64 * 12
             } else {
                 0
+            }
+            // Boids: steering, and the grid's keys, permutation, sorted positions, one
+            // neighbour count and list entry per slot, counting-sort scratch and cell ranges.
+            + match &spec.boids {
+                Some(b) => cap * 68 + (b.grid().cells() + 1) * 12,
+                None => 0,
             };
         if need > ctx.info.device_local_bytes {
             return Err(Error::Param(format!(
@@ -256,6 +262,11 @@ impl ParticleSystem {
     /// last step (tests).
     pub fn read_steer(&self, ctx: &Context) -> Result<Vec<[f32; 4]>> {
         ctx.readback(&self.steer, 0, self.steer.size as usize / 16)
+    }
+
+    /// Drawn as points: opaque and depth-written (the other modes are alpha-blended).
+    pub fn opaque(&self) -> bool {
+        self.mode == SpriteMode::Points
     }
 
     pub fn closed(&self) -> bool {
@@ -433,6 +444,7 @@ impl ParticleSystem {
                 nb_start,
                 nb_end,
                 nb_box: nb.box_buffer(),
+                capsules: bufs.capsules,
             };
             passes.boids.dispatch_indirect(
                 ctx,

@@ -116,6 +116,9 @@ pub struct SphRunStats {
     pub control: Option<crate::scene::targets::ControlSummary>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<crate::scene::emission::EmissionStats>,
+    /// The scene's particle systems, if any.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub particle_systems: Vec<crate::psys::run::SystemStats>,
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

@@ -102,6 +102,10 @@ pub struct Scene {
     /// The character sheds particles (seed 002): slots recycled by Emit.
     #[serde(default)]
     pub emission: Option<crate::scene::emission::EmissionDesc>,
+    /// Particle systems (seed 003) played with the fluid and drawn with it, composited
+    /// by depth; stepped once per frame of `frame_time`.
+    #[serde(default)]
+    pub system: Vec<crate::psys::spec::SystemSpec>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -261,6 +265,7 @@ fn liquid(
         targets: vec![],
         timeline: vec![],
         emission: None,
+        system: vec![],
     }
 }
 
@@ -370,6 +375,7 @@ fn trail(
             life_limit: Some(life),
             ..crate::scene::emission::EmissionDesc::new(slots)
         }),
+        system: vec![],
     }
 }
 
@@ -404,6 +410,7 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         targets: vec![],
         timeline: vec![],
         emission: None,
+        system: vec![],
     }
 }
 
@@ -483,6 +490,7 @@ impl Scene {
                 targets: vec![],
                 timeline: vec![],
                 emission: None,
+                system: vec![],
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -513,6 +521,7 @@ impl Scene {
                 targets: vec![],
                 timeline: vec![],
                 emission: None,
+                system: vec![],
             },
             // A liquid character: a pool rises into the built-in walker (control particles,
             // adaptive pressure), follows its walk at half speed, and is released at 1.5 s.
@@ -660,6 +669,7 @@ impl Scene {
                 targets: vec![],
                 timeline: vec![],
                 emission: None,
+                system: vec![],
             },
             _ => return None,
         })
@@ -802,7 +812,27 @@ impl Scene {
                 self.name
             )));
         }
-        Ok(())
+        self.validate_systems()
+    }
+
+    /// Particle systems play with the fluid, apart from the character.
+    fn validate_systems(&self) -> Result<()> {
+        if self.system.is_empty() {
+            return Ok(());
+        }
+        if !self.has_fluid() {
+            return Err(Error::Param(format!(
+                "scene {}: [[system]] without fluid: a character with particle systems is a particle scene (no [domain])",
+                self.name
+            )));
+        }
+        if let Some(s) = self.system.iter().find(|s| s.uses_character()) {
+            return Err(Error::Unsupported(format!(
+                "scene {}: system '{}' emits from or collides with the character, which SPH scenes' systems do not reach yet (a particle scene's [character] does)",
+                self.name, s.name
+            )));
+        }
+        crate::psys::scenes::validate_systems(&self.name, &self.system)
     }
 
     /// The names of the control targets: "character" for `[character]` with `[control]`,

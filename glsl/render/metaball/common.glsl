@@ -59,6 +59,8 @@ layout(std430, binding = MB_B_SKY) readonly buffer Sky { uint sky[]; };  // RGBA
 layout(std430, binding = MB_B_DEPTHS) buffer Depths { float depths[]; };  // view depths
 // Opaque layer (a character's mesh): W*H RGBA8 colours, then W*H depths (0..1, 1 = none).
 layout(std430, binding = MB_B_OPAQUE) readonly buffer Opaque { uint opaque[]; };
+// With the opaque layer: the NDC depth of the first surface each primary ray meets (march.comp).
+layout(std430, binding = MB_B_SCENE_DEPTH) writeonly buffer SceneDepth { float scene_depth[]; };
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
 

@@ -346,6 +346,15 @@ void main() {
     color = with_tank(color, o, d, min(dbg.x >= 0.0 ? dbg.x : 1e30, t_opaque));
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
+    if (P.opaque != 0u) {
+        // Layers drawn over the picture (blended particles) are depth-tested against it.
+        float z = uintBitsToFloat(opaque[P.width * P.height + id]);
+        if (dbg.x >= 0.0) {
+            vec4 c = P.view_proj * vec4(o + d * dbg.x, 1.0);
+            z = min(z, c.z / c.w);
+        }
+        scene_depth[id] = z;
+    }
     if (P.debug != 0u) debug_out[id] = dbg;
     if (longest > 0u) atomicMax(stats.longest, longest);
     if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);

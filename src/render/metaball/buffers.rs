@@ -25,6 +25,9 @@ pub struct MetaballBuffers {
     pub(super) depths: Buffer,
     /// The opaque layer the caller draws (settings.opaque): W*H RGBA8, then W*H f32 depths.
     pub opaque: Buffer,
+    /// With the opaque layer: per pixel, the NDC depth of the first surface the primary
+    /// ray meets (fluid or opaque layer; 1 = none), for layers drawn over the picture.
+    pub scene_depth: Buffer,
     pub(super) sky_size: (u32, u32),
     pub(super) bounds: BoundsBuffers,
     pub(super) scan: ScanScratch,
@@ -69,6 +72,7 @@ impl MetaballBuffers {
             &mut self.sky,
             &mut self.depths,
             &mut self.opaque,
+            &mut self.scene_depth,
         ] {
             ctx.destroy_buffer(b);
         }
@@ -130,6 +134,7 @@ impl MetaballBuffers {
             only(s.sorts_lists(), n_capacity.max(1) * 4),
         )?;
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
+        let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
         let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
         let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);
         let mut stats_readback = Guard::new(ctx, Vec::new());
@@ -162,6 +167,7 @@ impl MetaballBuffers {
                 sky: sky.take(),
                 depths: depths.take(),
                 opaque: opaque.take(),
+                scene_depth: scene_depth.take(),
                 sky_size: (sky_w, sky_h),
                 bounds: bounds.take(),
                 scan: scan.take(),

@@ -23,6 +23,7 @@ crate::gpu_interface! {
     pub MetaballIo / MetaballBufs: "MB", push () {
         params = 0, centers = 1, bounds = 2, offsets = 3, list = 4, heads = 5, nodes = 6,
         stats = 7, pixels = 8, debug = 9, sky = 10, depths = 11, opaque = 12,
+        scene_depth = 13,
     }
 }
 
@@ -152,6 +153,7 @@ impl MetaballRenderer {
             sky: &b.sky,
             depths: &b.depths,
             opaque: &b.opaque,
+            scene_depth: &b.scene_depth,
         }
     }
 
@@ -168,6 +170,25 @@ impl MetaballRenderer {
         n: u32,
         cam: &Camera,
         slot: usize,
+    ) -> Result<()> {
+        self.record_picture(ctx, cmd, scopes, b, centers, n, cam)?;
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // pixels, stats -> copies
+        self.record_readback(ctx, cmd, b, slot);
+        Ok(())
+    }
+
+    /// `record` without the readbacks: the picture in `b.pixels` (and `b.scene_depth` with
+    /// the opaque layer), for layers drawn over it before `record_readback`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_picture(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        b: &MetaballBuffers,
+        centers: &Buffer,
+        n: u32,
+        cam: &Camera,
     ) -> Result<()> {
         let s = &self.settings;
         let (w, h) = (s.width, s.height);
@@ -270,11 +291,22 @@ impl MetaballRenderer {
         scopes.begin(ctx, cmd, "march");
         self.march.dispatch_groups(ctx, cmd, &bufs, &(), groups);
         scopes.end(ctx, cmd);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // pixels, stats -> copies
+        Ok(())
+    }
+
+    /// Copy the stats and pixels (made visible to copies by the caller) into this slot's
+    /// readbacks.
+    pub fn record_readback(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        b: &MetaballBuffers,
+        slot: usize,
+    ) {
+        let px = self.settings.pixels();
         ctx.copy(cmd, &b.stats, 0, &b.stats_readback[slot], 0, GpuStats::SIZE);
         ctx.copy(cmd, &b.pixels, 0, &b.pixels_readback[slot], 0, px * 4);
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // readbacks -> the host
-        Ok(())
     }
 
     /// The statistics of the frame last rendered in `slot` (after its fence).
