@@ -187,8 +187,17 @@ impl FrameWork for OrbitsWork<'_> {
         // New positions -> the point view's vertex shader.
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
         let (s, save) = (&self.scene, self.frames.save(frame));
-        self.view
-            .record(ctx, cmd, prof, &s.pos, &s.color, s.n, Default::default(), slot, save)
+        self.view.record(
+            ctx,
+            cmd,
+            prof,
+            &s.pos,
+            &s.color,
+            s.n,
+            Default::default(),
+            slot,
+            save,
+        )
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
@@ -297,8 +306,17 @@ impl FrameWork for SphWork<'_> {
             mesh: mesh.as_ref(),
             overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
         };
-        self.view
-            .record(ctx, cmd, prof, st.pos(), st.attr(), st.n, layers, slot, save)
+        self.view.record(
+            ctx,
+            cmd,
+            prof,
+            st.pos(),
+            st.attr(),
+            st.n,
+            layers,
+            slot,
+            save,
+        )
     }
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {

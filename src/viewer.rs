@@ -306,9 +306,7 @@ impl View for MetaballViewer {
             target.begin_rendering(ctx, cmd, [0.0; 4]);
             if let Some(view) = &self.mesh {
                 let m = layers.mesh.ok_or_else(|| {
-                    crate::Error::Param(
-                        "a metaball view made to draw a mesh was given none".into(),
-                    )
+                    crate::Error::Param("a metaball view made to draw a mesh was given none".into())
                 })?;
                 view.draw(ctx, cmd, m);
             }

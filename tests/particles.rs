@@ -1093,8 +1093,14 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     }
     assert_eq!(flock_state.alive.len(), 1024);
     eprintln!("{avoiding} of 1024 boids look ahead into the body");
-    assert!(avoiding > 20, "only {avoiding} boids look ahead into the body");
-    assert!(count_mismatch <= 2, "{count_mismatch} boids saw other flockmates");
+    assert!(
+        avoiding > 20,
+        "only {avoiding} boids look ahead into the body"
+    );
+    assert!(
+        count_mismatch <= 2,
+        "{count_mismatch} boids saw other flockmates"
+    );
     assert!(worst < 2e-3, "steering differs from the CPU's by {worst}");
     for s in &mut systems {
         s.destroy(&ctx);
@@ -1205,7 +1211,10 @@ fn particles_composite_with_the_metaball_fluid_by_depth() {
         let ndc = c.truncate() / c.w;
         let x = ((ndc.x + 1.0) * 0.5 * w as f32 - 0.5).round() as i32;
         let y = ((ndc.y + 1.0) * 0.5 * h as f32 - 0.5).round() as i32;
-        assert!(x >= 2 && y >= 2 && x < w as i32 - 2 && y < h as i32 - 2, "{p} -> {x},{y}");
+        assert!(
+            x >= 2 && y >= 2 && x < w as i32 - 2 && y < h as i32 - 2,
+            "{p} -> {x},{y}"
+        );
         (x, y)
     };
     // Mean channel difference of two frames over the 5 x 5 pixels around `at`.
@@ -1238,10 +1247,21 @@ fn particles_composite_with_the_metaball_fluid_by_depth() {
             diff(&back, &fluid, beside),
             diff(&over, &fluid, water),
         );
-        eprintln!("{draw}: behind the water {hidden:.2}, beside it {seen:.2}, in front {covers:.2}");
-        assert!(hidden < 2.0, "{draw}: the sheet behind shows through the water ({hidden})");
-        assert!(seen > 30.0, "{draw}: the sheet behind is missing beside the water ({seen})");
-        assert!(covers > 30.0, "{draw}: the sheet in front does not cover the water ({covers})");
+        eprintln!(
+            "{draw}: behind the water {hidden:.2}, beside it {seen:.2}, in front {covers:.2}"
+        );
+        assert!(
+            hidden < 2.0,
+            "{draw}: the sheet behind shows through the water ({hidden})"
+        );
+        assert!(
+            seen > 30.0,
+            "{draw}: the sheet behind is missing beside the water ({seen})"
+        );
+        assert!(
+            covers > 30.0,
+            "{draw}: the sheet in front does not cover the water ({covers})"
+        );
     }
 }
 
@@ -1276,8 +1296,7 @@ fn sph_scenes_play_particle_systems_and_refuse_what_they_cannot() {
     assert!(systems.iter().all(|s| s["integrator"] == "verlet"));
     assert!(sum["stats"]["particles"].as_u64().unwrap() > 1000);
     // A system on the character, and systems with no fluid, are refused by name.
-    let body = sheet_scene("sprites", Some(0.0))
-        + "[[system.collider]]\nkind = \"character\"\n";
+    let body = sheet_scene("sprites", Some(0.0)) + "[[system.collider]]\nkind = \"character\"\n";
     let alone = "name = \"alone\"\n[domain]\nmin = [-1.0, 0.0, -1.0]\nmax = [1.0, 2.0, 1.0]\n\
                  [character]\nfile = \"builtin:walker\"\n"
         .to_string()

@@ -314,7 +314,13 @@ impl ColorTarget {
 
     /// The colour image into `dst` at byte `at` after rendering (the caller makes it
     /// visible).
-    pub fn copy_color_to(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: &super::Buffer, at: u64) {
+    pub fn copy_color_to(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        dst: &super::Buffer,
+        at: u64,
+    ) {
         self.copy_color(ctx, cmd, dst.raw, at);
     }
 

@@ -162,10 +162,7 @@ impl SceneSystems {
 
     /// Frame `frame`'s draws as a view's overlay.
     pub fn at(&self, frame: u64) -> SystemsFrame<'_> {
-        SystemsFrame {
-            scene: self,
-            frame,
-        }
+        SystemsFrame { scene: self, frame }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
