@@ -37,6 +37,17 @@ switch_enum!(SpriteMode {
     Sprites
 });
 switch_enum!(Neighbors { Morton, Grid, Hash });
+switch_enum!(
+    /// SPH pressure solver: weakly compressible (the papers'), or the incompressible
+    /// predictive-corrective, divergence-free and position-based ones.
+    Solver {
+        Wcsph,
+        Pcisph,
+        Dfsph,
+        Pbf
+    }
+);
+
 switch_enum!(ListKind {
     None,
     Abuffer,
@@ -144,6 +155,9 @@ pub struct FluidArgs {
     /// --fluid eos=tait (repeatable; the keys of a scene file's [fluid] table)
     #[arg(long = "fluid", value_name = "KEY=VALUE")]
     pub fluid: Vec<String>,
+    /// SPH pressure solver (default: the scene's [fluid] solver, else wcsph)
+    #[arg(long, value_enum)]
+    pub solver: Option<Solver>,
 }
 
 /// How `run` draws SPH particles.

@@ -388,7 +388,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
     let sw = &scene.look.apply(sw);
-    scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
+    scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
     crate::psys::scenes::set_integrator_draw(
         &mut scene.system,
         sw.particle.integrator,
@@ -502,6 +502,8 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         Err(_) => None,
     };
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
+    let density_error = work.stepper.density_error.clone();
+    let steps_csv = work.stepper.write_csv(&opts.out.join("steps.csv"));
     let render_stats = work.view.stats();
     let character_stats = work.targets.character_stats();
     let control_stats = work.targets.control_summary(&opts.out);
@@ -537,7 +539,9 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         control: control_stats?,
         emission: emission_stats?,
         particle_systems: particle_systems?,
+        density_error,
     };
+    steps_csv?;
     let config = RunConfig {
         command: "run".into(),
         scene: scene.name.clone(),

@@ -438,3 +438,121 @@ fn bad_scenes_are_clear_errors() {
         "dam break has {n} particles, meant 32K"
     );
 }
+
+#[test]
+fn step_density_errors_match_the_cpu() {
+    use fluidform::sph::errors::StepErrors;
+    let ctx = common::ctx();
+    let scene = Scene::built_in("dam-break").unwrap().with_particles(3000);
+    let parts = scene.particles(1);
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let mut st = solver.state(&ctx, &scene, &parts).unwrap();
+    // The column collapses: the flow compresses the water at the floor.
+    let steps = 400;
+    let mut errors = StepErrors::new(&ctx, st.n as u64, 1, steps).unwrap();
+    for chunk in 0..steps / 50 {
+        ctx.one_shot(|cmd| {
+            for k in chunk * 50..chunk * 50 + 50 {
+                solver.record_step(&ctx, cmd, &mut Labels, &mut st).unwrap();
+                errors.record(&ctx, cmd, &st, 0, k).unwrap();
+            }
+            errors.record_frame_end(&ctx, cmd);
+        })
+        .unwrap();
+    }
+    let rec = errors.read(0, steps);
+    let d = st.read(&ctx).unwrap();
+    assert_eq!(rec.len(), steps as usize);
+    for r in &rec {
+        assert_eq!(r.particles as usize, d.pos.len());
+        assert_eq!(r.dt, st.dt);
+        assert!(r.mean >= 0.0 && r.max >= r.mean);
+    }
+    // The last record reduces the last step's densities, which the state still holds.
+    let rho0 = scene.fluid.rest_density as f64;
+    let e: Vec<f64> = d
+        .rho_p
+        .iter()
+        .map(|r| (r[0] as f64 / rho0 - 1.0).max(0.0))
+        .collect();
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    let max = e.iter().cloned().fold(0.0, f64::max);
+    let last = rec.last().unwrap();
+    eprintln!(
+        "last step: mean {mean:.3e} max {max:.3e}; GPU {:.3e} {:.3e}",
+        last.mean, last.max
+    );
+    assert!(max > 1e-3, "the column does not compress ({max})");
+    assert!((last.max as f64 - max).abs() <= 1e-6 * max.max(1.0));
+    assert!(
+        (last.mean as f64 - mean).abs() <= 1e-5 * mean.max(1e-6),
+        "{} vs {mean}",
+        last.mean
+    );
+    errors.destroy(&ctx);
+    st.destroy(&ctx);
+    solver.destroy(&ctx);
+    common::finish(&ctx);
+}
+
+#[test]
+fn solver_switch_and_per_step_density_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfl = format!("{}/tests/scenes/cfl.toml", env!("CARGO_MANIFEST_DIR"));
+    let out = dir.path().join("wcsph");
+    let o = common::fluidform(&[
+        "run",
+        "--scene",
+        &cfl,
+        "--solver",
+        "wcsph",
+        "--render",
+        "points",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::text(&o));
+    let sum = common::summary(&out);
+    assert_eq!(sum["config"]["fluid"]["solver"], "wcsph");
+    let steps = sum["stats"]["steps"].as_u64().unwrap();
+    let err = &sum["stats"]["density_error"];
+    assert_eq!(err["steps"].as_u64(), Some(steps), "{err}");
+    assert!(err["max"].as_f64().unwrap() >= err["mean"].as_f64().unwrap());
+    let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len() as u64, steps);
+    // CFL: 11 steps per frame, their dts summing to the frame time (0.01 s).
+    let frame0: f64 = rows
+        .iter()
+        .filter(|r| r.starts_with("0,"))
+        .map(|r| r.split(',').nth(3).unwrap().parse::<f64>().unwrap())
+        .sum();
+    assert!(
+        (frame0 - 0.01).abs() < 1e-6,
+        "frame 0 steps sum to {frame0}"
+    );
+    // The incompressible solvers are refused until built, from the switch or the file.
+    let pbf = dir.path().join("pbf.toml");
+    std::fs::write(
+        &pbf,
+        std::fs::read_to_string(&cfl)
+            .unwrap()
+            .replace("cfl = 0.4", "cfl = 0.4\nsolver = \"pbf\""),
+    )
+    .unwrap();
+    for args in [
+        vec!["run", "--scene", cfl.as_str(), "--solver", "dfsph"],
+        vec!["run", "--scene", pbf.to_str().unwrap()],
+    ] {
+        let o = common::fluidform(&args);
+        assert!(!o.status.success());
+        let t = common::text(&o);
+        assert!(t.contains("not implemented yet"), "{t}");
+        assert_eq!(t.trim().lines().count(), 1, "{t}");
+    }
+}

@@ -64,7 +64,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     for (strategy, sort) in strategies {
         for &n in &counts {
             let mut scene = scene(n);
-            scene.fluid = scene.fluid.with_overrides(&sw.fluid_args.fluid)?;
+            scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
             let parts = scene.particles(sw.common.seed);
             // A solver per N: the emitter hooks into it.
             let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);

@@ -25,7 +25,7 @@ pub fn strategies(
 /// One SPH step per frame on the dam break scaled to N particles.
 pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut base = Scene::built_in("dam-break").expect("built-in");
-    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args.fluid)?;
+    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args)?;
     let mut rows = Vec::new();
     for (strategy, sort) in strategies(
         opts,
@@ -94,9 +94,7 @@ pub const STABILITY_STEPS: u64 = 10_000;
 /// the domain, the settled pool's mean density within 5% of rho_0.
 pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut scene = Scene::built_in("dam-break").expect("built-in");
-    scene.fluid = scene
-        .fluid
-        .with_overrides(&opts.switches.fluid_args.fluid)?;
+    scene.fluid = scene.fluid.with_overrides(&opts.switches.fluid_args)?;
     if let Some(n) = opts.switches.common.particles {
         scene = scene.with_particles(n);
     }

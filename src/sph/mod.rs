@@ -1,6 +1,7 @@
 //! Weakly compressible SPH after Müller et al. 2003 and Kelager 2006, on the GPU, with
 //! switchable neighbour search, boundaries and colliders, and an f64 CPU reference.
 pub mod cpu;
+pub mod errors;
 pub mod health;
 pub mod hooks;
 pub mod params;

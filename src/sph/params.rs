@@ -59,6 +59,8 @@ pub struct FluidParams {
     pub restitution: f32,
     /// Tangential velocity lost at a wall, 0..1
     pub friction: f32,
+    /// The pressure solver (`--solver`).
+    pub solver: crate::config::Solver,
 }
 
 impl Default for FluidParams {
@@ -81,6 +83,7 @@ impl Default for FluidParams {
             gravity: [0.0, -9.82, 0.0],
             restitution: 0.0,
             friction: 0.0,
+            solver: crate::config::Solver::Wcsph,
         }
     }
 }
@@ -90,6 +93,12 @@ pub const MAX_SUBSTEPS: u32 = 1000;
 
 impl FluidParams {
     pub fn validate(&self) -> Result<()> {
+        if self.solver != crate::config::Solver::Wcsph {
+            return Err(Error::Unsupported(format!(
+                "fluid solver {}: not implemented yet; wcsph is the one SPH solver so far",
+                self.solver.as_str()
+            )));
+        }
         let positive = [
             ("rest_density", self.rest_density),
             ("mass", self.mass),
@@ -152,7 +161,17 @@ impl FluidParams {
 
     /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
     /// a scene file's [fluid] table: unknown keys and invalid values are errors.
-    pub fn with_overrides(&self, overrides: &[String]) -> Result<Self> {
+    /// The parameters with `--fluid KEY=VALUE` overrides and `--solver` applied.
+    pub fn with_overrides(&self, args: &crate::config::FluidArgs) -> Result<Self> {
+        let mut out = self.with_values(&args.fluid)?;
+        if let Some(s) = args.solver {
+            out.solver = s;
+            out.validate()?;
+        }
+        Ok(out)
+    }
+
+    fn with_values(&self, overrides: &[String]) -> Result<Self> {
         if overrides.is_empty() {
             return Ok(self.clone());
         }

@@ -1,5 +1,6 @@
 //! Playing an SPH scene: steps per frame (fixed, or CFL-limited from the previous
 //! frame's largest speed), the state's health every frame, and end-of-run statistics.
+use super::errors::{DensityErrorStats, StepError, StepErrors};
 use super::health::Health;
 use super::scene::Scene;
 use super::solver::{SphSolver, SphState, StateDump};
@@ -12,6 +13,12 @@ use serde::{Deserialize, Serialize};
 /// exceeds cfl * h / max(c, v_max), v_max read back from the latest finished frame.
 pub struct Stepper {
     health: Health,
+    errors: StepErrors,
+    /// Per slot: the steps recorded into it and the scene time before them.
+    pending: Vec<(u32, f64)>,
+    /// Every step's density error: (frame, step in the frame, time after it, error).
+    pub steps: Vec<(u64, u32, f64, StepError)>,
+    pub density_error: DensityErrorStats,
     pub frame_time: f64,
     pub steps_taken: u64,
     pub sim_time: f64,
@@ -21,8 +28,19 @@ pub struct Stepper {
 
 impl Stepper {
     pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
+        let f = &st.fluid;
+        let max_steps = match f.cfl {
+            Some(_) => super::params::MAX_SUBSTEPS,
+            None => f.substeps,
+        };
+        let errors =
+            crate::gpu::Guard::new(ctx, StepErrors::new(ctx, st.n as u64, slots, max_steps)?);
         Ok(Self {
             health: Health::new(ctx, slots)?,
+            errors: errors.take(),
+            pending: vec![(0, 0.0); slots],
+            steps: Vec::new(),
+            density_error: DensityErrorStats::default(),
             frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
             steps_taken: 0,
             sim_time: 0.0,
@@ -60,9 +78,14 @@ impl Stepper {
     ) -> Result<()> {
         let (steps, dt) = self.plan(st);
         st.dt = dt;
-        for _ in 0..steps {
+        self.pending[slot] = (steps, self.sim_time);
+        for k in 0..steps {
             solver.record_step(ctx, cmd, prof, st)?;
+            prof.begin(ctx, cmd, StepErrors::NAME);
+            self.errors.record(ctx, cmd, st, slot, k)?;
+            prof.end(ctx, cmd);
         }
+        self.errors.record_frame_end(ctx, cmd);
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
         prof.begin(ctx, cmd, "sph/health");
@@ -75,11 +98,36 @@ impl Stepper {
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
         let h = self.health.check(slot, frame, self.rest_density)?;
         self.v_max = h.max_speed();
+        let (steps, mut t) = self.pending[slot];
+        for (k, e) in self.errors.read(slot, steps).into_iter().enumerate() {
+            t += e.dt as f64;
+            self.density_error.add(&e);
+            self.steps.push((frame, k as u32, t, e));
+        }
         Ok(())
+    }
+
+    /// `steps.csv`: one row per step.
+    pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
+        let mut out = String::from(
+            "frame,step,time,dt,iterations,density_error_mean,density_error_max,particles\n",
+        );
+        for (frame, k, t, e) in &self.steps {
+            // WCSPH solves no pressure system: 0 iterations.
+            out += &format!(
+                "{frame},{k},{t:.6},{:.6e},0,{:.6e},{:.6e},{}\n",
+                e.dt, e.mean, e.max, e.particles
+            );
+        }
+        std::fs::write(path, out).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            source: e,
+        })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.health.destroy(ctx);
+        self.errors.destroy(ctx);
     }
 }
 
@@ -116,6 +164,9 @@ pub struct SphRunStats {
     pub control: Option<crate::scene::targets::ControlSummary>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<crate::scene::emission::EmissionStats>,
+    /// The density error of every step (per step in steps.csv).
+    #[serde(default)]
+    pub density_error: super::errors::DensityErrorStats,
     /// The scene's particle systems, if any.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub particle_systems: Vec<crate::psys::run::SystemStats>,

@@ -1,0 +1,51 @@
+#version 450
+// The density error of a step (src/sph/errors.rs): per live particle (pos.w >= 0)
+// e = max(rho / rho0 - 1, 0), compression only (surface particles lack neighbours, as in
+// SPlisHSPlasH's solvers). Two levels: mode 0 reduces each block of WG * ITEMS particles to
+// a (sum, max, count) partial; mode 1 (one workgroup) reduces the partials into
+// records[step] = (mean, max, count, dt).
+#include "common/index.glsl"
+layout(constant_id = 1) const uint ITEMS = 8;
+layout(std430, binding = SERR_B_POS) readonly buffer Pos { vec4 pos[]; };
+layout(std430, binding = SERR_B_RHO_P) readonly buffer RhoP { vec2 rho_p[]; };
+layout(std430, binding = SERR_B_PARTIALS) buffer Partials { vec4 partials[]; };
+layout(std430, binding = SERR_B_RECORDS) buffer Records { vec4 records[]; };
+layout(push_constant) uniform Push {
+    uint n;      // mode 0: particles; mode 1: partials
+    uint mode;
+    uint step;   // the record written in mode 1
+    float rest_density;
+    float dt;
+} pc;
+shared vec3 s[gl_WorkGroupSize.x];  // sum, max, count
+void main() {
+    uint wg = gl_WorkGroupSize.x, lid = gl_LocalInvocationIndex;
+    vec3 acc = vec3(0.0);
+    if (pc.mode == 0u) {
+        uint base = group_id() * wg * ITEMS;
+        for (uint k = 0u; k < ITEMS; ++k) {
+            uint i = base + k * wg + lid;
+            if (i >= pc.n || pos[i].w < 0.0) continue;
+            float e = max(rho_p[i].x / pc.rest_density - 1.0, 0.0);
+            acc += vec3(e, 0.0, 1.0);
+            acc.y = max(acc.y, e);
+        }
+    } else {
+        for (uint i = lid; i < pc.n; i += wg) {
+            vec3 p = partials[i].xyz;
+            acc = vec3(acc.x + p.x, max(acc.y, p.y), acc.z + p.z);
+        }
+    }
+    s[lid] = acc;
+    barrier();
+    for (uint h = wg / 2u; h > 0u; h >>= 1u) {
+        if (lid < h) {
+            vec3 o = s[lid + h];
+            s[lid] = vec3(s[lid].x + o.x, max(s[lid].y, o.y), s[lid].z + o.z);
+        }
+        barrier();
+    }
+    if (lid != 0u) return;
+    if (pc.mode == 0u) partials[group_id()] = vec4(s[0], 0.0);
+    else records[pc.step] = vec4(s[0].x / max(s[0].z, 1.0), s[0].y, s[0].z, pc.dt);
+}
