@@ -279,7 +279,7 @@ impl MetaballViewer {
             target.end_rendering(ctx, cmd);
             // The load's read of the pixels -> this copy's write of them.
             ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
-            target.copy_color_to(ctx, cmd, &b.pixels, 0);
+            target.copy_color(ctx, cmd, &b.pixels, 0);
             ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::TRANSFER_READ);
             scopes.end(ctx, cmd);
         }

@@ -175,8 +175,9 @@ impl ColorTarget {
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
 
-    /// The colour image into `dst` at byte `offset`, after rendering.
-    fn copy_color(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: vk::Buffer, offset: u64) {
+    /// The colour image into `dst` at byte `offset`, after rendering (the caller makes
+    /// the copy visible).
+    pub fn copy_color(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: &Buffer, offset: u64) {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
         image_barrier(
             ctx,
@@ -196,7 +197,7 @@ impl ColorTarget {
                 cmd,
                 self.color.raw,
                 L::TRANSFER_SRC_OPTIMAL,
-                dst,
+                dst.raw,
                 &[region],
             )
         };
@@ -205,7 +206,7 @@ impl ColorTarget {
     /// Copy the colour image into this slot's readback buffer (after rendering).
     pub fn copy_out(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
         use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
-        self.copy_color(ctx, cmd, self.readbacks[slot].raw, 0);
+        self.copy_color(ctx, cmd, &self.readbacks[slot], 0);
         let b = [vk::MemoryBarrier2::default()
             .src_stage_mask(S::COPY)
             .src_access_mask(A::TRANSFER_WRITE)
@@ -247,7 +248,7 @@ impl ColorTarget {
         depth_at: u64,
     ) {
         use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
-        self.copy_color(ctx, cmd, dst.raw, color_at);
+        self.copy_color(ctx, cmd, dst, color_at);
         image_barrier(
             ctx,
             cmd,
@@ -310,18 +311,6 @@ impl ColorTarget {
                 )
             };
         }
-    }
-
-    /// The colour image into `dst` at byte `at` after rendering (the caller makes it
-    /// visible).
-    pub fn copy_color_to(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        dst: &super::Buffer,
-        at: u64,
-    ) {
-        self.copy_color(ctx, cmd, dst.raw, at);
     }
 
     /// RGBA8 pixels of the frame last copied out of `slot` (valid after its fence).

@@ -326,9 +326,9 @@ impl ParticleScene {
         validate_systems(&self.name, &self.system)
     }
 
-    /// The switches applied: --integrator and --draw to every system (`set_integrator_draw`), --sort to every
-    /// sorted (non-point) one, --particles as every system's capacity with its birth rate
-    /// scaled to match.
+    /// The switches applied: --integrator and --draw to every system
+    /// (`set_integrator_draw`), --sort to every sorted (non-point) one, --particles as
+    /// every system's capacity with its birth rate scaled to match.
     pub fn with_switches(
         mut self,
         integrator: Option<Integrator>,
