@@ -98,8 +98,18 @@ pub fn variants() -> Vec<Variant> {
             v.push(with::<neighbors::NbQueryIo>("primitives/nb_query.comp", &d));
             let mut sph = d.clone();
             sph.extend(crate::sph::params::Eos::defines());
+            sph.extend(crate::sph::pressure::solver_defines());
             for f in ["sph/density.comp", "sph/forces.comp", "sph/integrate.comp"] {
                 v.push(with::<crate::sph::solver::SphIo>(f, &sph));
+            }
+            use crate::config::Solver;
+            use crate::sph::pressure::{pass_defines, passes, PressureIo};
+            for solver in Solver::value_variants() {
+                for p in passes(*solver) {
+                    let mut d = sph.clone();
+                    d.extend(pass_defines(&p));
+                    v.push(with::<PressureIo>(p.1, &d));
+                }
             }
             use crate::control::force::{ControlIo, ControlSettings};
             for a in crate::config::Adaptive::value_variants() {

@@ -32,6 +32,18 @@ struct SphParams {
     float poly6_grad;  // -945 / (32 pi h^9)
     float spiky_grad;  // -45 / (pi h^6)
     float visc_lap;    // 45 / (pi h^6)
+    uint solver;       // SOLVER_WCSPH, _PCISPH, _DFSPH, _PBF
+    uint min_iter;     // pressure solves: iterations at least, at most
+    uint max_iter;
+    float density_target;     // mean density error a solve stops at
+    float divergence_target;  // dfsph: mean compression rate * dt
+    float proto_grad2;        // sum |V grad W|^2 over a full neighbourhood, V = m / rho0
+    float pbf_relaxation;
+    float scorr_k;
+    float scorr_n;
+    float scorr_inv_w;        // 1 / W_poly6(dq)
+    float xsph;
+    float vorticity;
 };
 struct Collider {
     vec4 a;    // plane: normal, w = offset (fluid where dot(n, x) >= w); sphere/capsule: point, w = radius
@@ -48,6 +60,54 @@ layout(std430, binding = SPH_B_COLLIDERS) readonly buffer Colliders { Collider c
 
 // Particles the passes cover: live ones come first (the sort puts dead slots last).
 uint sph_live() { return min(pc.n, P.live); }
+
+// Reflect the velocity's normal part (n points into the fluid side), damp the tangent.
+vec3 respond(vec3 v, vec3 n, vec3 wall_v) {
+    vec3 rel = v - wall_v;
+    float vn = dot(rel, n);
+    if (vn >= 0.0) return v;
+    vec3 vt = rel - vn * n;
+    return wall_v + vt * (1.0 - P.domain_max.w) - P.domain_min.w * vn * n;
+}
+
+// Collision response against the colliders and the domain box: x pushed out, both
+// velocities (leapfrog's half step and full; the same one twice elsewhere) answered with
+// restitution and friction; a final clamp, so no particle ever leaves the domain.
+void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
+    for (uint c = 0u; c < P.colliders; ++c) {
+        Collider col = cols[c];
+        uint kind = uint(col.b.w);
+        vec3 n;
+        float depth;
+        if (kind == 0u) {
+            n = col.a.xyz;
+            depth = col.a.w - dot(n, x);
+        } else {
+            vec3 q = col.a.xyz;
+            if (kind == 2u) {
+                vec3 ab = col.b.xyz - col.a.xyz;
+                float t = clamp(dot(x - col.a.xyz, ab) / max(dot(ab, ab), 1e-20), 0.0, 1.0);
+                q = col.a.xyz + t * ab;
+            }
+            vec3 d = x - q;
+            float len = length(d);
+            n = len > 1e-12 ? d / len : vec3(0.0, 1.0, 0.0);
+            depth = col.a.w - len;
+        }
+        if (depth > 0.0) {
+            x += depth * n;
+            va = respond(va, n, col.vel.xyz);
+            vb = respond(vb, n, col.vel.xyz);
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        vec3 n = vec3(0.0);
+        n[k] = 1.0;
+        if (x[k] < P.domain_min[k]) { x[k] = P.domain_min[k]; va = respond(va, n, vec3(0.0)); vb = respond(vb, n, vec3(0.0)); }
+        if (x[k] > P.domain_max[k]) { x[k] = P.domain_max[k]; va = respond(va, -n, vec3(0.0)); vb = respond(vb, -n, vec3(0.0)); }
+    }
+    x = clamp(x, P.domain_min.xyz, P.domain_max.xyz);
+}
 
 float pressure_of(float rho) {
     float p = P.eos == EOS_TAIT ? P.stiffness * (pow(rho / P.rest_density, P.gamma) - 1.0)

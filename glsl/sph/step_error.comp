@@ -3,13 +3,20 @@
 // e = max(rho / rho0 - 1, 0), compression only (surface particles lack neighbours, as in
 // SPlisHSPlasH's solvers). Two levels: mode 0 reduces each block of WG * ITEMS particles to
 // a (sum, max, count) partial; mode 1 (one workgroup) reduces the partials into
-// records[step] = (mean, max, count, dt).
+// records[2 step] = (mean, max, count, dt) and copies the pressure solve's iterations and
+// errors into records[2 step + 1] (SolveState in sph/pressure.glsl; zeros for wcsph).
 #include "common/index.glsl"
 layout(constant_id = 1) const uint ITEMS = 8;
 layout(std430, binding = SERR_B_POS) readonly buffer Pos { vec4 pos[]; };
 layout(std430, binding = SERR_B_RHO_P) readonly buffer RhoP { vec2 rho_p[]; };
 layout(std430, binding = SERR_B_PARTIALS) buffer Partials { vec4 partials[]; };
 layout(std430, binding = SERR_B_RECORDS) buffer Records { vec4 records[]; };
+layout(std430, binding = SERR_B_SOLVE) readonly buffer Solve {
+    uvec4 args_iter;
+    uvec4 done_pad;
+    uvec2 iters;  // density, divergence
+    vec2 errs;    // density, divergence
+} solve;
 layout(push_constant) uniform Push {
     uint n;      // mode 0: particles; mode 1: partials
     uint mode;
@@ -47,5 +54,9 @@ void main() {
     }
     if (lid != 0u) return;
     if (pc.mode == 0u) partials[group_id()] = vec4(s[0], 0.0);
-    else records[pc.step] = vec4(s[0].x / max(s[0].z, 1.0), s[0].y, s[0].z, pc.dt);
+    else {
+        records[2u * pc.step] = vec4(s[0].x / max(s[0].z, 1.0), s[0].y, s[0].z, pc.dt);
+        records[2u * pc.step + 1u] = vec4(uintBitsToFloat(solve.iters.x),
+                                          uintBitsToFloat(solve.iters.y), solve.errs);
+    }
 }

@@ -26,7 +26,7 @@ pub struct StepErrorPush {
 crate::gpu_interface! {
     /// glsl/sph/step_error.comp
     pub StepErrorIo / StepErrorBufs: "SERR", push StepErrorPush {
-        pos = 0, rho_p = 1, partials = 2, records = 3,
+        pos = 0, rho_p = 1, partials = 2, records = 3, solve = 4,
     }
 }
 
@@ -38,6 +38,13 @@ pub struct StepError {
     pub max: f32,
     /// Live particles counted.
     pub particles: u32,
+    /// Iterations of the pressure solve (0 for wcsph) and of DFSPH's divergence solve.
+    pub iterations: u32,
+    pub divergence_iterations: u32,
+    /// DFSPH: the divergence solve's mean compression rate times dt at its end.
+    pub divergence_error: f32,
+    /// The pressure solve's own estimate of the mean density error at its last iteration.
+    pub solver_error: f32,
 }
 
 /// Density error over a run's steps (`stats.density_error` in summary.json).
@@ -51,6 +58,17 @@ pub struct DensityErrorStats {
     /// The last step's mean and maximum.
     pub last_mean: f64,
     pub last_max: f64,
+    /// Pressure-solve iterations per step: mean and most (0 for wcsph).
+    #[serde(default)]
+    pub iterations_mean: f64,
+    #[serde(default)]
+    pub iterations_max: u32,
+    /// DFSPH's divergence solve: iterations per step, and its error (mean compression rate
+    /// times dt) averaged over steps.
+    #[serde(default)]
+    pub divergence_iterations_mean: f64,
+    #[serde(default)]
+    pub divergence_error_mean: f64,
 }
 
 impl DensityErrorStats {
@@ -60,6 +78,14 @@ impl DensityErrorStats {
         self.max = self.max.max(e.max as f64);
         self.last_mean = e.mean as f64;
         self.last_max = e.max as f64;
+        let avg = |m: f64, x: f64| (m * k + x) / (k + 1.0);
+        self.iterations_mean = avg(self.iterations_mean, e.iterations as f64);
+        self.iterations_max = self.iterations_max.max(e.iterations);
+        self.divergence_iterations_mean = avg(
+            self.divergence_iterations_mean,
+            e.divergence_iterations as f64,
+        );
+        self.divergence_error_mean = avg(self.divergence_error_mean, e.divergence_error as f64);
         self.steps += 1;
     }
 }
@@ -67,7 +93,9 @@ impl DensityErrorStats {
 pub struct StepErrors {
     pipeline: ComputePipeline<StepErrorIo>,
     partials: Buffer,
-    /// Per slot: one vec4 record per step of the frame, host-visible.
+    /// Bound as the solve state for wcsph (no pressure solve: zero iterations).
+    no_solve: Buffer,
+    /// Per slot: two vec4 records per step of the frame, host-visible.
     records: Vec<Buffer>,
     capacity: u64,
     max_steps: u32,
@@ -95,11 +123,13 @@ impl StepErrors {
             ctx,
             ctx.storage_buffer("step error partials", capacity.div_ceil(BLOCK).max(1) * 16)?,
         );
+        let no_solve = Guard::new(ctx, ctx.storage_buffer("no solve state", 48)?);
+        ctx.one_shot(|cmd| ctx.fill(cmd, &no_solve, 0))?;
         let mut records = Guard::new(ctx, Vec::new());
         for _ in 0..slots {
             records.push(ctx.create_buffer(
                 "step error records",
-                max_steps.max(1) as u64 * 16,
+                max_steps.max(1) as u64 * 32,
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::GpuToCpu,
             )?);
@@ -107,6 +137,7 @@ impl StepErrors {
         Ok(Self {
             pipeline: pipeline.take(),
             partials: partials.take(),
+            no_solve: no_solve.take(),
             records: records.take(),
             capacity,
             max_steps: max_steps.max(1),
@@ -143,6 +174,7 @@ impl StepErrors {
             rho_p: st.rho_p(),
             partials: &self.partials,
             records: &self.records[slot],
+            solve: st.pressure.as_ref().map_or(&self.no_solve, |p| p.solve()),
         };
         // The previous reduction may still read the partials.
         ctx.compute_barrier(cmd);
@@ -163,13 +195,18 @@ impl StepErrors {
     /// After the slot's fence: its frame's first `steps` records.
     pub fn read(&self, slot: usize, steps: u32) -> Vec<StepError> {
         let raw = self.records[slot].mapped().expect("records are mapped");
-        let v: &[[f32; 4]] = bytemuck::cast_slice(&raw[..steps.min(self.max_steps) as usize * 16]);
+        let v: &[[[f32; 4]; 2]] =
+            bytemuck::cast_slice(&raw[..steps.min(self.max_steps) as usize * 32]);
         v.iter()
-            .map(|r| StepError {
+            .map(|[r, s]| StepError {
                 mean: r[0],
                 max: r[1],
                 particles: r[2] as u32,
                 dt: r[3],
+                iterations: s[0].to_bits(),
+                divergence_iterations: s[1].to_bits(),
+                solver_error: s[2],
+                divergence_error: s[3],
             })
             .collect()
     }
@@ -177,6 +214,7 @@ impl StepErrors {
     pub fn destroy(&mut self, ctx: &Context) {
         self.pipeline.destroy(ctx);
         ctx.destroy_buffer(&mut self.partials);
+        ctx.destroy_buffer(&mut self.no_solve);
         for b in &mut self.records {
             ctx.destroy_buffer(b);
         }

@@ -1,10 +1,15 @@
 //! Weakly compressible SPH after Müller et al. 2003 and Kelager 2006, on the GPU, with
 //! switchable neighbour search, boundaries and colliders, and an f64 CPU reference.
 pub mod cpu;
+pub mod cpu_pressure;
+pub mod dfsph;
 pub mod errors;
 pub mod health;
 pub mod hooks;
 pub mod params;
+pub mod pbf;
+pub mod pcisph;
+pub mod pressure;
 pub mod run;
 pub mod scene;
 pub mod solver;

@@ -61,6 +61,28 @@ pub struct FluidParams {
     pub friction: f32,
     /// The pressure solver (`--solver`).
     pub solver: crate::config::Solver,
+    /// With `cfl`: the largest step, s (default: `dt`). The frame time stays dt * substeps.
+    pub dt_max: Option<f32>,
+    /// pcisph, dfsph, pbf: iterate until the mean density error (rho / rho_0 - 1 where
+    /// compressed) the solver predicts is at most this (0.001: 0.1%).
+    pub density_error: f32,
+    /// dfsph: iterate until the mean compression rate times dt is at most this.
+    pub divergence_error: f32,
+    /// Iterations each pressure solve takes at least and at most.
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+    /// pbf: a fixed iteration count (0: iterate to `density_error`).
+    pub pbf_iterations: u32,
+    /// pbf: constraint relaxation epsilon, relative to a full neighbourhood's gradient sum.
+    pub pbf_relaxation: f32,
+    /// pbf: tensile-instability correction s_corr = -k (W(r) / W(dq h))^n.
+    pub scorr_k: f32,
+    pub scorr_n: f32,
+    pub scorr_dq: f32,
+    /// pbf: XSPH viscosity c.
+    pub xsph: f32,
+    /// pbf: vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
+    pub vorticity: f32,
 }
 
 impl Default for FluidParams {
@@ -84,21 +106,30 @@ impl Default for FluidParams {
             restitution: 0.0,
             friction: 0.0,
             solver: crate::config::Solver::Wcsph,
+            dt_max: None,
+            density_error: 0.001,
+            divergence_error: 0.001,
+            min_iterations: 2,
+            max_iterations: 100,
+            pbf_iterations: 0,
+            pbf_relaxation: 0.01,
+            scorr_k: 0.1,
+            scorr_n: 4.0,
+            scorr_dq: 0.2,
+            xsph: 0.01,
+            vorticity: 0.01,
         }
     }
 }
 
 /// Most steps one frame may be split into.
 pub const MAX_SUBSTEPS: u32 = 1000;
+/// Most iterations one pressure solve may take (each is recorded, skipped once converged).
+pub const MAX_ITERATIONS: u32 = 500;
 
 impl FluidParams {
     pub fn validate(&self) -> Result<()> {
-        if self.solver != crate::config::Solver::Wcsph {
-            return Err(Error::Unsupported(format!(
-                "fluid solver {}: not implemented yet; wcsph is the one SPH solver so far",
-                self.solver.as_str()
-            )));
-        }
+        self.validate_solver()?;
         let positive = [
             ("rest_density", self.rest_density),
             ("mass", self.mass),
@@ -159,6 +190,62 @@ impl FluidParams {
         Ok(())
     }
 
+    fn validate_solver(&self) -> Result<()> {
+        for (name, v, lo, hi) in [
+            ("density_error", self.density_error, 1e-6, 0.5),
+            ("divergence_error", self.divergence_error, 1e-6, 0.5),
+            ("pbf_relaxation", self.pbf_relaxation, 1e-6, 10.0),
+            ("scorr_k", self.scorr_k, 0.0, 1.0),
+            ("scorr_n", self.scorr_n, 1.0, 8.0),
+            ("scorr_dq", self.scorr_dq, 0.01, 0.99),
+            ("xsph", self.xsph, 0.0, 1.0),
+            ("vorticity", self.vorticity, 0.0, 10.0),
+        ] {
+            if !(v >= lo && v <= hi) {
+                return Err(Error::Param(format!(
+                    "fluid.{name} must be in {lo}..={hi}, got {v}"
+                )));
+            }
+        }
+        if self.min_iterations == 0
+            || self.min_iterations > self.max_iterations
+            || self.max_iterations > MAX_ITERATIONS
+        {
+            return Err(Error::Param(format!(
+                "fluid iterations: need 1 <= min_iterations ({}) <= max_iterations ({}) <= \
+                 {MAX_ITERATIONS}",
+                self.min_iterations, self.max_iterations
+            )));
+        }
+        if self.pbf_iterations > MAX_ITERATIONS {
+            return Err(Error::Param(format!(
+                "fluid.pbf_iterations must be at most {MAX_ITERATIONS}, got {}",
+                self.pbf_iterations
+            )));
+        }
+        if let Some(d) = self.dt_max {
+            if !(d > 0.0 && d.is_finite()) {
+                return Err(Error::Param(format!(
+                    "fluid.dt_max must be positive, got {d}"
+                )));
+            }
+            if self.cfl.is_none() {
+                return Err(Error::Param(
+                    "fluid.dt_max needs fluid.cfl (without it every step is dt)".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// (least, most) iterations of the solver's pressure solve: pbf's fixed count, if set.
+    pub fn iterations(&self) -> (u32, u32) {
+        match (self.solver, self.pbf_iterations) {
+            (crate::config::Solver::Pbf, k) if k > 0 => (k, k),
+            _ => (self.min_iterations, self.max_iterations),
+        }
+    }
+
     /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
     /// a scene file's [fluid] table: unknown keys and invalid values are errors.
     /// The parameters with `--fluid KEY=VALUE` overrides and `--solver` applied.
@@ -211,8 +298,12 @@ impl FluidParams {
         }
     }
 
-    /// Speed of sound used by the CFL limit.
+    /// Speed of sound used by the CFL limit: the equation of state's for wcsph; the
+    /// incompressible solvers have none (their CFL limit is the largest speed alone).
     pub fn sound(&self) -> f32 {
+        if self.solver != crate::config::Solver::Wcsph {
+            return 0.0;
+        }
         match self.eos {
             Eos::Ideal => self.stiffness.sqrt(),
             Eos::Tait => self.sound_speed,
@@ -245,8 +336,24 @@ pub struct SphGpuParams {
     pub poly6_grad: f32,
     pub spiky_grad: f32,
     pub visc_lap: f32,
+    /// `Solver` as u32.
+    pub solver: u32,
+    pub min_iter: u32,
+    pub max_iter: u32,
+    pub density_target: f32,
+    pub divergence_target: f32,
+    /// sum over a full neighbourhood at the rest spacing of |V grad W_spiky|^2, V = m / rho_0
+    /// (PCISPH's delta, DFSPH's and PBF's denominators are relative to it).
+    pub proto_grad2: f32,
+    pub pbf_relaxation: f32,
+    pub scorr_k: f32,
+    pub scorr_n: f32,
+    /// 1 / W_poly6(scorr_dq h)
+    pub scorr_inv_w: f32,
+    pub xsph: f32,
+    pub vorticity: f32,
 }
-const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 112);
+const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 160);
 
 impl SphGpuParams {
     /// Byte offset of `live` (the emitter copies its GPU-side count there).
@@ -255,6 +362,10 @@ impl SphGpuParams {
     pub fn new(f: &FluidParams, lo: [f32; 3], hi: [f32; 3], dt: f32, colliders: u32) -> Self {
         let h = f.h;
         let k = Kernels::new(h as f64);
+        let incompressible = f.solver != crate::config::Solver::Wcsph;
+        let (min_iter, max_iter) = f.iterations();
+        let dq = (f.scorr_dq * h) as f64;
+        let w_dq = k.poly6 * (h as f64 * h as f64 - dq * dq).powi(3);
         Self {
             gravity: [f.gravity[0], f.gravity[1], f.gravity[2], dt],
             domain_min: [lo[0], lo[1], lo[2], f.restitution],
@@ -262,12 +373,26 @@ impl SphGpuParams {
             h,
             mass: f.mass,
             rest_density: f.rest_density,
-            stiffness: f.eos_constant(),
-            viscosity: f.viscosity,
+            // The pressure solvers replace the equation of state (forces.comp then adds
+            // no pressure term); pbf replaces the viscous force by XSPH.
+            stiffness: if incompressible {
+                0.0
+            } else {
+                f.eos_constant()
+            },
+            viscosity: if f.solver == crate::config::Solver::Pbf {
+                0.0
+            } else {
+                f.viscosity
+            },
             tension: f.surface_tension,
             tension_threshold: f.tension_threshold,
             gamma: f.gamma,
-            eos: f.eos as u32,
+            eos: if incompressible {
+                Eos::Ideal as u32
+            } else {
+                f.eos as u32
+            },
             clamp_negative: f.clamp_negative_pressure as u32,
             colliders,
             live: u32::MAX,
@@ -275,8 +400,43 @@ impl SphGpuParams {
             poly6_grad: k.poly6_grad as f32,
             spiky_grad: k.spiky_grad as f32,
             visc_lap: k.visc_lap as f32,
+            solver: f.solver as u32,
+            min_iter,
+            max_iter,
+            density_target: f.density_error,
+            divergence_target: f.divergence_error,
+            proto_grad2: proto_grad2(f) as f32,
+            pbf_relaxation: f.pbf_relaxation,
+            scorr_k: f.scorr_k,
+            scorr_n: f.scorr_n,
+            scorr_inv_w: (1.0 / w_dq) as f32,
+            xsph: f.xsph,
+            vorticity: f.vorticity,
         }
     }
+}
+
+/// sum_j |V grad W_spiky(x_i - x_j)|^2 over a full neighbourhood: a cubic lattice at the
+/// rest spacing (V = m / rho_0). The pressure solvers' prototype particle.
+pub fn proto_grad2(f: &FluidParams) -> f64 {
+    let h = f.h as f64;
+    let s = f.spacing() as f64;
+    let k = Kernels::new(h);
+    let v = f.mass as f64 / f.rest_density as f64;
+    let r = (h / s).ceil() as i32;
+    let mut sum = 0.0;
+    for a in -r..=r {
+        for b in -r..=r {
+            for c in -r..=r {
+                let r2 = s * s * (a * a + b * b + c * c) as f64;
+                if r2 > 0.0 && r2 < h * h {
+                    let g = v * k.spiky_grad * (h - r2.sqrt()).powi(2);
+                    sum += g * g;
+                }
+            }
+        }
+    }
+    sum
 }
 
 /// The smoothing kernels' constants (Müller 2003), for the GPU parameters and the CPU

@@ -10,7 +10,8 @@ use ash::vk;
 use serde::{Deserialize, Serialize};
 
 /// Chooses steps per frame and watches the state's health. With `cfl`, a step never
-/// exceeds cfl * h / max(c, v_max), v_max read back from the latest finished frame.
+/// exceeds cfl * h / max(c, v_max) (c: wcsph's speed of sound; 0 for the incompressible
+/// solvers) nor `dt_max` (default `dt`), v_max read back from the latest finished frame.
 pub struct Stepper {
     health: Health,
     errors: StepErrors,
@@ -56,7 +57,7 @@ impl Stepper {
             None => (f.substeps, f.dt),
             Some(cfl) => {
                 let limit = cfl * f.h / f.sound().max(self.v_max).max(1e-6);
-                let dt = f.dt.min(limit);
+                let dt = f.dt_max.unwrap_or(f.dt).min(limit);
                 let steps = (self.frame_time / dt as f64)
                     .ceil()
                     .clamp(1.0, super::params::MAX_SUBSTEPS as f64)
@@ -110,13 +111,20 @@ impl Stepper {
     /// `steps.csv`: one row per step.
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
         let mut out = String::from(
-            "frame,step,time,dt,iterations,density_error_mean,density_error_max,particles\n",
+            "frame,step,time,dt,iterations,density_error_mean,density_error_max,\
+             divergence_iterations,divergence_error,particles\n",
         );
         for (frame, k, t, e) in &self.steps {
-            // WCSPH solves no pressure system: 0 iterations.
+            // WCSPH solves no pressure system: 0 iterations; only DFSPH has a divergence solve.
             out += &format!(
-                "{frame},{k},{t:.6},{:.6e},0,{:.6e},{:.6e},{}\n",
-                e.dt, e.mean, e.max, e.particles
+                "{frame},{k},{t:.6},{:.6e},{},{:.6e},{:.6e},{},{:.6e},{}\n",
+                e.dt,
+                e.iterations,
+                e.mean,
+                e.max,
+                e.divergence_iterations,
+                e.divergence_error,
+                e.particles
             );
         }
         std::fs::write(path, out).map_err(|e| Error::Io {

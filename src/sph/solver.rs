@@ -5,8 +5,9 @@
 //! `add_pre_arrange` (hooks.rs).
 use super::hooks::SphHook;
 use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
+use super::pressure::{PressureBuffers, PressurePasses};
 use super::scene::{Particles, Scene};
-use crate::config::{Neighbors, SortAlgo};
+use crate::config::{Neighbors, Solver, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::particles::{AttrId, AttributeDecl, ParticleStore};
@@ -69,9 +70,9 @@ const ATTRIBUTES: [AttributeDecl; 6] = [
 pub const MAX_PARTICLES: u64 = 1 << 26;
 
 /// Device bytes per particle, an upper bound for the solver's state and neighbour buffers
-/// and a view's per-particle buffers (measured in tests/sph.rs), for refusing scenes that
-/// cannot fit before anything is made.
-pub const BYTES_PER_PARTICLE: u64 = 320;
+/// (the pressure solvers' included) and a view's per-particle buffers (measured in
+/// tests/sph.rs), for refusing scenes that cannot fit before anything is made.
+pub const BYTES_PER_PARTICLE: u64 = 320 + super::pressure::BYTES_PER_PARTICLE;
 
 /// Local size of the per-particle passes.
 pub const LOCAL_SIZE: u32 = 128;
@@ -86,6 +87,10 @@ pub struct SphSolver {
     force_hooks: Vec<Box<dyn SphHook>>,
     /// Extra per-particle passes before arrange (emission, skinning).
     pre_arrange: Vec<Box<dyn SphHook>>,
+    /// The incompressible solvers' passes, built by `state` for the scene's solver.
+    pressure: std::cell::RefCell<Vec<PressurePasses>>,
+    /// The neighbour search's and the EOS's defines (for those passes).
+    defines: Vec<(String, String)>,
 }
 
 /// Particle state and scratch for up to `particles.capacity` particles.
@@ -101,6 +106,8 @@ pub struct SphState {
     collider_list: Vec<GpuCollider>,
     /// Current step size (the CFL limit may lower it below fluid.dt).
     pub dt: f32,
+    /// The incompressible solvers' buffers (None for wcsph).
+    pub pressure: Option<PressureBuffers>,
 }
 
 impl SphState {
@@ -122,6 +129,28 @@ impl SphState {
     /// The parameters buffer (SphParams) of the current step.
     pub fn params(&self) -> &Buffer {
         &self.params
+    }
+
+    /// The neighbour query constants of every SPH pass.
+    pub fn neighbor_push(&self) -> NeighborPush {
+        NeighborPush {
+            origin_cell: [
+                self.grid.origin[0],
+                self.grid.origin[1],
+                self.grid.origin[2],
+                self.grid.cell,
+            ],
+            dims: [
+                self.grid.dims[0],
+                self.grid.dims[1],
+                self.grid.dims[2],
+                self.nb.table,
+            ],
+            radius: self.fluid.h,
+            n: self.n,
+            max_neighbors: self.nb.max_neighbors,
+            pad: 0,
+        }
     }
 
     /// The buffers every SPH pass binds, in the current order.
@@ -185,6 +214,9 @@ impl SphState {
         ctx.destroy_buffer(&mut self.params);
         ctx.destroy_buffer(&mut self.colliders);
         self.nb.destroy(ctx);
+        if let Some(p) = &mut self.pressure {
+            p.destroy(ctx);
+        }
     }
 }
 
@@ -230,9 +262,17 @@ impl StateDump {
 impl SphSolver {
     pub fn new(ctx: &Context, neighbors: Neighbors, sort: Option<SortAlgo>) -> Result<Self> {
         let search = Guard::new(ctx, NeighborSearch::new(ctx, neighbors, sort)?);
-        let eos = super::params::Eos::defines();
-        let mut refs = search.defines();
-        refs.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        let mut defines: Vec<(String, String)> = search
+            .defines()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        defines.extend(super::params::Eos::defines());
+        defines.extend(super::pressure::solver_defines());
+        let refs: Vec<(&str, String)> = defines
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
         let pipeline = |name, shader| {
             ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &refs, LOCAL_SIZE))
         };
@@ -248,7 +288,24 @@ impl SphSolver {
             search: search.take(),
             force_hooks: Vec::new(),
             pre_arrange: Vec::new(),
+            pressure: Default::default(),
+            defines,
         })
+    }
+
+    /// Build the passes of `solver` (once).
+    fn prepare(&self, ctx: &Context, solver: Solver) -> Result<()> {
+        if solver == Solver::Wcsph || self.pressure.borrow().iter().any(|p| p.solver == solver) {
+            return Ok(());
+        }
+        let refs: Vec<(&str, String)> = self
+            .defines
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        let p = PressurePasses::new(ctx, solver, &refs)?;
+        self.pressure.borrow_mut().push(p);
+        Ok(())
     }
 
     /// Add an extra force term, run after the forces pass (it adds into `acc`).
@@ -304,6 +361,12 @@ impl SphSolver {
                 (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
             )?,
         );
+        self.prepare(ctx, f.solver)?;
+        let pressure = match f.solver {
+            Solver::Wcsph => None,
+            _ => Some(PressureBuffers::new(ctx, n as u64)?),
+        };
+        let pressure = Guard::new(ctx, pressure);
         let nb = self.search.buffers(ctx, n as u64, &grid, 0)?;
         Ok(SphState {
             particles: store.take(),
@@ -316,11 +379,12 @@ impl SphSolver {
             domain: (scene.domain.min, scene.domain.max),
             collider_list: colliders,
             dt: f.dt,
+            pressure: pressure.take(),
         })
     }
 
     fn push(&self, st: &SphState) -> NeighborPush {
-        self.search.push(&st.nb, &st.grid, st.fluid.h, st.n)
+        st.neighbor_push()
     }
 
     /// Upload parameters and colliders for the next step (inside the command buffer).
@@ -330,6 +394,9 @@ impl SphSolver {
         ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
         ctx.update(cmd, &st.params, 0, &[p]);
         ctx.update(cmd, &st.colliders, 0, &st.collider_list);
+        if let Some(b) = &st.pressure {
+            b.record_reset(ctx, cmd);
+        }
         // New parameters -> every pass of the step.
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
     }
@@ -426,14 +493,31 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &mut SphState,
     ) -> Result<()> {
+        let solver = st.fluid.solver;
+        if solver != Solver::Wcsph && st.pressure.is_none() {
+            st.pressure()?;
+        }
+        self.prepare(ctx, solver)?;
+        let passes = self.pressure.borrow();
+        let p = passes.iter().find(|p| p.solver == solver);
         scopes.begin(ctx, cmd, "sph");
         self.record_params(ctx, cmd, st);
         Self::run_hooks(&self.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
         self.record_density(ctx, cmd, scopes, st);
+        if let (Some(p), Solver::Dfsph) = (p, solver) {
+            super::dfsph::record_divergence(p, ctx, cmd, scopes, st)?;
+        }
         self.record_forces(ctx, cmd, scopes, st);
         Self::run_hooks(&self.force_hooks, ctx, cmd, scopes, st)?;
-        self.record_integrate(ctx, cmd, scopes, st);
+        match (p, solver) {
+            (Some(p), Solver::Pcisph) => super::pcisph::record(p, ctx, cmd, scopes, st)?,
+            (Some(p), Solver::Dfsph) => super::dfsph::record_density(p, ctx, cmd, scopes, st)?,
+            (Some(p), Solver::Pbf) => super::pbf::record(p, ctx, cmd, scopes, st)?,
+            _ => self.record_integrate(ctx, cmd, scopes, st),
+        }
+        // The step's state -> the next step or its readers.
+        ctx.compute_barrier(cmd);
         scopes.end(ctx, cmd);
         Ok(())
     }
@@ -444,6 +528,9 @@ impl SphSolver {
         self.density.destroy(ctx);
         self.forces.destroy(ctx);
         self.integrate.destroy(ctx);
+        for p in self.pressure.get_mut() {
+            p.destroy(ctx);
+        }
         for h in self
             .force_hooks
             .iter_mut()

@@ -1,0 +1,18 @@
+#version 450
+// Symplectic Euler for PCISPH and DFSPH: v += dt (a_nonpressure + a_pressure) (PCISPH's
+// pressure acceleration in aux2; DFSPH has corrected vel itself and zeroes both), then
+// x += dt v and the collision response. vel.w: DFSPH's density kappa, kept for the next
+// step's warm start.
+#include "pressure.glsl"
+void main() {
+    uint i = global_id();
+    if (!sph_alive(i)) return;
+    float dt = P.gravity.w;
+    vec3 v = vel[i].xyz;
+    if (P.solver == SOLVER_PCISPH) v += dt * (acc[i].xyz + aux2[i].xyz);
+    vec3 x = pos[i].xyz + dt * v;
+    vec3 v2 = v;
+    collide(x, v, v2);
+    pos[i].xyz = x;
+    vel[i] = vec4(v, P.solver == SOLVER_DFSPH ? aux2[i].x : vel[i].w);
+}

@@ -1,0 +1,59 @@
+// The pressure solvers' shared part (src/sph/pressure.rs): PressureIo's bindings past
+// SphIo's, the iteration state, the poly6 kernel and gradient, and the per-workgroup error
+// reduction the loop pass (solve_loop.comp) finishes. V = m / rho0 throughout.
+#ifndef SPH_PRESSURE_GLSL
+#define SPH_PRESSURE_GLSL
+#include "common.glsl"
+layout(std430, binding = SPH_B_AUX) buffer Aux { vec4 aux[]; };     // per solver, see its passes
+layout(std430, binding = SPH_B_AUX2) buffer Aux2 { vec4 aux2[]; };
+layout(std430, binding = SPH_B_PARTIALS) buffer Partials { vec4 partials[]; };  // (sum, max, count)
+struct SolveState {
+    uint gx, gy, gz;   // the iteration passes' VkDispatchIndirectCommand; gz 0 once done
+    uint iter;             // iterations of the current solve
+    uint done;
+    uint pad0, pad1, pad2;
+    uint density_iters, divergence_iters;
+    float density_err, divergence_err;  // the solve's own estimate at its last iteration
+};
+layout(std430, binding = SPH_B_SOLVE) buffer Solve { SolveState S; };
+
+bool sph_alive(uint i) { return i < sph_live() && pos[i].w >= 0.0; }
+float vol0() { return P.mass / P.rest_density; }
+
+// Density by poly6 (as the density pass), gradients by spiky (Macklin & Mueller's choice):
+// poly6's gradient vanishes as r -> 0, so it cannot part particles the walls' projection
+// stacks together, which then pin their pressure high. Spiky's divergence reads about 0.8
+// of poly6's density change on a rest lattice: the solves over-correct compression a
+// little (measured by the density pass, the error the runs report).
+float w_poly6(float r2) { float q = P.h * P.h - r2; return P.poly6 * q * q * q; }
+vec3 grad_w(vec3 d, float r2) {
+    float r = sqrt(r2);
+    if (r <= 1e-6 * P.h) return vec3(0.0);
+    float w = P.h - r;
+    return P.spiky_grad * w * w * (d / r);
+}
+
+// The velocity the collision response leaves to a particle at x moving with v for dt.
+void wall_response(vec3 x, float dt, inout vec3 v) {
+    vec3 y = x + dt * v;
+    vec3 v2 = v;
+    collide(y, v, v2);
+}
+
+shared vec3 red_s[gl_WorkGroupSize.x];
+// Every invocation calls it (no early return before): the workgroup's (sum, max, count) of
+// e over its counted invocations into partials[group_id()].
+void reduce_error(float e, bool counted) {
+    uint lid = gl_LocalInvocationIndex;
+    red_s[lid] = counted ? vec3(e, e, 1.0) : vec3(0.0);
+    barrier();
+    for (uint h = gl_WorkGroupSize.x / 2u; h > 0u; h >>= 1u) {
+        if (lid < h) {
+            vec3 o = red_s[lid + h];
+            red_s[lid] = vec3(red_s[lid].x + o.x, max(red_s[lid].y, o.y), red_s[lid].z + o.z);
+        }
+        barrier();
+    }
+    if (lid == 0u) partials[group_id()] = vec4(red_s[0], 0.0);
+}
+#endif

@@ -1,0 +1,268 @@
+//! CPU reference in f64 of one step of the incompressible solvers, brute-force neighbours,
+//! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count and no
+//! wall in reach (the collision response is left out). Starts from a state with no
+//! warm-start stiffness (a scene's first step).
+use super::params::{Eos, FluidParams, Kernels};
+use crate::config::Solver;
+
+type V3 = [f64; 3];
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn axpy(a: f64, x: V3, y: V3) -> V3 {
+    [y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2]]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+struct K {
+    h: f64,
+    k: Kernels,
+    v: f64,
+    rho0: f64,
+    m: f64,
+}
+
+impl K {
+    fn w(&self, r2: f64) -> f64 {
+        let q = self.h * self.h - r2;
+        if q <= 0.0 {
+            0.0
+        } else {
+            self.k.poly6 * q * q * q
+        }
+    }
+    /// V grad W_spiky (zero past h or at r ~ 0).
+    fn vg(&self, d: V3) -> V3 {
+        let r = dot(d, d).sqrt();
+        if r >= self.h || r <= 1e-6 * self.h {
+            return [0.0; 3];
+        }
+        let s = self.v * self.k.spiky_grad * (self.h - r).powi(2) / r;
+        [s * d[0], s * d[1], s * d[2]]
+    }
+    fn density(&self, x: &[V3], i: usize) -> f64 {
+        self.m
+            * x.iter()
+                .map(|y| self.w(dot(sub(x[i], *y), sub(x[i], *y))))
+                .sum::<f64>()
+    }
+    /// (|sum V grad W|^2 + sum |V grad W|^2) at x_i.
+    fn grad2(&self, x: &[V3], i: usize) -> f64 {
+        let (mut sg, mut s2) = ([0.0; 3], 0.0);
+        for (j, y) in x.iter().enumerate() {
+            if j != i {
+                let g = self.vg(sub(x[i], *y));
+                sg = axpy(1.0, g, sg);
+                s2 += dot(g, g);
+            }
+        }
+        dot(sg, sg) + s2
+    }
+}
+
+/// Positions and velocities after one step of `f.solver` with `iterations` per solve.
+pub fn step(
+    f: &FluidParams,
+    dt: f64,
+    pos: &[[f32; 4]],
+    vel: &[[f32; 4]],
+    iterations: u32,
+) -> (Vec<V3>, Vec<V3>) {
+    let n = pos.len();
+    let kk = K {
+        h: f.h as f64,
+        k: Kernels::new(f.h as f64),
+        v: f.mass as f64 / f.rest_density as f64,
+        rho0: f.rest_density as f64,
+        m: f.mass as f64,
+    };
+    let proto = super::params::proto_grad2(f);
+    let x: Vec<V3> = pos
+        .iter()
+        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        .collect();
+    let mut v: Vec<V3> = vel
+        .iter()
+        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        .collect();
+    let rho: Vec<f64> = (0..n).map(|i| kk.density(&x, i)).collect();
+    // Non-pressure accelerations (the forces pass with no equation of state).
+    let mut fnp = f.clone();
+    fnp.eos = Eos::Ideal;
+    fnp.stiffness = 0.0;
+    if f.solver == Solver::Pbf {
+        fnp.viscosity = 0.0;
+    }
+    let f32s = |a: &[V3]| -> Vec<[f32; 4]> {
+        a.iter()
+            .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32, 0.0])
+            .collect()
+    };
+    let a_np = |v: &[V3]| super::cpu::evaluate(&fnp, pos, &f32s(v)).acc;
+    match f.solver {
+        Solver::Wcsph => panic!("cpu_pressure covers the incompressible solvers"),
+        Solver::Pcisph => {
+            let a = a_np(&v);
+            let delta: Vec<f64> = (0..n)
+                .map(|i| 0.5 / (2.0 * dt * dt * kk.grad2(&x, i).max(1e-3 * proto)))
+                .collect();
+            let cap = 0.2 / (2.0 * dt * dt * proto);
+            let mut p = vec![0.0; n];
+            let mut ap = vec![[0.0; 3]; n];
+            for _ in 0..iterations {
+                let xs: Vec<V3> = (0..n)
+                    .map(|i| axpy(dt, axpy(dt, axpy(1.0, a[i], ap[i]), v[i]), x[i]))
+                    .collect();
+                for i in 0..n {
+                    let err = kk.density(&xs, i) / kk.rho0 - 1.0;
+                    p[i] = (p[i] + delta[i] * err).clamp(0.0, cap);
+                }
+                for i in 0..n {
+                    let mut s = [0.0; 3];
+                    for j in 0..n {
+                        if j != i {
+                            s = axpy(-(p[i] + p[j]), kk.vg(sub(xs[i], xs[j])), s);
+                        }
+                    }
+                    ap[i] = s;
+                }
+            }
+            let v: Vec<V3> = (0..n)
+                .map(|i| axpy(dt, axpy(1.0, a[i], ap[i]), v[i]))
+                .collect();
+            let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+            (x, v)
+        }
+        Solver::Dfsph => {
+            let alpha: Vec<f64> = (0..n)
+                .map(|i| {
+                    let d = kk.grad2(&x, i);
+                    if d > 1e-3 * proto {
+                        1.0 / d
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let rate = |v: &[V3], i: usize| -> f64 {
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
+                    .sum()
+            };
+            let solve = |v: &mut Vec<V3>, divergence: bool| {
+                let source = |v: &[V3]| -> Vec<f64> {
+                    (0..n)
+                        .map(|i| {
+                            if divergence {
+                                rate(v, i).max(0.0)
+                            } else {
+                                (rho[i] / kk.rho0 + dt * rate(v, i) - 1.0).max(0.0)
+                            }
+                        })
+                        .collect()
+                };
+                let mut s = source(v);
+                let scale = if divergence { dt } else { dt * dt };
+                for _ in 0..iterations {
+                    let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
+                    let old = v.clone();
+                    for i in 0..n {
+                        for j in 0..n {
+                            if j != i {
+                                v[i] = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), v[i]);
+                            }
+                        }
+                    }
+                    debug_assert_eq!(old.len(), v.len());
+                    s = source(v);
+                }
+            };
+            solve(&mut v, true);
+            let a = a_np(&v);
+            for i in 0..n {
+                v[i] = axpy(dt, a[i], v[i]);
+            }
+            solve(&mut v, false);
+            let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+            (x, v)
+        }
+        Solver::Pbf => {
+            let a = a_np(&v);
+            let mut xs: Vec<V3> = (0..n)
+                .map(|i| axpy(dt, axpy(dt, a[i], v[i]), x[i]))
+                .collect();
+            let dq = f.scorr_dq as f64 * kk.h;
+            let wdq = kk.w(dq * dq);
+            for _ in 0..iterations {
+                let lambda: Vec<f64> = (0..n)
+                    .map(|i| {
+                        let c = (kk.density(&xs, i) / kk.rho0 - 1.0).max(0.0);
+                        -c / (kk.grad2(&xs, i) + f.pbf_relaxation as f64 * proto)
+                    })
+                    .collect();
+                let dx: Vec<V3> = (0..n)
+                    .map(|i| {
+                        let mut s = [0.0; 3];
+                        for j in 0..n {
+                            let d = sub(xs[i], xs[j]);
+                            if j != i && dot(d, d) < kk.h * kk.h {
+                                let sc = -f.scorr_k as f64
+                                    * (kk.w(dot(d, d)) / wdq).powf(f.scorr_n as f64)
+                                    / proto;
+                                s = axpy(lambda[i] + lambda[j] + sc, kk.vg(d), s);
+                            }
+                        }
+                        s
+                    })
+                    .collect();
+                for i in 0..n {
+                    xs[i] = axpy(1.0, dx[i], xs[i]);
+                }
+            }
+            let mut v: Vec<V3> = (0..n)
+                .map(|i| axpy(-1.0, x[i], xs[i]).map(|c| c / dt))
+                .collect();
+            let x = xs;
+            let mut w = vec![[0.0; 3]; n];
+            let mut dv = vec![[0.0; 3]; n];
+            for i in 0..n {
+                for j in 0..n {
+                    let d = sub(x[i], x[j]);
+                    if j != i && dot(d, d) < kk.h * kk.h {
+                        let vji = sub(v[j], v[i]);
+                        w[i] = axpy(1.0, cross(kk.vg(d), vji), w[i]);
+                        dv[i] = axpy(kk.v * kk.w(dot(d, d)) * f.xsph as f64, vji, dv[i]);
+                    }
+                }
+            }
+            for i in 0..n {
+                let wl = dot(w[i], w[i]).sqrt();
+                let mut eta = [0.0; 3];
+                for j in 0..n {
+                    if j != i {
+                        let wj = dot(w[j], w[j]).sqrt();
+                        eta = axpy(wj - wl, kk.vg(sub(x[i], x[j])), eta);
+                    }
+                }
+                let el = dot(eta, eta).sqrt();
+                let fv = if el > 1e-6 / kk.h {
+                    cross(eta.map(|c| c / el), w[i]).map(|c| c * f.vorticity as f64)
+                } else {
+                    [0.0; 3]
+                };
+                v[i] = axpy(1.0, dv[i], axpy(dt, fv, v[i]));
+            }
+            (x, v)
+        }
+    }
+}

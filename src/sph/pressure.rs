@@ -1,0 +1,368 @@
+//! The incompressible solvers' shared machinery (pcisph.rs, dfsph.rs, pbf.rs): their extra
+//! per-particle buffers, their passes (one table, also read by the every-shader-compiles
+//! registry), and the iteration loop. A solve records `max_iter` iterations; each ends in
+//! a one-workgroup pass (solve_loop.comp) that reduces the iteration's error on the GPU and,
+//! once the solve has converged, zeroes the group count of the indirect dispatches that
+//! remain: no read-back per iteration, and skipped iterations cost an empty dispatch.
+use super::solver::{SphState, LOCAL_SIZE};
+use crate::config::Solver;
+use crate::error::{Error, Result};
+use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::primitives::neighbors::NeighborPush;
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+
+crate::gpu_interface! {
+    /// glsl/sph/pressure.glsl: SphIo's bindings (same numbers), then the pressure solvers'.
+    pub PressureIo / PressureBufs: "SPH", push NeighborPush {
+        params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
+        pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
+        aux = 11, aux2 = 12, partials = 13, solve = 14,
+    }
+}
+
+/// Mirror of `SolveState` in glsl/sph/pressure.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SolveState {
+    /// The iteration passes' VkDispatchIndirectCommand; `gz` is 0 once converged.
+    pub gx: u32,
+    pub gy: u32,
+    pub gz: u32,
+    pub iter: u32,
+    pub done: u32,
+    pub pad: [u32; 3],
+    pub density_iters: u32,
+    pub divergence_iters: u32,
+    /// The solves' own error estimates at their last iteration.
+    pub density_err: f32,
+    pub divergence_err: f32,
+}
+const _: () = assert!(std::mem::size_of::<SolveState>() == 48);
+
+/// Bytes per particle the pressure solvers add (aux, aux2).
+pub const BYTES_PER_PARTICLE: u64 = 32;
+
+/// A pass: (name, shader, PASS, DIVERGENCE).
+type PassDecl = (&'static str, &'static str, &'static str, bool);
+
+const LOOP_DENSITY: PassDecl = ("loop/density", "sph/solve_loop.comp", "PASS_LOOP", false);
+const LOOP_DIVERGENCE: PassDecl = ("loop/divergence", "sph/solve_loop.comp", "PASS_LOOP", true);
+const EULER: PassDecl = ("euler", "sph/euler.comp", "PASS_EULER", false);
+
+/// The passes of each incompressible solver.
+pub fn passes(solver: Solver) -> Vec<PassDecl> {
+    let mut v: Vec<PassDecl> = match solver {
+        Solver::Wcsph => return Vec::new(),
+        Solver::Pcisph => ["factor", "predict", "pressure", "accel"]
+            .iter()
+            .zip(["PASS_FACTOR", "PASS_PREDICT", "PASS_PRESSURE", "PASS_ACCEL"])
+            .map(|(n, p)| (*n, "sph/pcisph.comp", p, false))
+            .collect(),
+        Solver::Dfsph => vec![
+            ("factor", "sph/dfsph.comp", "PASS_FACTOR", false),
+            ("predict", "sph/dfsph.comp", "PASS_PREDICT", false),
+            ("warm/density", "sph/dfsph.comp", "PASS_WARM", false),
+            ("source/density", "sph/dfsph.comp", "PASS_SOURCE", false),
+            ("velocity/density", "sph/dfsph.comp", "PASS_VELOCITY", false),
+            ("warm/divergence", "sph/dfsph.comp", "PASS_WARM", true),
+            ("source/divergence", "sph/dfsph.comp", "PASS_SOURCE", true),
+            (
+                "velocity/divergence",
+                "sph/dfsph.comp",
+                "PASS_VELOCITY",
+                true,
+            ),
+            LOOP_DIVERGENCE,
+        ],
+        Solver::Pbf => [
+            ("predict", "PASS_PREDICT"),
+            ("lambda", "PASS_LAMBDA"),
+            ("delta", "PASS_DELTA"),
+            ("apply", "PASS_APPLY"),
+            ("velocity", "PASS_VELOCITY"),
+            ("vorticity", "PASS_VORTICITY"),
+            ("confine", "PASS_CONFINE"),
+        ]
+        .iter()
+        .map(|(n, p)| (*n, "sph/pbf.comp", *p, false))
+        .collect(),
+    };
+    v.push(LOOP_DENSITY);
+    if solver != Solver::Pbf {
+        v.push(EULER);
+    }
+    v
+}
+
+const PASS_NAMES: [&str; 14] = [
+    "PASS_PREDICT",
+    "PASS_PRESSURE",
+    "PASS_ACCEL",
+    "PASS_FACTOR",
+    "PASS_WARM",
+    "PASS_SOURCE",
+    "PASS_VELOCITY",
+    "PASS_LAMBDA",
+    "PASS_DELTA",
+    "PASS_APPLY",
+    "PASS_VORTICITY",
+    "PASS_CONFINE",
+    "PASS_LOOP",
+    "PASS_EULER",
+];
+
+/// Local size of the loop pass (one workgroup).
+const LOOP_WG: u32 = 256;
+
+/// The defines of one pass, on top of the neighbour search's and the EOS's.
+pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
+    let mut v: Vec<(String, String)> = PASS_NAMES
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (n.to_string(), (k + 1).to_string()))
+        .collect();
+    v.push(("PASS".into(), d.2.into()));
+    v.push(("DIVERGENCE".into(), (d.3 as u32).to_string()));
+    v.push(("PARTICLE_WG".into(), format!("{LOCAL_SIZE}u")));
+    v.extend(solver_defines());
+    v
+}
+
+/// `SOLVER_WCSPH`, ... for glsl/sph/common.glsl.
+pub fn solver_defines() -> Vec<(String, String)> {
+    crate::gpu::interface::enum_defines(
+        "SOLVER",
+        &[
+            ("wcsph", Solver::Wcsph as u32),
+            ("pcisph", Solver::Pcisph as u32),
+            ("dfsph", Solver::Dfsph as u32),
+            ("pbf", Solver::Pbf as u32),
+        ],
+    )
+}
+
+/// One solver's pipelines, by pass name.
+pub struct PressurePasses {
+    pub solver: Solver,
+    pipelines: Vec<(&'static str, ComputePipeline<PressureIo>)>,
+}
+
+impl PressurePasses {
+    /// `base`: the neighbour search's and the EOS's defines.
+    pub fn new(ctx: &Context, solver: Solver, base: &[(&str, String)]) -> Result<Self> {
+        let mut out = Guard::new(
+            ctx,
+            Self {
+                solver,
+                pipelines: Vec::new(),
+            },
+        );
+        for d in passes(solver) {
+            let own = pass_defines(&d);
+            let mut defines: Vec<(&str, String)> = base.to_vec();
+            defines.extend(own.iter().map(|(k, v)| (k.as_str(), v.clone())));
+            let local = if d.2 == "PASS_LOOP" {
+                LOOP_WG
+            } else {
+                LOCAL_SIZE
+            };
+            let label = format!("{}/{}", solver.as_str(), d.0);
+            let p = ComputePipeline::new(ctx, &ComputeDesc::plain(&label, d.1, &defines, local))?;
+            out.pipelines.push((d.0, p));
+        }
+        Ok(out.take())
+    }
+
+    fn get(&self, name: &str) -> &ComputePipeline<PressureIo> {
+        &self
+            .pipelines
+            .iter()
+            .find(|(n, _)| *n == name)
+            .expect("every pass of passes() is built")
+            .1
+    }
+
+    /// One pass over every particle, then its writes -> the next pass.
+    pub fn run(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        st: &SphState,
+        name: &str,
+    ) -> Result<()> {
+        let b = st.pressure_bufs()?;
+        self.get(name)
+            .dispatch(ctx, cmd, &b, &st.neighbor_push(), st.n as u64);
+        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+        Ok(())
+    }
+
+    /// [`run`](Self::run) inside its own timestamp scope.
+    pub fn scoped(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+        name: &str,
+    ) -> Result<()> {
+        scopes.begin(ctx, cmd, name);
+        let r = self.run(ctx, cmd, st, name);
+        scopes.end(ctx, cmd);
+        r
+    }
+
+    /// An iterative solve: `body` passes per iteration (the one that reduces the error
+    /// among them), then the loop pass, `max_iter` times, in the scope `scope`.
+    pub fn solve(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+        (scope, body, divergence): (&str, &[&str], bool),
+    ) -> Result<()> {
+        let b = st.pressure_bufs()?;
+        let solve = st.pressure()?.solve();
+        let push = st.neighbor_push();
+        let groups = (st.n as u64).div_ceil(LOCAL_SIZE as u64).max(1);
+        let gx = groups.min(crate::gpu::pipeline::MAX_GROUPS_X as u64) as u32;
+        let gy = groups.div_ceil(gx as u64) as u32;
+        let (_, max_iter) = st.fluid.iterations();
+        scopes.begin(ctx, cmd, scope);
+        // The last solve's loop passes and dispatches may still read the state.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_READ | sync::INDIRECT_READ,
+            sync::TRANSFER_WRITE,
+        );
+        ctx.update(cmd, solve, 0, &[gx, gy, 1, 0, 0, 0, 0, 0]);
+        ctx.barrier(
+            cmd,
+            sync::TRANSFER_WRITE,
+            sync::COMPUTE_READ | sync::INDIRECT_READ,
+        );
+        let check = self.get(if divergence {
+            LOOP_DIVERGENCE.0
+        } else {
+            LOOP_DENSITY.0
+        });
+        for _ in 0..max_iter {
+            for name in body {
+                self.get(name)
+                    .dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
+                ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+            }
+            check.dispatch_groups(ctx, cmd, &b, &push, 1);
+            // The decision -> the next iteration's dispatches and passes.
+            ctx.barrier(
+                cmd,
+                sync::COMPUTE_WRITE,
+                sync::COMPUTE_READ | sync::INDIRECT_READ,
+            );
+        }
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for (_, p) in &mut self.pipelines {
+            p.destroy(ctx);
+        }
+    }
+}
+
+/// The pressure solvers' buffers, beside the state's.
+pub struct PressureBuffers {
+    aux: Buffer,
+    aux2: Buffer,
+    partials: Buffer,
+    solve: Buffer,
+}
+
+impl PressureBuffers {
+    pub fn new(ctx: &Context, capacity: u64) -> Result<Self> {
+        let n = capacity.max(1);
+        let aux = Guard::new(ctx, ctx.storage_buffer("pressure aux", n * 16)?);
+        let aux2 = Guard::new(ctx, ctx.storage_buffer("pressure aux2", n * 16)?);
+        let partials = Guard::new(
+            ctx,
+            ctx.storage_buffer("pressure partials", n.div_ceil(LOCAL_SIZE as u64) * 16)?,
+        );
+        let solve = ctx.create_buffer(
+            "pressure solve state",
+            std::mem::size_of::<SolveState>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::INDIRECT_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
+            crate::gpu::MemoryLocation::GpuOnly,
+        )?;
+        Ok(Self {
+            aux: aux.take(),
+            aux2: aux2.take(),
+            partials: partials.take(),
+            solve,
+        })
+    }
+
+    /// The solve state (iterations and errors of the current step).
+    pub fn solve(&self) -> &Buffer {
+        &self.solve
+    }
+    pub fn aux2(&self) -> &Buffer {
+        &self.aux2
+    }
+
+    /// Zero the step's solve statistics (a step that solves nothing reports 0).
+    pub fn record_reset(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        ctx.update(cmd, &self.solve, 0, &[SolveState::default()]);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [
+            &mut self.aux,
+            &mut self.aux2,
+            &mut self.partials,
+            &mut self.solve,
+        ] {
+            ctx.destroy_buffer(b);
+        }
+    }
+}
+
+impl SphState {
+    pub fn pressure(&self) -> Result<&PressureBuffers> {
+        self.pressure.as_ref().ok_or_else(|| {
+            Error::Param(format!(
+                "solver {} on a state made for wcsph: make the state with the solver set",
+                self.fluid.solver.as_str()
+            ))
+        })
+    }
+
+    pub fn pressure_bufs(&self) -> Result<PressureBufs<'_>> {
+        let p = self.pressure()?;
+        let b = self.bufs();
+        Ok(PressureBufs {
+            params: b.params,
+            nb_keys: b.nb_keys,
+            nb_start: b.nb_start,
+            nb_end: b.nb_end,
+            nb_box: b.nb_box,
+            pos: b.pos,
+            vel: b.vel,
+            rho_p: b.rho_p,
+            acc: b.acc,
+            vhalf: b.vhalf,
+            colliders: b.colliders,
+            aux: &p.aux,
+            aux2: &p.aux2,
+            partials: &p.partials,
+            solve: &p.solve,
+        })
+    }
+}
+
+crate::impl_destroy!(PressurePasses, PressureBuffers);
