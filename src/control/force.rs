@@ -538,24 +538,7 @@ impl SphHook for ControlHook {
                 "control particles stepped before their first pose".into(),
             ));
         }
-        let push = NeighborPush {
-            origin_cell: [
-                st.grid.origin[0],
-                st.grid.origin[1],
-                st.grid.origin[2],
-                st.grid.cell,
-            ],
-            dims: [
-                st.grid.dims[0],
-                st.grid.dims[1],
-                st.grid.dims[2],
-                st.nb.table,
-            ],
-            radius: st.fluid.h,
-            n: st.n,
-            max_neighbors: st.nb.max_neighbors,
-            pad: 0,
-        };
+        let push = st.neighbor_push();
         let bufs = c.bufs(g, st);
         scopes.begin(ctx, cmd, "control-density");
         g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);

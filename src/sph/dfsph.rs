@@ -18,20 +18,37 @@ pub fn record_divergence(
     st: &SphState,
 ) -> Result<()> {
     p.scoped(ctx, cmd, scopes, st, "factor")?;
-    scopes.begin(ctx, cmd, "divergence");
-    p.run(ctx, cmd, st, "warm/divergence")?;
-    p.run(ctx, cmd, st, "source/divergence")?;
-    let r = p.solve(
-        ctx,
-        cmd,
-        scopes,
-        st,
-        (
-            "iterations",
-            &["velocity/divergence", "source/divergence"],
-            true,
-        ),
-    );
+    solve(p, ctx, cmd, scopes, st, "divergence")
+}
+
+/// Warm start, sources, iterations of one solve (`mode`: divergence or density).
+fn solve(
+    p: &PressurePasses,
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    scopes: &mut dyn Scopes,
+    st: &SphState,
+    mode: &str,
+) -> Result<()> {
+    let scope = if mode == "density" { "pressure" } else { mode };
+    let (velocity, source) = (format!("velocity/{mode}"), format!("source/{mode}"));
+    scopes.begin(ctx, cmd, scope);
+    let r = p
+        .run(ctx, cmd, st, &format!("warm/{mode}"))
+        .and_then(|_| p.run(ctx, cmd, st, &source))
+        .and_then(|_| {
+            p.solve(
+                ctx,
+                cmd,
+                scopes,
+                st,
+                (
+                    "iterations",
+                    &[velocity.as_str(), source.as_str()],
+                    mode == "divergence",
+                ),
+            )
+        });
     scopes.end(ctx, cmd);
     r
 }
@@ -46,17 +63,6 @@ pub fn record_density(
     st: &SphState,
 ) -> Result<()> {
     p.scoped(ctx, cmd, scopes, st, "predict")?;
-    scopes.begin(ctx, cmd, "pressure");
-    p.run(ctx, cmd, st, "warm/density")?;
-    p.run(ctx, cmd, st, "source/density")?;
-    let r = p.solve(
-        ctx,
-        cmd,
-        scopes,
-        st,
-        ("iterations", &["velocity/density", "source/density"], false),
-    );
-    scopes.end(ctx, cmd);
-    r?;
+    solve(p, ctx, cmd, scopes, st, "density")?;
     p.scoped(ctx, cmd, scopes, st, "euler")
 }
