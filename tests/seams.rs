@@ -320,7 +320,16 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             fields!(SphGpuParams;
             gravity, domain_min, domain_max, h, mass, rest_density, stiffness, viscosity,
             tension, tension_threshold, gamma, eos, clamp_negative, colliders, live, poly6,
-            poly6_grad, spiky_grad, visc_lap),
+            poly6_grad, spiky_grad, visc_lap, solver, min_iter, max_iter, density_target,
+            divergence_target, proto_grad2, pbf_relaxation, scorr_k, scorr_n, scorr_inv_w,
+            xsph, vorticity),
+        ),
+        (
+            "sph/solve_loop.comp",
+            "SolveState",
+            fields!(fluidform::sph::pressure::SolveState;
+            gx, gy, gz, iter, done, pad, density_iters, divergence_iters, density_err,
+            divergence_err),
         ),
         (
             "sph/integrate.comp",
