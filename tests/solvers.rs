@@ -5,7 +5,6 @@ use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
 use fluidform::sph::scene::{Block, Domain, Particles, Scene};
 use fluidform::sph::{cpu_pressure, FluidParams, SphSolver, SphState};
-use rand::{Rng, SeedableRng};
 
 const SOLVERS: [Solver; 3] = [Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
 
@@ -37,41 +36,9 @@ fn scene(fluid: FluidParams, domain: [f32; 3], blocks: Vec<Block>) -> Scene {
 /// Random points in a cube around `c` (no two closer than a third of the rest spacing),
 /// random velocities of up to `speed`.
 fn random_particles(f: &FluidParams, n: usize, c: f32, speed: f32, seed: u64) -> Particles {
-    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
     let s = f.spacing();
     let side = s * (n as f32).cbrt();
-    let mut pos: Vec<[f32; 4]> = Vec::new();
-    while pos.len() < n {
-        let p: [f32; 4] = std::array::from_fn(|k| {
-            if k < 3 {
-                c - side / 2.0 + rng.random::<f32>() * side
-            } else {
-                0.0
-            }
-        });
-        let close = pos
-            .iter()
-            .any(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>() < (s / 3.0).powi(2));
-        if !close {
-            pos.push(p);
-        }
-    }
-    let vel = (0..n)
-        .map(|_| {
-            std::array::from_fn(|k| {
-                if k < 3 {
-                    rng.random_range(-speed..speed)
-                } else {
-                    0.0
-                }
-            })
-        })
-        .collect();
-    Particles {
-        pos,
-        vel,
-        attr: vec![[1.0, 1.0, 1.0, 0.0]; n],
-    }
+    common::random_particles(s, n, [c - side / 2.0; 3], side, speed, seed)
 }
 
 fn fixed_iterations(solver: Solver, k: u32) -> FluidParams {

@@ -6,7 +6,6 @@ use fluidform::sph::cpu;
 use fluidform::sph::params::Collider;
 use fluidform::sph::scene::{Ball, Block, Domain, Particles, Scene};
 use fluidform::sph::{Eos, FluidParams, SphSolver};
-use rand::{Rng, SeedableRng};
 
 const STRATEGIES: [(Neighbors, SortAlgo); 4] = [
     (Neighbors::Grid, SortAlgo::Counting),
@@ -52,37 +51,9 @@ fn block_scene(fluid: FluidParams) -> Scene {
 
 /// Random points (no two closer than a third of the rest spacing) with random velocities.
 fn random_particles(scene: &Scene, n: usize, seed: u64) -> Particles {
-    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
     let s = scene.fluid.spacing();
-    let lo = [0.05f32, 0.02, 0.05];
     let side = s * (n as f32).cbrt() * 1.1;
-    let mut pos: Vec<[f32; 4]> = Vec::new();
-    while pos.len() < n {
-        let p = [
-            lo[0] + rng.random::<f32>() * side,
-            lo[1] + rng.random::<f32>() * side,
-            lo[2] + rng.random::<f32>() * side,
-            0.0,
-        ];
-        let close = pos
-            .iter()
-            .any(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>() < (s / 3.0).powi(2));
-        if !close {
-            pos.push(p);
-        }
-    }
-    let vel = (0..n)
-        .map(|_| {
-            [
-                rng.random_range(-0.5..0.5),
-                rng.random_range(-0.5..0.5),
-                rng.random_range(-0.5..0.5),
-                0.0,
-            ]
-        })
-        .collect();
-    let attr = vec![[1.0, 1.0, 1.0, 0.0]; n];
-    Particles { pos, vel, attr }
+    common::random_particles(s, n, [0.05, 0.02, 0.05], side, 0.5, seed)
 }
 
 /// One arrange + density + forces on the GPU; compare with the reference on the same

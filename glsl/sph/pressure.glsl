@@ -41,11 +41,11 @@ void wall_response(vec3 x, float dt, inout vec3 v) {
 }
 
 shared vec3 red_s[gl_WorkGroupSize.x];
-// Every invocation calls it (no early return before): the workgroup's (sum, max, count) of
-// e over its counted invocations into partials[group_id()].
-void reduce_error(float e, bool counted) {
+// Every invocation calls it (no early return before): the workgroup's (sum, max, count)
+// of the invocations' (sum, max, count), for every invocation.
+vec3 reduce_workgroup(vec3 a) {
     uint lid = gl_LocalInvocationIndex;
-    red_s[lid] = counted ? vec3(e, e, 1.0) : vec3(0.0);
+    red_s[lid] = a;
     barrier();
     for (uint h = gl_WorkGroupSize.x / 2u; h > 0u; h >>= 1u) {
         if (lid < h) {
@@ -54,6 +54,13 @@ void reduce_error(float e, bool counted) {
         }
         barrier();
     }
-    if (lid == 0u) partials[group_id()] = vec4(red_s[0], 0.0);
+    return red_s[0];
+}
+
+// The workgroup's (sum, max, count) of e over its counted invocations into
+// partials[group_id()]; every invocation calls it.
+void reduce_error(float e, bool counted) {
+    vec3 r = reduce_workgroup(counted ? vec3(e, e, 1.0) : vec3(0.0));
+    if (gl_LocalInvocationIndex == 0u) partials[group_id()] = vec4(r, 0.0);
 }
 #endif

@@ -14,17 +14,9 @@ void main() {
         vec3 p = partials[k].xyz;
         a = vec3(a.x + p.x, max(a.y, p.y), a.z + p.z);
     }
-    red_s[lid] = a;
-    barrier();
-    for (uint h = gl_WorkGroupSize.x / 2u; h > 0u; h >>= 1u) {
-        if (lid < h) {
-            vec3 o = red_s[lid + h];
-            red_s[lid] = vec3(red_s[lid].x + o.x, max(red_s[lid].y, o.y), red_s[lid].z + o.z);
-        }
-        barrier();
-    }
+    vec3 r = reduce_workgroup(a);
     if (lid != 0u) return;
-    float mean = red_s[0].x / max(red_s[0].z, 1.0);
+    float mean = r.x / max(r.z, 1.0);
     uint it = S.iter + 1u;
     S.iter = it;
 #if DIVERGENCE

@@ -97,7 +97,8 @@ fn all_defines<I: Interface>(own: &[(&str, String)]) -> Vec<(String, String)> {
     d
 }
 
-fn as_refs(d: &[(String, String)]) -> Vec<(&str, String)> {
+/// Owned defines as the `(&str, String)` pairs a `ComputeDesc` takes.
+pub fn as_refs(d: &[(String, String)]) -> Vec<(&str, String)> {
     d.iter().map(|(k, v)| (k.as_str(), v.clone())).collect()
 }
 

@@ -353,7 +353,7 @@ impl NeighborSearch {
         })
     }
 
-    pub fn push(&self, b: &NeighborBuffers, grid: &GridSpec, radius: f32, n: u32) -> NeighborPush {
+    pub fn push(b: &NeighborBuffers, grid: &GridSpec, radius: f32, n: u32) -> NeighborPush {
         NeighborPush {
             origin_cell: [grid.origin[0], grid.origin[1], grid.origin[2], grid.cell],
             dims: [grid.dims[0], grid.dims[1], grid.dims[2], b.table],
@@ -382,7 +382,7 @@ impl NeighborSearch {
                 b.capacity
             )));
         }
-        let push = self.push(b, grid, grid.cell, n);
+        let push = Self::push(b, grid, grid.cell, n);
         // Keys into (keys, vals) for counting, straight into the sorted arrays otherwise.
         let counting = matches!(self.sorter, Sorter::Counting(_));
         let (kd, vd) = if counting {
@@ -469,7 +469,7 @@ impl NeighborSearch {
                 grid.cell
             )));
         }
-        let push = self.push(b, grid, radius, n);
+        let push = Self::push(b, grid, radius, n);
         let (starts, ends) = b.cell_buffers();
         ctx.compute_barrier(cmd); // the build's permutation and cell ranges -> query
         scopes.begin(ctx, cmd, "reorder");

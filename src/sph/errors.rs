@@ -74,11 +74,11 @@ pub struct DensityErrorStats {
 impl DensityErrorStats {
     pub fn add(&mut self, e: &StepError) {
         let k = self.steps as f64;
-        self.mean = (self.mean * k + e.mean as f64) / (k + 1.0);
+        let avg = |m: f64, x: f64| (m * k + x) / (k + 1.0);
+        self.mean = avg(self.mean, e.mean as f64);
         self.max = self.max.max(e.max as f64);
         self.last_mean = e.mean as f64;
         self.last_max = e.max as f64;
-        let avg = |m: f64, x: f64| (m * k + x) / (k + 1.0);
         self.iterations_mean = avg(self.iterations_mean, e.iterations as f64);
         self.iterations_max = self.iterations_max.max(e.iterations);
         self.divergence_iterations_mean = avg(

@@ -161,7 +161,7 @@ impl PressurePasses {
         for d in passes(solver) {
             let own = pass_defines(&d);
             let mut defines: Vec<(&str, String)> = base.to_vec();
-            defines.extend(own.iter().map(|(k, v)| (k.as_str(), v.clone())));
+            defines.extend(crate::gpu::pipeline::as_refs(&own));
             let local = if d.2 == "PASS_LOOP" {
                 LOOP_WG
             } else {
@@ -248,10 +248,10 @@ impl PressurePasses {
         } else {
             LOOP_DENSITY.0
         });
+        let body: Vec<_> = body.iter().map(|name| self.get(name)).collect();
         for _ in 0..max_iter {
-            for name in body {
-                self.get(name)
-                    .dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
+            for p in &body {
+                p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
                 ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
             }
             check.dispatch_groups(ctx, cmd, &b, &push, 1);

@@ -133,24 +133,7 @@ impl SphState {
 
     /// The neighbour query constants of every SPH pass.
     pub fn neighbor_push(&self) -> NeighborPush {
-        NeighborPush {
-            origin_cell: [
-                self.grid.origin[0],
-                self.grid.origin[1],
-                self.grid.origin[2],
-                self.grid.cell,
-            ],
-            dims: [
-                self.grid.dims[0],
-                self.grid.dims[1],
-                self.grid.dims[2],
-                self.nb.table,
-            ],
-            radius: self.fluid.h,
-            n: self.n,
-            max_neighbors: self.nb.max_neighbors,
-            pad: 0,
-        }
+        NeighborSearch::push(&self.nb, &self.grid, self.fluid.h, self.n)
     }
 
     /// The buffers every SPH pass binds, in the current order.
@@ -269,10 +252,7 @@ impl SphSolver {
             .collect();
         defines.extend(super::params::Eos::defines());
         defines.extend(super::pressure::solver_defines());
-        let refs: Vec<(&str, String)> = defines
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
+        let refs = crate::gpu::pipeline::as_refs(&defines);
         let pipeline = |name, shader| {
             ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &refs, LOCAL_SIZE))
         };
@@ -298,12 +278,7 @@ impl SphSolver {
         if solver == Solver::Wcsph || self.pressure.borrow().iter().any(|p| p.solver == solver) {
             return Ok(());
         }
-        let refs: Vec<(&str, String)> = self
-            .defines
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        let p = PressurePasses::new(ctx, solver, &refs)?;
+        let p = PressurePasses::new(ctx, solver, &crate::gpu::pipeline::as_refs(&self.defines))?;
         self.pressure.borrow_mut().push(p);
         Ok(())
     }
@@ -381,10 +356,6 @@ impl SphSolver {
             dt: f.dt,
             pressure: pressure.take(),
         })
-    }
-
-    fn push(&self, st: &SphState) -> NeighborPush {
-        st.neighbor_push()
     }
 
     /// Upload parameters and colliders for the next step (inside the command buffer).
@@ -465,7 +436,7 @@ impl SphSolver {
         name: &str,
     ) {
         scopes.begin(ctx, cmd, name);
-        p.dispatch(ctx, cmd, &st.bufs(), &self.push(st), st.n as u64);
+        p.dispatch(ctx, cmd, &st.bufs(), &st.neighbor_push(), st.n as u64);
         scopes.end(ctx, cmd);
     }
 
@@ -494,8 +465,8 @@ impl SphSolver {
         st: &mut SphState,
     ) -> Result<()> {
         let solver = st.fluid.solver;
-        if solver != Solver::Wcsph && st.pressure.is_none() {
-            st.pressure()?;
+        if solver != Solver::Wcsph {
+            st.pressure()?; // a state made for another solver: a clear error, nothing recorded
         }
         self.prepare(ctx, solver)?;
         let passes = self.pressure.borrow();

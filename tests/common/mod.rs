@@ -66,6 +66,50 @@ pub fn summary(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// `n` random points in the cube [lo, lo + side]^3, no two closer than a third of
+/// `spacing`, with random velocities of up to `speed` per axis and white attributes.
+pub fn random_particles(
+    spacing: f32,
+    n: usize,
+    lo: [f32; 3],
+    side: f32,
+    speed: f32,
+    seed: u64,
+) -> fluidform::sph::scene::Particles {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    let mut pos: Vec<[f32; 4]> = Vec::new();
+    while pos.len() < n {
+        let p = [
+            lo[0] + rng.random::<f32>() * side,
+            lo[1] + rng.random::<f32>() * side,
+            lo[2] + rng.random::<f32>() * side,
+            0.0,
+        ];
+        let close = pos
+            .iter()
+            .any(|q| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>() < (spacing / 3.0).powi(2));
+        if !close {
+            pos.push(p);
+        }
+    }
+    let vel = (0..n)
+        .map(|_| {
+            [
+                rng.random_range(-speed..speed),
+                rng.random_range(-speed..speed),
+                rng.random_range(-speed..speed),
+                0.0,
+            ]
+        })
+        .collect();
+    fluidform::sph::scene::Particles {
+        pos,
+        vel,
+        attr: vec![[1.0, 1.0, 1.0, 0.0]; n],
+    }
+}
+
 /// Seeded pseudo-random u32s.
 pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
     use rand::{Rng, SeedableRng};
