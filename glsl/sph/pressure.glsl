@@ -40,22 +40,7 @@ void wall_response(vec3 x, float dt, inout vec3 v) {
     collide(y, v, v2);
 }
 
-shared vec3 red_s[gl_WorkGroupSize.x];
-// Every invocation calls it (no early return before): the workgroup's (sum, max, count)
-// of the invocations' (sum, max, count), for every invocation.
-vec3 reduce_workgroup(vec3 a) {
-    uint lid = gl_LocalInvocationIndex;
-    red_s[lid] = a;
-    barrier();
-    for (uint h = gl_WorkGroupSize.x / 2u; h > 0u; h >>= 1u) {
-        if (lid < h) {
-            vec3 o = red_s[lid + h];
-            red_s[lid] = vec3(red_s[lid].x + o.x, max(red_s[lid].y, o.y), red_s[lid].z + o.z);
-        }
-        barrier();
-    }
-    return red_s[0];
-}
+#include "common/reduce.glsl"
 
 // The workgroup's (sum, max, count) of e over its counted invocations into
 // partials[group_id()]; every invocation calls it.

@@ -11,8 +11,7 @@ void main() {
     uint parts = (pc.n + PARTICLE_WG - 1u) / PARTICLE_WG;
     vec3 a = vec3(0.0);
     for (uint k = lid; k < parts; k += gl_WorkGroupSize.x) {
-        vec3 p = partials[k].xyz;
-        a = vec3(a.x + p.x, max(a.y, p.y), a.z + p.z);
+        a = combine(a, partials[k].xyz);
     }
     vec3 r = reduce_workgroup(a);
     if (lid != 0u) return;

@@ -6,6 +6,7 @@
 // records[2 step] = (mean, max, count, dt) and copies the pressure solve's iterations and
 // errors into records[2 step + 1] (SolveState in sph/pressure.glsl; zeros for wcsph).
 #include "common/index.glsl"
+#include "common/reduce.glsl"
 layout(constant_id = 1) const uint ITEMS = 8;
 layout(std430, binding = SERR_B_POS) readonly buffer Pos { vec4 pos[]; };
 layout(std430, binding = SERR_B_RHO_P) readonly buffer RhoP { vec2 rho_p[]; };
@@ -24,7 +25,6 @@ layout(push_constant) uniform Push {
     float rest_density;
     float dt;
 } pc;
-shared vec3 s[gl_WorkGroupSize.x];  // sum, max, count
 void main() {
     uint wg = gl_WorkGroupSize.x, lid = gl_LocalInvocationIndex;
     vec3 acc = vec3(0.0);
@@ -39,23 +39,14 @@ void main() {
         }
     } else {
         for (uint i = lid; i < pc.n; i += wg) {
-            vec3 p = partials[i].xyz;
-            acc = vec3(acc.x + p.x, max(acc.y, p.y), acc.z + p.z);
+            acc = combine(acc, partials[i].xyz);
         }
     }
-    s[lid] = acc;
-    barrier();
-    for (uint h = wg / 2u; h > 0u; h >>= 1u) {
-        if (lid < h) {
-            vec3 o = s[lid + h];
-            s[lid] = vec3(s[lid].x + o.x, max(s[lid].y, o.y), s[lid].z + o.z);
-        }
-        barrier();
-    }
+    vec3 s = reduce_workgroup(acc);  // sum, max, count
     if (lid != 0u) return;
-    if (pc.mode == 0u) partials[group_id()] = vec4(s[0], 0.0);
+    if (pc.mode == 0u) partials[group_id()] = vec4(s, 0.0);
     else {
-        records[2u * pc.step] = vec4(s[0].x / max(s[0].z, 1.0), s[0].y, s[0].z, pc.dt);
+        records[2u * pc.step] = vec4(s.x / max(s.z, 1.0), s.y, s.z, pc.dt);
         records[2u * pc.step + 1u] = vec4(uintBitsToFloat(solve.iters.x),
                                           uintBitsToFloat(solve.iters.y), solve.errs);
     }
