@@ -137,8 +137,19 @@ enum BenchWhat {
     },
     /// One SPH step of the dam break scaled to N, per neighbour strategy
     Sph(SphBench),
-    /// The 32K dam break for 10 000 steps, with physics checkpoints
-    Stability(SphBench),
+    /// The 32K dam break for 10 simulated seconds (or --seconds) with the solver's own
+    /// stable step (or --solver), with physics checkpoints
+    Stability {
+        #[command(flatten)]
+        sph: SphBench,
+        /// Simulated seconds
+        #[arg(long, default_value_t = fluidform::bench::sph::STABILITY_SECONDS)]
+        seconds: f64,
+    },
+    /// The dam break per pressure solver (or --solver) at 16K, 64K, 256K (or --particles):
+    /// each at its own stable step and at mean density error <= 1% and <= 0.1%; times
+    /// --frames frames of 20 ms after --warmup frames
+    Solvers(SphBench),
     /// GPU skinning per method (or --skinning) on a character and on a generated mesh
     Skin {
         #[command(flatten)]
@@ -323,7 +334,8 @@ impl BenchWhat {
                     ..d()
                 },
             ),
-            BenchWhat::Stability(a) => ("stability", a.switches()),
+            BenchWhat::Stability { sph, .. } => ("stability", sph.switches()),
+            BenchWhat::Solvers(a) => ("solvers", a.switches()),
             BenchWhat::Particles {
                 common,
                 frame,
@@ -440,6 +452,10 @@ fn real_main() -> Result<()> {
             warmup,
             budget_s,
         } => {
+            let seconds = match &what {
+                BenchWhat::Stability { seconds, .. } => *seconds,
+                _ => fluidform::bench::sph::STABILITY_SECONDS,
+            };
             let (what, switches, character, vertices, velocities) = what.into_parts();
             let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
                 what: what.to_string(),
@@ -452,6 +468,7 @@ fn real_main() -> Result<()> {
                 vertices,
                 velocities,
                 counts: Vec::new(),
+                seconds,
             })?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{} configurations; wrote {}", rows.len(), out.display());

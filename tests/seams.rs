@@ -328,7 +328,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "sph/solve_loop.comp",
             "SolveState",
             fields!(fluidform::sph::pressure::SolveState;
-            gx, gy, gz, iter, done, pad, density_iters, divergence_iters, density_err,
+            gx, gy, gz, iter, done, lx, ly, lz, density_iters, divergence_iters, density_err,
             divergence_err),
         ),
         (

@@ -11,7 +11,7 @@ struct SolveState {
     uint gx, gy, gz;   // the iteration passes' VkDispatchIndirectCommand; gz 0 once done
     uint iter;             // iterations of the current solve
     uint done;
-    uint pad[3];
+    uint lx, ly, lz;   // the loop pass's own indirect dispatch (1, 1, 1); lz 0 once done
     uint density_iters, divergence_iters;
     float density_err, divergence_err;  // the solve's own estimate at its last iteration
 };

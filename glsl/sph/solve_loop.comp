@@ -2,7 +2,8 @@
 // The end of one pressure-solve iteration, one workgroup: the iteration pass's partials
 // into the mean error, the iteration count, and the stop decision (at least min_iter, at
 // most max_iter, else until the mean is within the target). Stopping zeroes the indirect
-// dispatch of the remaining recorded iterations: no read-back per iteration.
+// dispatch of the remaining recorded iterations and of this pass: no read-back per
+// iteration, and a converged solve's remaining iterations cost empty dispatches only.
 // DIVERGENCE: 1 for DFSPH's divergence solve, 0 for the density solve.
 #include "pressure.glsl"
 void main() {
@@ -30,5 +31,6 @@ void main() {
     if ((it >= P.min_iter && mean <= target) || it >= P.max_iter) {
         S.done = 1u;
         S.gz = 0u;
+        S.lz = 0u;
     }
 }

@@ -8,6 +8,7 @@ pub mod plot;
 pub mod primitives;
 pub mod render;
 pub mod skin;
+pub mod solvers;
 pub mod sph;
 
 use crate::config::{Group, Switches};
@@ -37,6 +38,8 @@ pub struct BenchOptions {
     pub velocities: Vec<f32>,
     /// Particle counts to sweep where --particles is unset (empty: the benchmark's own).
     pub counts: Vec<u32>,
+    /// bench stability: simulated seconds to run.
+    pub seconds: f64,
 }
 
 /// `config` of one benchmark configuration's summary.json.
@@ -63,6 +66,7 @@ pub const WHATS: &[&str] = &[
     "neighbors",
     "sph",
     "stability",
+    "solvers",
     "render",
     "skin",
     "control",
@@ -126,6 +130,13 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
                 &[Group::Sort, Group::Neighbors, Group::Fluid],
             )?;
             sph::stability(&ctx, opts)?
+        }
+        "solvers" => {
+            sw.reject_unused(
+                "bench solvers",
+                &[Group::Sort, Group::Neighbors, Group::Fluid],
+            )?;
+            solvers::solvers(&ctx, opts)?
         }
         "render" => {
             sw.reject_unused("bench render", &[Group::Metaball, Group::Camera])?;

@@ -109,6 +109,13 @@ pub fn sweep_dated(
     rows: &[Row],
 ) -> Result<()> {
     font()?;
+    // Rows without a time (a run that went unstable) have no point.
+    let kept: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.main.median.is_finite())
+        .cloned()
+        .collect();
+    let rows = &kept[..];
     let mut variants: Vec<&str> = Vec::new();
     for r in rows {
         if !variants.contains(&r.variant.as_str()) {
@@ -404,4 +411,78 @@ pub fn sheet(
         root.present().map_err(|e| err(path, e))?;
     }
     image::save_buffer(path, &buf, sw, sh, image::ExtendedColorType::Rgb8).map_err(|e| err(path, e))
+}
+
+/// A point of `error_cost`: (series, label, x, y).
+pub type LabelledPoint = (String, String, f64, f64);
+
+/// Density error against cost, log-log: one colour per series (solver), each point
+/// labelled (e.g. its N). `points`: (series, label, GPU s per simulated s, mean error %).
+pub fn error_cost(path: &Path, caption: &str, points: &[LabelledPoint]) -> Result<()> {
+    font()?;
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let range = |f: &dyn Fn(&LabelledPoint) -> f64| {
+        let (a, b) = points
+            .iter()
+            .map(f)
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .fold((f64::MAX, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        if b <= 0.0 {
+            (0.1, 10.0)
+        } else {
+            (
+                10f64.powf((a / 1.5).log10().floor()),
+                10f64.powf((b * 1.5).log10().ceil()),
+            )
+        }
+    };
+    let (x0, x1) = range(&|p| p.2);
+    let (y0, y1) = range(&|p| p.3);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("GPU seconds per simulated second (lower is cheaper)")
+        .y_desc("mean density error %")
+        .x_label_formatter(&|x| format!("{x}"))
+        .y_label_formatter(&|y| format!("{y}"))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    let mut series: Vec<&str> = Vec::new();
+    for p in points {
+        if !series.contains(&p.0.as_str()) {
+            series.push(&p.0);
+        }
+    }
+    for (i, s) in series.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        let pts: Vec<_> = points.iter().filter(|p| p.0 == *s).collect();
+        chart
+            .draw_series(pts.iter().map(|p| Circle::new((p.2, p.3), 5, c.filled())))
+            .map_err(|e| err(path, e))?
+            .label(*s)
+            .legend(move |(x, y)| Circle::new((x + 9, y), 5, c.filled()));
+        chart
+            .draw_series(pts.iter().map(|p| {
+                Text::new(
+                    p.1.clone(),
+                    (p.2 * 1.08, p.3),
+                    ("sans-serif", 13).into_font().color(&c),
+                )
+            }))
+            .map_err(|e| err(path, e))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    root.present().map_err(|e| err(path, e))
 }

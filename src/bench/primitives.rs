@@ -313,6 +313,7 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
     };
     let mut out = Vec::new();
     match what {
+        "solvers" => out.extend(super::solvers::notes(rows)),
         "emission" => {
             if let (Some(h), Some(g)) =
                 (ms("hash/bitonic", 64 << 10), ms("grid/counting", 64 << 10))

@@ -1,11 +1,13 @@
 //! SPH benchmarks: steps per second and per-pass ms over N and neighbour strategies, and
-//! the dam-break stability run (32K particles, 10 000 steps).
+//! the dam-break stability run (32K particles, 10 simulated seconds, any solver).
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, FrameLoop, Guard, Labels, Profiler, RecordOnly};
+use crate::gpu::{Context, FrameLoop, Guard};
 use crate::primitives::neighbors::default_sort;
-use crate::sph::run::{check, physics_stats, PhysicsStats};
+use crate::sph::errors::DensityErrorStats;
+use crate::sph::params::FluidParams;
+use crate::sph::run::{check, physics_stats, PhysicsStats, Stepper};
 use crate::sph::{Scene, SphSolver};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -67,6 +69,8 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Checkpoint {
     pub step: u64,
+    /// Simulated seconds.
+    pub time: f64,
     #[serde(flatten)]
     pub physics: PhysicsStats,
 }
@@ -79,24 +83,44 @@ pub struct StabilitySummary {
     pub sort: SortAlgo,
     pub particles: usize,
     pub steps: u64,
-    pub dt: f32,
+    /// The fluid as run: solver, step (fixed, or CFL up to dt_max), targets.
+    pub fluid: FluidParams,
     pub simulated_seconds: f64,
     pub gpu_seconds: f64,
     pub wall_seconds: f64,
+    pub density_error: DensityErrorStats,
     pub checkpoints: Vec<Checkpoint>,
     pub mean_density_within_5_percent: bool,
+    /// Why the run stopped early, if it went unstable.
+    pub unstable: Option<String>,
 }
 
-/// Steps the stability run takes.
-pub const STABILITY_STEPS: u64 = 10_000;
+/// Simulated seconds of the stability run unless --seconds.
+pub const STABILITY_SECONDS: f64 = 10.0;
 
-/// The dam break at its natural 32K particles for 10 000 steps: no NaN, every particle in
-/// the domain, the settled pool's mean density within 5% of rho_0.
+/// The dam break at its natural 32K particles for --seconds simulated seconds (default
+/// 10) with the solver's own stable configuration (`solvers::own`): no NaN, every particle
+/// in the domain, the settled pool's mean density within 5% of rho_0. Checkpoints every
+/// tenth of the run.
 pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut scene = Scene::built_in("dam-break").expect("built-in");
+    let solver_kind = opts
+        .switches
+        .fluid_args
+        .solver
+        .unwrap_or(scene.fluid.solver);
+    // Frames of 20 ms: they bound a CFL step.
+    scene.fluid.substeps = 50;
+    scene.fluid = super::solvers::own(&scene.fluid, solver_kind);
     scene.fluid = scene.fluid.with_overrides(&opts.switches.fluid_args)?;
     if let Some(n) = opts.switches.common.particles {
         scene = scene.with_particles(n);
+    }
+    if !(opts.seconds > 0.0 && opts.seconds.is_finite()) {
+        return Err(Error::Param(format!(
+            "--seconds must be positive, got {}",
+            opts.seconds
+        )));
     }
     let (strategy, sort) = strategies(
         opts,
@@ -109,31 +133,36 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
     let parts = scene.particles(opts.switches.common.seed);
     let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
-    let per_frame = 50u64;
-    let mut frames = FrameLoop::new(ctx, 2)?;
+    let st_n = st.n as usize;
+    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::session::SLOTS)?);
+    let frame_time = stepper.frame_time;
+    let total = (opts.seconds / frame_time).ceil().max(1.0) as u64;
+    let mut frames = FrameLoop::new(ctx, crate::session::SLOTS)?;
     let mut checkpoints: Vec<Checkpoint> = Vec::new();
     let started = std::time::Instant::now();
-    let frame_count = STABILITY_STEPS / per_frame;
     let result = (|| -> Result<()> {
-        for chunk in 0..10 {
-            let count = frame_count / 10;
-            let mut work = RecordOnly(|prof: &mut Profiler, cmd| {
-                prof.begin(ctx, cmd, "steps");
-                for _ in 0..per_frame {
-                    solver.record_step(ctx, cmd, &mut Labels, &mut st)?;
-                }
-                prof.end(ctx, cmd);
-                Ok(())
-            });
+        let mut played = 0;
+        for chunk in 1..=10u64 {
+            let count = total * chunk / 10 - played;
+            if count == 0 {
+                continue;
+            }
+            let mut work = super::solvers::Play {
+                solver: &solver,
+                st: &mut st,
+                stepper: &mut stepper,
+            };
             frames.run(ctx, count, &mut work)?;
+            played += count;
             let d = st.read(ctx)?;
             let s = Checkpoint {
-                step: (chunk + 1) * count * per_frame,
+                step: stepper.steps_taken,
+                time: stepper.sim_time,
                 physics: physics_stats(&d, &scene),
             };
             eprintln!(
-                "stability: step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",
-                s.step, s.physics.density_mean_over_rest, s.physics.max_speed, s.physics.nan, s.physics.outside_domain
+                "stability {}: {:.2} s, step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",
+                solver_kind.as_str(), s.time, s.step, s.physics.density_mean_over_rest, s.physics.max_speed, s.physics.nan, s.physics.outside_domain
             );
             checkpoints.push(s);
         }
@@ -141,28 +170,36 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     })();
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);
+    let (steps, simulated) = (stepper.steps_taken, stepper.sim_time);
+    let density_error = stepper.density_error.clone();
+    drop(stepper);
     drop(st);
     drop(solver);
-    result?;
-    let last = checkpoints
-        .last()
-        .map(|c| c.physics.clone())
-        .ok_or_else(|| Error::Param("stability: no checkpoint".into()))?;
-    let ratio = last.density_mean_over_rest;
+    let unstable = match &result {
+        Err(Error::Unstable(m)) => Some(m.clone()),
+        _ => None,
+    };
+    if unstable.is_none() {
+        result?;
+    }
+    let last = checkpoints.last().map(|c| c.physics.clone());
+    let ratio = last.as_ref().map_or(f64::NAN, |l| l.density_mean_over_rest);
     let density_ok = (ratio - 1.0).abs() <= 0.05;
     let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
     let summary = StabilitySummary {
         scene: scene.name.clone(),
         neighbors: strategy,
         sort,
-        particles: last.particles,
-        steps: STABILITY_STEPS,
-        dt: scene.fluid.dt,
-        simulated_seconds: STABILITY_STEPS as f64 * scene.fluid.dt as f64,
+        particles: last.as_ref().map_or(st_n, |l| l.particles),
+        steps,
+        fluid: scene.fluid.clone(),
+        simulated_seconds: simulated,
         gpu_seconds: gpu_ms / 1000.0,
         wall_seconds: started.elapsed().as_secs_f64(),
+        density_error,
         checkpoints,
         mean_density_within_5_percent: density_ok,
+        unstable: unstable.clone(),
     };
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
         path: opts.out.display().to_string(),
@@ -180,21 +217,40 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         path: path.display().to_string(),
         source: e,
     })?;
+    if let Some(m) = unstable {
+        return Err(Error::Unstable(format!(
+            "{} after {:.2} simulated s (wrote {}): {m}",
+            solver_kind.as_str(),
+            simulated,
+            path.display()
+        )));
+    }
+    let last = last.ok_or_else(|| Error::Param("stability: no checkpoint".into()))?;
     check(&last)?;
     let row = Row {
-        variant: format!("stability {}/{}", strategy.as_str(), sort.as_str()),
+        variant: format!(
+            "stability {} {}/{}",
+            solver_kind.as_str(),
+            strategy.as_str(),
+            sort.as_str()
+        ),
         n: last.particles as u64,
-        main: crate::report::stat(
-            &timings
-                .iter()
-                .map(|t| t.frame_ms / per_frame as f64)
-                .collect::<Vec<_>>(),
-        )
-        .ok_or_else(|| Error::Param("no frames".into()))?,
+        // GPU ms per frame of 20 ms.
+        main: crate::report::stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>())
+            .ok_or_else(|| Error::Param("no frames".into()))?,
         passes: vec![],
         reps: timings.len() as u64,
         extra: vec![
-            ("steps".into(), STABILITY_STEPS.to_string()),
+            ("simulated s".into(), format!("{simulated:.2}")),
+            ("steps".into(), steps.to_string()),
+            (
+                "sim s per GPU s".into(),
+                format!("{:.4}", simulated / (gpu_ms / 1000.0).max(1e-12)),
+            ),
+            (
+                "mean density error %".into(),
+                format!("{:.3}", summary.density_error.mean * 100.0),
+            ),
             ("final mean density / rho0".into(), format!("{ratio:.4}")),
             ("NaN".into(), last.nan.to_string()),
             ("outside domain".into(), last.outside_domain.to_string()),

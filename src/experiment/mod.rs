@@ -127,6 +127,7 @@ impl Env {
             vertices: None,
             velocities: Vec::new(),
             counts: Vec::new(),
+            seconds: crate::bench::sph::STABILITY_SECONDS,
         }
     }
 }

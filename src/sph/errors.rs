@@ -69,6 +69,10 @@ pub struct DensityErrorStats {
     pub divergence_iterations_mean: f64,
     #[serde(default)]
     pub divergence_error_mean: f64,
+    /// Solves that used every iteration their frame recorded, fewer than max_iterations
+    /// (they may end above their target; see `Stepper::retire_slot`).
+    #[serde(default)]
+    pub bounded_steps: u64,
 }
 
 impl DensityErrorStats {

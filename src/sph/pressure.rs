@@ -31,7 +31,10 @@ pub struct SolveState {
     pub gz: u32,
     pub iter: u32,
     pub done: u32,
-    pub pad: [u32; 3],
+    /// The loop pass's own VkDispatchIndirectCommand (1, 1, 1); `lz` is 0 once converged.
+    pub lx: u32,
+    pub ly: u32,
+    pub lz: u32,
     pub density_iters: u32,
     pub divergence_iters: u32,
     /// The solves' own error estimates at their last iteration.
@@ -39,6 +42,10 @@ pub struct SolveState {
     pub divergence_err: f32,
 }
 const _: () = assert!(std::mem::size_of::<SolveState>() == 48);
+
+/// Byte offset of the loop pass's dispatch (lx) in SolveState.
+const LOOP_ARGS_OFFSET: u64 = 20;
+const _: () = assert!(std::mem::offset_of!(SolveState, lx) == LOOP_ARGS_OFFSET as usize);
 
 /// Bytes per particle the pressure solvers add (aux, aux2).
 pub const BYTES_PER_PARTICLE: u64 = 32;
@@ -229,7 +236,13 @@ impl PressurePasses {
         let groups = (st.n as u64).div_ceil(LOCAL_SIZE as u64).max(1);
         let gx = groups.min(crate::gpu::pipeline::MAX_GROUPS_X as u64) as u32;
         let gy = groups.div_ceil(gx as u64) as u32;
-        let (_, max_iter) = st.fluid.iterations();
+        let (min_iter, max_iter) = st.fluid.iterations();
+        // The iterations recorded: the state's bound (set from earlier steps' counts by
+        // the Stepper), else max_iter.
+        let recorded = match st.iteration_bound[divergence as usize] {
+            0 => max_iter,
+            b => b.clamp(min_iter.max(1), max_iter),
+        };
         scopes.begin(ctx, cmd, scope);
         // The last solve's loop passes and dispatches may still read the state.
         ctx.barrier(
@@ -237,7 +250,7 @@ impl PressurePasses {
             sync::COMPUTE_READ | sync::INDIRECT_READ,
             sync::TRANSFER_WRITE,
         );
-        ctx.update(cmd, solve, 0, &[gx, gy, 1, 0, 0, 0, 0, 0]);
+        ctx.update(cmd, solve, 0, &[gx, gy, 1, 0, 0, 1, 1, 1]);
         ctx.barrier(
             cmd,
             sync::TRANSFER_WRITE,
@@ -249,12 +262,12 @@ impl PressurePasses {
             LOOP_DENSITY.0
         });
         let body: Vec<_> = body.iter().map(|name| self.get(name)).collect();
-        for _ in 0..max_iter {
+        for _ in 0..recorded {
             for p in &body {
                 p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
                 ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
             }
-            check.dispatch_groups(ctx, cmd, &b, &push, 1);
+            check.dispatch_indirect(ctx, cmd, &b, &push, solve, LOOP_ARGS_OFFSET);
             // The decision -> the next iteration's dispatches and passes.
             ctx.barrier(
                 cmd,

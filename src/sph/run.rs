@@ -15,8 +15,11 @@ use serde::{Deserialize, Serialize};
 pub struct Stepper {
     health: Health,
     errors: StepErrors,
-    /// Per slot: the steps recorded into it and the scene time before them.
-    pending: Vec<(u32, f64)>,
+    /// Per slot: the steps recorded into it, the scene time before them, and the
+    /// iterations each solve recorded (density, divergence; 0: max_iter).
+    pending: Vec<(u32, f64, [u32; 2])>,
+    /// Iterations the next frame records per solve (see `retire_slot`).
+    bound: [u32; 2],
     /// Every step's density error: (frame, step in the frame, time after it, error).
     pub steps: Vec<(u64, u32, f64, StepError)>,
     pub density_error: DensityErrorStats,
@@ -25,6 +28,8 @@ pub struct Stepper {
     pub sim_time: f64,
     v_max: f32,
     rest_density: f32,
+    /// The fluid's (min, max) iterations.
+    iterations: (u32, u32),
 }
 
 impl Stepper {
@@ -39,7 +44,8 @@ impl Stepper {
         Ok(Self {
             health: Health::new(ctx, slots)?,
             errors: errors.take(),
-            pending: vec![(0, 0.0); slots],
+            pending: vec![(0, 0.0, [0; 2]); slots],
+            bound: [0; 2],
             steps: Vec::new(),
             density_error: DensityErrorStats::default(),
             frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
@@ -47,6 +53,7 @@ impl Stepper {
             sim_time: 0.0,
             v_max: 0.0,
             rest_density: st.fluid.rest_density,
+            iterations: st.fluid.iterations(),
         })
     }
 
@@ -79,7 +86,8 @@ impl Stepper {
     ) -> Result<()> {
         let (steps, dt) = self.plan(st);
         st.dt = dt;
-        self.pending[slot] = (steps, self.sim_time);
+        st.iteration_bound = self.bound;
+        self.pending[slot] = (steps, self.sim_time, self.bound);
         for k in 0..steps {
             solver.record_step(ctx, cmd, prof, st)?;
             prof.begin(ctx, cmd, StepErrors::NAME);
@@ -95,16 +103,39 @@ impl Stepper {
         Ok(())
     }
 
-    /// After a slot's fence: stop on an unstable frame; update v_max for CFL.
+    /// After a slot's fence: stop on an unstable frame; update v_max for CFL and the
+    /// iterations the next frame records.
+    ///
+    /// Iterations past convergence cost empty indirect dispatches, which are not free
+    /// (on lavapipe about 0.2 ms each). So a frame records the most iterations the last
+    /// finished frame took, plus 2 and a quarter, up to max_iter; a step that used every
+    /// iteration recorded (it may have stopped above its target) is counted in
+    /// `bounded_steps`, and the next frame records twice as many.
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
         let h = self.health.check(slot, frame, self.rest_density)?;
         self.v_max = h.max_speed();
-        let (steps, mut t) = self.pending[slot];
+        let (steps, mut t, recorded) = self.pending[slot];
+        let (_, max_iter) = self.iterations;
+        let cap = |b: u32| if b == 0 { max_iter } else { b.min(max_iter) };
+        let mut most = [0u32; 2];
+        let mut hit = false;
         for (k, e) in self.errors.read(slot, steps).into_iter().enumerate() {
             t += e.dt as f64;
+            let used = [e.iterations, e.divergence_iterations];
+            for d in 0..2 {
+                most[d] = most[d].max(used[d]);
+                if used[d] > 0 && used[d] >= cap(recorded[d]) && cap(recorded[d]) < max_iter {
+                    hit = true;
+                    self.density_error.bounded_steps += 1;
+                }
+            }
             self.density_error.add(&e);
             self.steps.push((frame, k as u32, t, e));
         }
+        self.bound = match hit {
+            true => recorded.map(|r| (2 * cap(r)).min(max_iter)),
+            false => most.map(|m| (m + 2 + m / 4).min(max_iter)),
+        };
         Ok(())
     }
 

@@ -108,6 +108,9 @@ pub struct SphState {
     pub dt: f32,
     /// The incompressible solvers' buffers (None for wcsph).
     pub pressure: Option<PressureBuffers>,
+    /// Iterations the next steps record per solve (density, divergence); 0: max_iter.
+    /// The Stepper lowers it from the counts it reads back (see `Stepper::retire_slot`).
+    pub iteration_bound: [u32; 2],
 }
 
 impl SphState {
@@ -355,6 +358,7 @@ impl SphSolver {
             collider_list: colliders,
             dt: f.dt,
             pressure: pressure.take(),
+            iteration_bound: [0; 2],
         })
     }
 

@@ -1,0 +1,374 @@
+//! `bench solvers`: the dam break per pressure solver, at each solver's own stable step and
+//! at matched accuracy (mean density error at most 1% and at most 0.1%): GPU ms per step,
+//! simulated seconds per GPU second, iterations, mean and max density error.
+//!
+//! A configuration plays `--warmup` frames of 20 ms untimed (the column starts to fall),
+//! then `--frames` frames timed; every step is CFL-limited (`Stepper`).
+use super::{BenchOptions, Row};
+use crate::config::Solver;
+use crate::error::{Error, Result};
+use crate::gpu::{Context, FrameWork, Guard, Profiler};
+use crate::report::stat;
+use crate::sph::errors::DensityErrorStats;
+use crate::sph::params::{Eos, FluidParams};
+use crate::sph::run::Stepper;
+use crate::sph::{Scene, SphSolver, SphState};
+use ash::vk;
+
+pub const SOLVERS: [Solver; 4] = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
+
+/// Default particle counts: the dam break scaled to 16K, 64K and 256K.
+pub const COUNTS: &[u32] = &[16 << 10, 64 << 10, 256 << 10];
+
+/// Mean density errors the matched-accuracy rows reach: 1% and 0.1%.
+pub const TARGETS: [f64; 2] = [0.01, 0.001];
+
+/// A configuration's largest step, where the solver stays stable on the dam break
+/// (PCISPH fails at 4 ms: its iterations hit the limit and particles are flung).
+fn own_dt_max(solver: Solver) -> f32 {
+    match solver {
+        Solver::Pcisph => 0.002,
+        Solver::Dfsph => 0.008,
+        _ => 0.004,
+    }
+}
+
+/// The solver's own stable configuration: WCSPH as the scene has it (Tait, c = 40 m/s,
+/// 0.4 ms steps); the others CFL 0.4 up to their own largest step, at their default
+/// density error target (0.1%).
+pub fn own(base: &FluidParams, solver: Solver) -> FluidParams {
+    match solver {
+        Solver::Wcsph => FluidParams {
+            solver,
+            ..base.clone()
+        },
+        _ => FluidParams {
+            solver,
+            cfl: Some(0.4),
+            dt_max: Some(own_dt_max(solver)),
+            ..base.clone()
+        },
+    }
+}
+
+/// The candidates a matched-accuracy row tries, cheapest first: WCSPH raises the speed of
+/// sound (CFL 0.3 limits the step by it); the incompressible solvers take the target as
+/// their error target and halve their largest step.
+pub fn ladder(base: &FluidParams, solver: Solver, target: f64) -> Vec<FluidParams> {
+    match solver {
+        Solver::Wcsph => [10.0, 20.0, 40.0, 80.0, 160.0]
+            .into_iter()
+            .map(|c| FluidParams {
+                solver,
+                eos: Eos::Tait,
+                sound_speed: c,
+                cfl: Some(0.3),
+                dt_max: Some(0.01),
+                ..base.clone()
+            })
+            .collect(),
+        _ => [1.0, 0.5, 0.25]
+            .into_iter()
+            .map(|k| FluidParams {
+                solver,
+                cfl: Some(0.4),
+                dt_max: Some(own_dt_max(solver) * k),
+                density_error: target as f32,
+                ..base.clone()
+            })
+            .collect(),
+    }
+}
+
+/// How a configuration reads in the table.
+pub fn setting(f: &FluidParams) -> String {
+    let step = match (f.cfl, f.dt_max) {
+        (Some(c), Some(m)) => format!("cfl {c}, dt <= {} ms", m * 1000.0),
+        _ => format!("dt {} ms", f.dt * 1000.0),
+    };
+    match f.solver {
+        Solver::Wcsph => format!("c {} m/s, {step}", f.sound()),
+        _ => format!("target {}%, {step}", f.density_error * 100.0),
+    }
+}
+
+/// What one configuration did over its timed frames.
+#[derive(Clone, Debug, Default)]
+pub struct Outcome {
+    pub particles: usize,
+    pub steps: u64,
+    pub simulated_s: f64,
+    /// The timed steps' `sph` scopes (the whole step: search, density, forces, solve).
+    pub gpu_ms: f64,
+    /// GPU ms per step, one value per timed frame.
+    pub per_step_ms: Vec<f64>,
+    pub errors: DensityErrorStats,
+    /// Why the run stopped early (the health check's message), if it did.
+    pub unstable: Option<String>,
+}
+
+impl Outcome {
+    pub fn simulated_per_gpu_s(&self) -> f64 {
+        self.simulated_s / (self.gpu_ms / 1000.0).max(1e-12)
+    }
+    pub fn meets(&self, target: f64) -> bool {
+        self.unstable.is_none() && self.errors.mean <= target
+    }
+}
+
+/// Frames of CFL steps (`Stepper`), nothing drawn.
+pub struct Play<'a> {
+    pub solver: &'a SphSolver,
+    pub st: &'a mut SphState,
+    pub stepper: &'a mut Stepper,
+}
+
+impl FrameWork for Play<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        _frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        self.stepper
+            .record_frame(ctx, cmd, prof, self.solver, self.st, slot)
+    }
+    fn retire(&mut self, _ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        self.stepper.retire_slot(slot, frame)
+    }
+}
+
+/// Play `scene` for `warmup` + `frames` frames; statistics over the timed frames. An
+/// unstable run is an outcome (the row says so), not an error.
+pub fn play(
+    ctx: &Context,
+    solver: &SphSolver,
+    scene: &Scene,
+    opts: &BenchOptions,
+    label: &str,
+) -> Result<Outcome> {
+    let parts = scene.particles(opts.switches.common.seed);
+    let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
+    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::session::SLOTS)?);
+    let mut work = Play {
+        solver,
+        st: &mut st,
+        stepper: &mut stepper,
+    };
+    let total = opts.warmup + opts.frames;
+    let quiet = opts.switches.common.quiet;
+    let played = crate::session::play(ctx, total, &mut work, label, quiet);
+    let mut out = Outcome {
+        particles: st.n as usize,
+        ..Outcome::default()
+    };
+    let timings = match played {
+        Ok(t) => t,
+        Err(Error::Unstable(m)) => {
+            out.unstable = Some(m);
+            return Ok(out);
+        }
+        Err(e) => return Err(e),
+    };
+    for t in timings.iter().filter(|t| t.frame >= opts.warmup) {
+        let ms: f64 = t
+            .passes
+            .iter()
+            .filter(|(k, _)| k == "sph")
+            .map(|(_, v)| v)
+            .sum();
+        let steps: Vec<_> = stepper.steps.iter().filter(|s| s.0 == t.frame).collect();
+        for s in &steps {
+            out.errors.add(&s.3);
+            out.simulated_s += s.3.dt as f64;
+        }
+        out.steps += steps.len() as u64;
+        out.gpu_ms += ms;
+        out.per_step_ms.push(ms / steps.len().max(1) as f64);
+    }
+    Ok(out)
+}
+
+/// One table row of an outcome.
+fn row(variant: String, f: &FluidParams, o: &Outcome) -> Result<Row> {
+    let e = &o.errors;
+    let fail = || Error::Param(format!("bench solvers: {variant}: no timed step"));
+    let main = match &o.unstable {
+        Some(_) => stat(&[f64::NAN]).ok_or_else(fail)?,
+        None => stat(&o.per_step_ms).ok_or_else(fail)?,
+    };
+    let dt_mean = o.simulated_s / o.steps.max(1) as f64;
+    let status = match &o.unstable {
+        Some(m) => format!("unstable: {m}"),
+        None => "ok".into(),
+    };
+    Ok(Row {
+        variant,
+        n: o.particles as u64,
+        main,
+        passes: vec![],
+        reps: o.per_step_ms.len() as u64,
+        extra: vec![
+            ("setting".into(), setting(f)),
+            ("steps".into(), o.steps.to_string()),
+            ("mean dt ms".into(), format!("{:.3}", dt_mean * 1000.0)),
+            (
+                "sim s per GPU s".into(),
+                format!("{:.4}", o.simulated_per_gpu_s()),
+            ),
+            ("iterations".into(), format!("{:.1}", e.iterations_mean)),
+            (
+                "divergence iterations".into(),
+                format!("{:.1}", e.divergence_iterations_mean),
+            ),
+            ("mean error %".into(), format!("{:.3}", e.mean * 100.0)),
+            ("max error %".into(), format!("{:.2}", e.max * 100.0)),
+            ("status".into(), status),
+        ],
+    })
+}
+
+/// The solvers to run: --solver, else all four.
+fn chosen(opts: &BenchOptions) -> Vec<Solver> {
+    match opts.switches.fluid_args.solver {
+        Some(s) => vec![s],
+        None => SOLVERS.to_vec(),
+    }
+}
+
+/// Every N: each solver's own row, then per target the cheapest candidate that reaches it.
+pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let mut base = Scene::built_in("dam-break").expect("built-in");
+    // Frames of 20 ms (50 steps of WCSPH's 0.4 ms): the frame bounds a step, and the
+    // incompressible solvers' CFL steps reach 8 ms.
+    base.fluid.substeps = 50;
+    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args)?;
+    let (strategy, sort) = super::sph::strategies(
+        opts,
+        &[(
+            crate::config::Neighbors::Grid,
+            crate::config::SortAlgo::Counting,
+        )],
+    )[0];
+    let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
+    let counts = match (opts.switches.common.particles, opts.counts.is_empty()) {
+        (Some(n), _) => vec![n],
+        (None, false) => opts.counts.clone(),
+        (None, true) => COUNTS.to_vec(),
+    };
+    let mut rows = Vec::new();
+    let mut points = Vec::new();
+    for n in counts {
+        let scene = base.with_particles(n);
+        // A candidate shared by rows (own and matched) runs once.
+        let mut done: Vec<(String, Outcome)> = Vec::new();
+        let mut run = |f: &FluidParams| -> Result<Outcome> {
+            let key = format!("{f:?}");
+            if let Some((_, o)) = done.iter().find(|(k, _)| *k == key) {
+                return Ok(o.clone());
+            }
+            f.validate()?;
+            let sc = Scene {
+                fluid: f.clone(),
+                ..scene.clone()
+            };
+            let label = format!("{} n={n} {}", f.solver.as_str(), setting(f));
+            let o = play(ctx, &solver, &sc, opts, &label)?;
+            eprintln!(
+                "{label}: {} steps, {:.3} ms/step, {:.4} sim s per GPU s, {:.1} + {:.1} iterations, error mean {:.3}% max {:.2}%{}",
+                o.steps,
+                o.gpu_ms / o.steps.max(1) as f64,
+                o.simulated_per_gpu_s(),
+                o.errors.iterations_mean,
+                o.errors.divergence_iterations_mean,
+                o.errors.mean * 100.0,
+                o.errors.max * 100.0,
+                o.unstable.as_deref().map(|m| format!(", UNSTABLE: {m}")).unwrap_or_default()
+            );
+            done.push((key, o.clone()));
+            Ok(o)
+        };
+        for &s in &chosen(opts) {
+            let f = own(&base.fluid, s);
+            let o = run(&f)?;
+            rows.push(row(format!("{} own", s.as_str()), &f, &o)?);
+        }
+        for target in TARGETS {
+            for &s in &chosen(opts) {
+                let mut last = None;
+                for f in ladder(&base.fluid, s, target) {
+                    let o = run(&f)?;
+                    let ok = o.meets(target);
+                    last = Some((f, o));
+                    if ok {
+                        break;
+                    }
+                }
+                let (f, o) = last.expect("a ladder has candidates");
+                let mut r = row(format!("{} <= {}%", s.as_str(), target * 100.0), &f, &o)?;
+                if o.unstable.is_none() && !o.meets(target) {
+                    let status = r.extra.iter_mut().find(|(k, _)| k == "status");
+                    status.expect("status column").1 = "target not reached".into();
+                }
+                if o.meets(target) {
+                    points.push((
+                        s.as_str(),
+                        format!("{}K", o.particles / 1000),
+                        1.0 / o.simulated_per_gpu_s(),
+                        o.errors.mean * 100.0,
+                    ));
+                }
+                rows.push(r);
+            }
+        }
+    }
+    drop(solver);
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
+        path: opts.out.display().to_string(),
+        source: e,
+    })?;
+    super::plot::error_cost(
+        &opts.out.join("solvers.png"),
+        &format!("bench solvers: {}, {}", ctx.info.name, super::plot::today()),
+        &points,
+    )?;
+    Ok(rows)
+}
+
+/// The ratios the issue's targets name: DFSPH over WCSPH in simulated seconds per GPU
+/// second at each matched accuracy and N.
+pub fn notes(rows: &[Row]) -> Vec<String> {
+    let rate = |variant: &str, n: u64| {
+        let r = rows.iter().find(|r| r.variant == variant && r.n == n)?;
+        let get = |k: &str| r.extra.iter().find(|(n, _)| n == k).map(|(_, v)| v.clone());
+        if get("status")? != "ok" {
+            return None;
+        }
+        get("sim s per GPU s")?.parse::<f64>().ok()
+    };
+    let mut ns: Vec<u64> = rows.iter().map(|r| r.n).collect();
+    ns.dedup();
+    let mut out = vec![
+        "Candidates per matched row, cheapest first: WCSPH c = 10, 20, 40, 80, 160 m/s (CFL 0.3); \
+         the others their own largest step, then 1/2 and 1/4 of it, at the target as their \
+         error target. A row shows the first that reached the target, else the last tried."
+            .to_string(),
+    ];
+    for n in ns {
+        for (target, goal) in [(1.0, 3.0), (0.1, 10.0)] {
+            let (w, d) = (
+                rate(&format!("wcsph <= {target}%"), n),
+                rate(&format!("dfsph <= {target}%"), n),
+            );
+            if let (Some(w), Some(d)) = (w, d) {
+                out.push(format!(
+                    "N {n}, mean density error <= {target}%: DFSPH {:.1}x WCSPH in simulated s per GPU s (target at 64K: {goal}x)",
+                    d / w
+                ));
+            }
+        }
+    }
+    out
+}
