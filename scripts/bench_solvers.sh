@@ -4,17 +4,23 @@
 # accuracy (mean density error <= 1% and <= 0.1%), with a plot of density error against
 # cost; then the 32K dam break for 10 simulated seconds per solver (stability).
 # Usage: scripts/bench_solvers.sh [--device N|NAME] [--frames N] [--warmup N]
-#        [--particles N] [--seconds S]
+#        [--particles N] [--seconds S] [--stability-particles N] [--skip-stability]
 # --frames/--warmup: frames of 20 ms timed / played first (default 10 after 5: the timed
-# window is 0.1 s..0.3 s of the dam break); --seconds: the stability run's length.
-# FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
+# window is 0.1 s..0.3 s of the dam break); --seconds: the stability run's length;
+# --stability-particles: its N (default the scene's 32K); --skip-stability: rows only.
+# FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine); SKIP_ROWS=1
+# rewrites the md from out/bench/solvers without running the rows again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=10
+stab_n=()
+skip=0
 pass=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=$2; shift 2 ;;
+    --stability-particles) stab_n=(--particles "$2"); shift 2 ;;
+    --skip-stability) skip=1; shift ;;
     *) pass+=("$1"); shift ;;
   esac
 done
@@ -24,13 +30,17 @@ done
 source scripts/bench_common.sh "${pass[@]}"
 md=$dir/solvers.md
 rows=("$bin" bench solvers --out out/bench/solvers "${dev[@]}" "${args[@]}")
-"${rows[@]}" > /dev/null
+if [ -z "${SKIP_ROWS:-}" ]; then
+  "${rows[@]}" > /dev/null
+fi
 cp out/bench/solvers/sweep.csv "$dir/solvers.csv"
 cp out/bench/solvers/solvers.png "$dir/solvers.png"
 stab_rows=()
-for s in wcsph pcisph dfsph pbf; do
+solvers=(wcsph pcisph dfsph pbf)
+[ "$skip" = 1 ] && solvers=()
+for s in "${solvers[@]}"; do
   out=out/bench/stability-$s
-  cmd=("$bin" bench stability --solver "$s" --seconds "$seconds" --out "$out" "${dev[@]}")
+  cmd=("$bin" bench stability --solver "$s" --seconds "$seconds" "${stab_n[@]}" --out "$out" "${dev[@]}")
   if "${cmd[@]}" > /dev/null 2> "$out.log"; then
     status=ok
   else
@@ -59,10 +69,11 @@ done
   echo
   echo "![mean density error against GPU seconds per simulated second](solvers.png)"
   echo
-  echo "## Stability: the 32K dam break for $seconds simulated seconds per solver"
+  echo "## Stability: the dam break (${stab_n[1]:-32K} particles) for $seconds simulated seconds per solver"
   echo
   echo "| solver | result | simulated s | steps | sim s per GPU s | final mean density / rho0 | NaN | outside | command |"
   echo "|---|---|---|---|---|---|---|---|---|"
+  [ "$skip" = 1 ] && echo "(not run: --skip-stability)"
   for r in "${stab_rows[@]}"; do
     IFS='|' read -r s status cmd <<< "$r"
     f=out/bench/stability-$s/stability.json

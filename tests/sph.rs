@@ -584,3 +584,92 @@ fn solver_switch_and_per_step_density_errors() {
         assert_eq!(t.trim().lines().count(), 1, "{t}");
     }
 }
+
+/// `bench solvers` writes each solver's own row and its matched-accuracy rows (with the
+/// measured error and a status), and the error-cost plot; `bench stability` runs any
+/// solver and reports its steps and density error.
+#[test]
+fn bench_solvers_and_stability_per_solver() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("solvers");
+    let o = common::fluidform(&[
+        "bench",
+        "solvers",
+        "--solver",
+        "dfsph",
+        "--particles",
+        "1500",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--quiet",
+        "--validation",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::text(&o));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let mut r = csv::Reader::from_reader(csv.as_bytes());
+    let head = r.headers().unwrap().clone();
+    let col = |name: &str| {
+        head.iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("{name} in {head:?}"))
+    };
+    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    let variants: Vec<&str> = rows.iter().map(|x| &x[0]).collect();
+    assert_eq!(variants, ["dfsph own", "dfsph <= 1%", "dfsph <= 0.1%"]);
+    for x in &rows {
+        let err: f64 = x[col("mean error %")].parse().unwrap();
+        let rate: f64 = x[col("sim s per GPU s")].parse().unwrap();
+        let steps: u64 = x[col("steps")].parse().unwrap();
+        assert!(steps >= 2 && rate > 0.0 && err >= 0.0, "{x:?}");
+        let status = &x[col("status")];
+        // A matched row that says ok has reached its target.
+        if status == "ok" && x[0].ends_with("<= 1%") {
+            assert!(err <= 1.0, "{x:?}");
+        }
+        if status == "ok" && x[0].ends_with("<= 0.1%") {
+            assert!(err <= 0.1, "{x:?}");
+        }
+    }
+    assert!(out.join("solvers.png").exists());
+    let out = dir.path().join("stability");
+    let o = common::fluidform(&[
+        "bench",
+        "stability",
+        "--solver",
+        "pbf",
+        "--particles",
+        "1500",
+        "--seconds",
+        "0.1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // Mid-collapse at 0.1 s the mean density may be off rho0: only the run is checked.
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("stability.json")).unwrap())
+            .unwrap_or_else(|e| panic!("{e}: {}", common::text(&o)));
+    assert_eq!(j["fluid"]["solver"], "pbf");
+    assert!(j["simulated_seconds"].as_f64().unwrap() >= 0.1 - 1e-6);
+    assert!(
+        j["steps"].as_u64().unwrap() >= 25,
+        "CFL steps of at most 4 ms"
+    );
+    assert!(j["density_error"]["iterations_mean"].as_f64().unwrap() >= 1.0);
+    // A checkpoint every tenth of the run, at most one per frame of 20 ms.
+    assert_eq!(j["checkpoints"].as_array().unwrap().len(), 5);
+    assert!(j["unstable"].is_null());
+    let o = common::fluidform(&[
+        "bench",
+        "stability",
+        "--seconds",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && common::text(&o).contains("--seconds must be positive"));
+}

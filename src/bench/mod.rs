@@ -275,6 +275,15 @@ fn run_frames(
     crate::session::play(ctx, count, &mut work, label, quiet)
 }
 
+/// A CSV field, quoted where it holds a comma, a quote or a line break.
+fn csv_field(v: &str) -> String {
+    if v.contains([',', '"', '\n']) {
+        format!("\"{}\"", v.replace('"', "\"\""))
+    } else {
+        v.to_string()
+    }
+}
+
 fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {
     let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
         path: p.display().to_string(),
@@ -338,7 +347,7 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String
                 .iter()
                 .find(|(n, _)| n == k)
                 .map(|(_, s)| s.as_str());
-            csv.push_str(&format!(",{}", v.unwrap_or("")));
+            csv.push_str(&format!(",{}", csv_field(v.unwrap_or(""))));
             md.push_str(&format!(" {} |", v.unwrap_or("-")));
         }
         csv.push('\n');
