@@ -63,6 +63,23 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(127, 127, 127),
 ];
 
+/// The series' legend, boxed on a pale ground (plotters' place unless `at`).
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    path: &Path,
+    at: Option<SeriesLabelPosition>,
+) -> Result<()> {
+    let mut labels = chart.configure_series_labels();
+    if let Some(at) = at {
+        labels.position(at);
+    }
+    labels
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(path, e))
+}
+
 /// The rows of a sweep.csv (`variant,n,reps,median_ms,min_ms,max_ms,...`).
 pub fn read_sweep(path: &Path) -> Result<Vec<Row>> {
     let bad = |m: String| Error::Param(format!("{}: {m}", path.display()));
@@ -178,12 +195,7 @@ pub fn sweep_dated(
                 .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))
                 .map_err(|e| err(path, e))?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(path, e))?;
+        legend(&mut chart, path, None)?;
     } else {
         let ymax = rows.iter().map(|r| r.main.max).fold(0.0f64, f64::max);
         let mut chart = ChartBuilder::on(&root)
@@ -273,13 +285,7 @@ pub fn coverage(
     chart
         .draw_series(LineSeries::new(vec![(0.0, 0.9), (tmax, 0.9)], gray))
         .map_err(|e| err(path, e))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(path, e))?;
+    legend(&mut chart, path, Some(SeriesLabelPosition::LowerRight))?;
     root.present().map_err(|e| err(path, e))
 }
 
@@ -350,13 +356,7 @@ pub fn grouped_bars(
             .label(name.as_str())
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(path, e))?;
+    legend(&mut chart, path, Some(SeriesLabelPosition::UpperRight))?;
     root.present().map_err(|e| err(path, e))
 }
 
@@ -478,11 +478,6 @@ pub fn error_cost(path: &Path, caption: &str, points: &[LabelledPoint]) -> Resul
             }))
             .map_err(|e| err(path, e))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(path, e))?;
+    legend(&mut chart, path, None)?;
     root.present().map_err(|e| err(path, e))
 }
