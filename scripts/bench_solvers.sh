@@ -84,10 +84,10 @@ j = json.load(open(sys.argv[1])); c = j["checkpoints"][-1] if j["checkpoints"] e
 gpu = j["gpu_seconds"] or float("nan")
 print(f"| {sys.argv[2]} | {sys.argv[3]} | {j['simulated_seconds']:.2f} | {j['steps']} | "
       f"{j['simulated_seconds'] / gpu:.4f} | {c.get('density_mean_over_rest', float('nan')):.4f} | "
-      f"{c.get('nan', '-')} | {c.get('outside_domain', '-')} | \`{sys.argv[4]}\` |")
+      f"{c.get('nan', '-')} | {c.get('outside_domain', '-')} | `{sys.argv[4]}` |")
 PY
     else
-      echo "| $s | $status | - | - | - | - | - | - | \`$cmd\` |"
+      echo "| $s | $status | - | - | - | - | - | - | `$cmd` |"
     fi
   done
   echo
