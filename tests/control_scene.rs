@@ -263,7 +263,12 @@ fn a_capsule_fills_and_the_time_step_does_not_matter() {
         half.coverage,
         last.coverage
     );
-    assert!((half.inside_fraction - last.inside_fraction).abs() < 0.1);
+    assert!(
+        (half.inside_fraction - last.inside_fraction).abs() < 0.1,
+        "inside fraction {} vs {}",
+        half.inside_fraction,
+        last.inside_fraction
+    );
 }
 
 #[test]
