@@ -179,10 +179,15 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
 
 /// Particle counts to measure: --particles, or the default sweep.
 pub fn counts(opts: &BenchOptions) -> Vec<u32> {
+    counts_or(opts, SWEEP)
+}
+
+/// --particles, else the caller's counts, else the benchmark's `default`.
+pub fn counts_or(opts: &BenchOptions, default: &[u32]) -> Vec<u32> {
     match opts.switches.common.particles {
         Some(n) => vec![n],
         None if !opts.counts.is_empty() => opts.counts.clone(),
-        None => SWEEP.to_vec(),
+        None => default.to_vec(),
     }
 }
 

@@ -253,11 +253,7 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         )],
     )[0];
     let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
-    let counts = match (opts.switches.common.particles, opts.counts.is_empty()) {
-        (Some(n), _) => vec![n],
-        (None, false) => opts.counts.clone(),
-        (None, true) => COUNTS.to_vec(),
-    };
+    let counts = super::counts_or(opts, COUNTS);
     let mut rows = Vec::new();
     let mut points = Vec::new();
     for n in counts {
