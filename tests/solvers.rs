@@ -52,7 +52,9 @@ fn fixed_iterations(solver: Solver, k: u32) -> FluidParams {
     }
 }
 
-/// Sort once (so the step's own sort keeps the order), read, step, read.
+/// Arrange, read, step, read. The counting sort's order inside a cell is arbitrary, so the
+/// step's own sort may swap particles: both reads are put back in the order of the tag each
+/// particle carries in its red colour channel (its index, exact in f32).
 fn one_step(
     ctx: &Context,
     solver: &SphSolver,
@@ -68,11 +70,41 @@ fn one_step(
     })
     .unwrap()
     .unwrap();
-    let before = st.read(ctx).unwrap();
+    let before = by_tag(st.read(ctx).unwrap());
     ctx.one_shot(|cmd| solver.record_step(ctx, cmd, &mut Labels, st))
         .unwrap()
         .unwrap();
-    (before.pos, before.vel, st.read(ctx).unwrap())
+    (before.pos, before.vel, by_tag(st.read(ctx).unwrap()))
+}
+
+/// Particles tagged 0..n in their red colour channel.
+fn tagged(mut p: Particles) -> Particles {
+    for (i, a) in p.attr.iter_mut().enumerate() {
+        a[0] = i as f32;
+    }
+    p
+}
+
+/// The dump in tag order.
+fn by_tag(d: fluidform::sph::solver::StateDump) -> fluidform::sph::solver::StateDump {
+    let n = d.pos.len();
+    let mut slot = vec![usize::MAX; n];
+    for (i, a) in d.attr.iter().enumerate() {
+        let t = a[0] as usize;
+        assert!(
+            t < n && slot[t] == usize::MAX,
+            "particle tags lost: {t} at {i}"
+        );
+        slot[t] = i;
+    }
+    let order = |v: &Vec<[f32; 4]>| slot.iter().map(|&i| v[i]).collect::<Vec<_>>();
+    fluidform::sph::solver::StateDump {
+        pos: order(&d.pos),
+        vel: order(&d.vel),
+        attr: order(&d.attr),
+        acc: order(&d.acc),
+        rho_p: slot.iter().map(|&i| d.rho_p[i]).collect(),
+    }
 }
 
 #[test]
@@ -83,7 +115,7 @@ fn one_step_of_each_solver_matches_the_f64_reference() {
         let f = fixed_iterations(s, 3);
         let sc = scene(f.clone(), [0.4; 3], vec![]);
         // Packed tighter than rest (up to 3x in places): every solve has work to do.
-        let parts = random_particles(&f, 400, 0.2, 0.5, 7);
+        let parts = tagged(random_particles(&f, 400, 0.2, 0.5, 7));
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
         let (pos, vel, after) = one_step(&ctx, &solver, &mut st);
         st.destroy(&ctx);
