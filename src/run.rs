@@ -384,7 +384,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         uses.push(Group::Particles);
     }
     sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
-    use crate::sph::solver::{BYTES_PER_PARTICLE, MAX_PARTICLES};
+    use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
     let sw = &scene.look.apply(sw);
@@ -396,18 +396,15 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     );
     // Refused before any particle or buffer is made (the count is estimated, not built).
     scene.validate()?;
-    scene.check_size(MAX_PARTICLES, BYTES_PER_PARTICLE, 0)?;
+    let per_particle = bytes_per_particle(&scene.fluid);
+    scene.check_size(MAX_PARTICLES, per_particle, 0)?;
     let scene = match sw.common.particles {
         Some(n) => scene.with_particles(n),
         None => scene,
     };
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
-    scene.check_size(
-        MAX_PARTICLES,
-        BYTES_PER_PARTICLE,
-        ctx.info.device_local_bytes,
-    )?;
+    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
     let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
     let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
     let parts = scene.particles(sw.common.seed);
@@ -502,7 +499,10 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         Err(_) => None,
     };
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
-    let density_error = work.stepper.density_error.clone();
+    let density_error = crate::sph::errors::DensityErrorStats {
+        list_overflows: work.st.list_overflows(),
+        ..work.stepper.density_error.clone()
+    };
     let steps_csv = work.stepper.write_csv(&opts.out.join("steps.csv"));
     let render_stats = work.view.stats();
     let character_stats = work.targets.character_stats();

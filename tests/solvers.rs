@@ -142,6 +142,60 @@ fn one_step_of_each_solver_matches_the_f64_reference() {
     common::finish(&ctx);
 }
 
+/// DFSPH's neighbour lists against the grid search every pass: lists long enough for every
+/// particle, lists too short for most (each overflowing particle is searched in the grid
+/// and counted) and none must give the same step to float noise.
+#[test]
+fn dfsph_neighbor_lists_match_the_grid_search() {
+    let ctx = common::ctx();
+    let solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let mut runs = Vec::new();
+    for list in [0u32, 4, 96] {
+        let f = FluidParams {
+            neighbor_list: list,
+            ..fixed_iterations(Solver::Dfsph, 3)
+        };
+        let sc = scene(f.clone(), [0.4; 3], vec![]);
+        let parts = tagged(random_particles(&f, 400, 0.2, 0.5, 7));
+        let mut st = solver.state(&ctx, &sc, &parts).unwrap();
+        let (_, _, after) = one_step(&ctx, &solver, &mut st);
+        let overflows = st.list_overflows();
+        st.destroy(&ctx);
+        eprintln!("list {list}: {overflows} particles overflowed");
+        runs.push((list, after, overflows));
+    }
+    let (_, plain, _) = &runs[0];
+    let vmax = plain
+        .vel
+        .iter()
+        .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+        .fold(0.0f32, f32::max);
+    for (list, d, overflows) in &runs[1..] {
+        let (mut ex, mut ev) = (0.0f32, 0.0f32);
+        for i in 0..d.pos.len() {
+            for k in 0..3 {
+                ex = ex.max((d.pos[i][k] - plain.pos[i][k]).abs());
+                ev = ev.max((d.vel[i][k] - plain.vel[i][k]).abs());
+            }
+        }
+        eprintln!("list {list}: |dx| {ex:.3e} m, |dv| {ev:.3e} m/s of speeds up to {vmax:.3e}");
+        assert!(
+            ex <= 1e-6 && ev <= 1e-5 * vmax,
+            "list {list} differs: {ex} m, {ev} m/s"
+        );
+        match list {
+            4 => assert!(
+                *overflows > 200,
+                "only {overflows} of 400 overflowed 4 entries"
+            ),
+            _ => assert_eq!(*overflows, 0, "a list of {list} overflowed"),
+        }
+    }
+    let mut solver = solver;
+    solver.destroy(&ctx);
+    common::finish(&ctx);
+}
+
 #[test]
 fn momentum_is_conserved_without_walls() {
     let ctx = common::ctx();

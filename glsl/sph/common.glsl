@@ -44,6 +44,8 @@ struct SphParams {
     float scorr_inv_w;        // 1 / W_poly6(dq)
     float xsph;
     float vorticity;
+    uint list_max;            // dfsph: neighbour list length (0: off)
+    uint pad0, pad1, pad2;
 };
 struct Collider {
     vec4 a;    // plane: normal, w = offset (fluid where dot(n, x) >= w); sphere/capsule: point, w = radius

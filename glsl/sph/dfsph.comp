@@ -5,13 +5,15 @@
 // from the velocities; divergence: max(D(rho/rho0)/Dt, 0)). aux2.x, aux2.y: the
 // stiffness kappa the density and divergence solves apply in this step, kept for the next
 // step's warm start in vel.w (by euler.comp) and vhalf.w (by PREDICT): reordered with them.
-//   FACTOR    alpha
+//   FACTOR    density (as density.comp), alpha, the step's neighbour lists
 //   WARM      kappa = last step's / 2 (halved, so a stale kappa fades);
 //             v -= dt sum V (kappa_i + kappa_j) grad W
 //   SOURCE    s, and the iteration's error: s (density), s dt (divergence)
 //   VELOCITY  k = s alpha / dt^2 (density) or / dt (divergence); v -= dt sum V (k_i + k_j)
 //             grad W; kappa += k
 //   PREDICT   v* = v + dt a_nonpressure; the divergence kappa kept
+// The other passes, and DFSPH's forces (forces.comp), read the lists through
+// FOR_NEIGHBORS (pressure.glsl).
 // DIVERGENCE: 1 for the divergence-free solve, 0 for the constant-density solve.
 #include "pressure.glsl"
 
@@ -34,16 +36,27 @@ void main() {
     if (!sph_alive(i)) return;
     vec3 xi = pos[i].xyz;
     vec3 sg = vec3(0.0);
-    float s2 = 0.0;
+    float s2 = 0.0, sum = 0.0;
+    uint count = 0u;
     NB_BEGIN(xi, P.h, j)
         vec3 d = xi - pos[j].xyz;
         float r2 = dot(d, d);
+        if (r2 < h2) { float q = h2 - r2; sum += q * q * q; }  // density, self included
         if (j != i && r2 < h2) {
             vec3 g = V * grad_w(d, r2);
             sg += g;
             s2 += dot(g, g);
+            if (count < P.list_max) nb_list[(count + 1u) * pc.n + i] = j;
+            ++count;
         }
     NB_END
+    if (P.list_max != 0u) {
+        nb_list[i] = count;
+        if (count > P.list_max) atomicAdd(list_overflows, 1u);
+    }
+    // As density.comp, which DFSPH skips (the same sum in the same order).
+    float rho = P.mass * P.poly6 * sum;
+    rho_p[i] = vec2(rho, pressure_of(rho));
     float denom = dot(sg, sg) + s2;
     aux[i] = vec4(denom > 1e-3 * P.proto_grad2 ? 1.0 / denom : 0.0, 0.0, 0.0, 0.0);
 #elif PASS == PASS_SOURCE
@@ -53,11 +66,10 @@ void main() {
         vec3 xi = pos[i].xyz;
         vec3 vi = vel[i].xyz;
         float rate = 0.0;
-        NB_BEGIN(xi, P.h, j)
-            vec3 d = xi - pos[j].xyz;
-            float r2 = dot(d, d);
-            if (j != i && r2 < h2) rate += V * dot(vi - vel[j].xyz, grad_w(d, r2));
-        NB_END
+#define VISIT(j) { vec3 d = xi - pos[j].xyz; float r2 = dot(d, d); \
+            if (j != i && r2 < h2) rate += V * dot(vi - vel[j].xyz, grad_w(d, r2)); }
+        FOR_NEIGHBORS(i, xi, VISIT)
+#undef VISIT
 #if DIVERGENCE
         float s = max(rate, 0.0);
         e = s * dt;
@@ -77,18 +89,15 @@ void main() {
     float ki = k_of(i, dt);
 #endif
     vec3 dv = vec3(0.0);
-    NB_BEGIN(xi, P.h, j)
-        vec3 d = xi - pos[j].xyz;
-        float r2 = dot(d, d);
-        if (j != i && r2 < h2) {
 #if PASS == PASS_WARM
-            float kj = kappa_of(j);
+#define KAPPA_J(j) kappa_of(j)
 #else
-            float kj = k_of(j, dt);
+#define KAPPA_J(j) k_of(j, dt)
 #endif
-            dv -= dt * V * (ki + kj) * grad_w(d, r2);
-        }
-    NB_END
+#define VISIT(j) { vec3 d = xi - pos[j].xyz; float r2 = dot(d, d); \
+        if (j != i && r2 < h2) dv -= dt * V * (ki + KAPPA_J(j)) * grad_w(d, r2); }
+    FOR_NEIGHBORS(i, xi, VISIT)
+#undef VISIT
     // The walls take no pressure: a velocity into one is answered as the step will (the
     // solve then sees the fluid pile up against it).
     vec3 v = vel[i].xyz + dv;

@@ -1,7 +1,13 @@
 #version 450
 // Forces: pressure (spiky gradient, symmetric), viscosity (viscosity Laplacian), surface
 // tension (colour field, where |n| >= threshold), gravity; writes the acceleration f / rho.
+#ifdef PASS
+// DFSPH's forces pass (src/sph/pressure.rs): neighbours from the step's lists.
+#include "pressure.glsl"
+#else
 #include "common.glsl"
+#define FOR_NEIGHBORS(I, XI, VISIT) { NB_BEGIN(XI, P.h, nl_j) VISIT(nl_j) NB_END }
+#endif
 void main() {
     uint i = global_id();
     if (i >= sph_live() || pos[i].w < 0.0) return;  // past the live, or dead
@@ -12,23 +18,24 @@ void main() {
     vec3 f_press = vec3(0.0), f_visc = vec3(0.0), n = vec3(0.0);
     // Colour-field Laplacian, self term included: lap W_poly6(0) = poly6_grad * h^2 * 3h^2.
     float lap = P.mass / rho_i * P.poly6_grad * h2 * 3.0 * h2;
-    NB_BEGIN(xi, h, j)
-        vec3 d = xi - pos[j].xyz;
-        float r2 = dot(d, d);
-        if (j != i && r2 < h2) {
-            vec2 rp = rho_p[j];
-            float vol = P.mass / rp.x;
-            float q = h2 - r2;
-            n += vol * P.poly6_grad * q * q * d;
-            lap += vol * P.poly6_grad * q * (3.0 * h2 - 7.0 * r2);
-            float r = sqrt(r2);
-            if (r > 1e-6 * h) {
-                float w = h - r;
-                f_press -= vol * 0.5 * (p_i + rp.y) * P.spiky_grad * w * w * (d / r);
-                f_visc += vol * (vel[j].xyz - vi) * P.visc_lap * w;
-            }
-        }
-    NB_END
+#define VISIT(j) { \
+        vec3 d = xi - pos[j].xyz; \
+        float r2 = dot(d, d); \
+        if (j != i && r2 < h2) { \
+            vec2 rp = rho_p[j]; \
+            float vol = P.mass / rp.x; \
+            float q = h2 - r2; \
+            n += vol * P.poly6_grad * q * q * d; \
+            lap += vol * P.poly6_grad * q * (3.0 * h2 - 7.0 * r2); \
+            float r = sqrt(r2); \
+            if (r > 1e-6 * h) { \
+                float w = h - r; \
+                f_press -= vol * 0.5 * (p_i + rp.y) * P.spiky_grad * w * w * (d / r); \
+                f_visc += vol * (vel[j].xyz - vi) * P.visc_lap * w; \
+            } \
+        } }
+    FOR_NEIGHBORS(i, xi, VISIT)
+#undef VISIT
     vec3 f = f_press + P.viscosity * f_visc + rho_i * P.gravity.xyz;
     float nl = length(n);
     if (nl >= P.tension_threshold) f -= P.tension * lap * n / nl;

@@ -16,6 +16,19 @@ struct SolveState {
     float density_err, divergence_err;  // the solve's own estimate at its last iteration
 };
 layout(std430, binding = SPH_B_SOLVE) buffer Solve { SolveState S; };
+// DFSPH's neighbour lists of the step (FACTOR writes them; positions stay put until euler):
+// nb_list[i] = the count, nb_list[(k + 1) n + i] = the k-th neighbour (j != i, r < h), in
+// the grid search's order, so a list visit sums exactly as the search would.
+layout(std430, binding = SPH_B_NB_LIST) buffer NbList { uint nb_list[]; };
+layout(std430, binding = SPH_B_OVERFLOW) buffer Overflow { uint list_overflows; };
+
+// VISIT(j) for every neighbour j of particle I at XI: from its list when it has one that
+// holds them all, else by the grid search (VISIT then filters j != I, r < h itself).
+#define FOR_NEIGHBORS(I, XI, VISIT) { \
+    uint nl_n = P.list_max == 0u ? 0xffffffffu : nb_list[I]; \
+    if (nl_n <= P.list_max) { \
+        for (uint nl_k = 0u; nl_k < nl_n; ++nl_k) { uint nl_j = nb_list[(nl_k + 1u) * pc.n + (I)]; VISIT(nl_j) } \
+    } else { NB_BEGIN(XI, P.h, nl_j) VISIT(nl_j) NB_END } }
 
 bool sph_alive(uint i) { return i < sph_live() && pos[i].w >= 0.0; }
 float vol0() { return P.mass / P.rest_density; }

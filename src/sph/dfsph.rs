@@ -9,7 +9,9 @@ use crate::error::Result;
 use crate::gpu::{Context, Scopes};
 use ash::vk;
 
-/// After the density pass: factors and the divergence-free solve.
+/// After the arrange, in place of the density and forces passes: densities, factors and
+/// the step's neighbour lists, the divergence-free solve, the non-pressure forces (from the
+/// lists).
 pub fn record_divergence(
     p: &PressurePasses,
     ctx: &Context,
@@ -18,7 +20,8 @@ pub fn record_divergence(
     st: &SphState,
 ) -> Result<()> {
     p.scoped(ctx, cmd, scopes, st, "factor")?;
-    solve(p, ctx, cmd, scopes, st, "divergence")
+    solve(p, ctx, cmd, scopes, st, "divergence")?;
+    p.scoped(ctx, cmd, scopes, st, "forces")
 }
 
 /// Warm start, sources, iterations of one solve (`mode`: divergence or density).

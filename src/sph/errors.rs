@@ -73,6 +73,10 @@ pub struct DensityErrorStats {
     /// (they may end above their target; see `Stepper::retire_slot`).
     #[serde(default)]
     pub bounded_steps: u64,
+    /// DFSPH: particle-steps with more neighbours than `fluid.neighbor_list`, searched in
+    /// the grid instead (exact, slower).
+    #[serde(default)]
+    pub list_overflows: u64,
 }
 
 impl DensityErrorStats {

@@ -83,6 +83,10 @@ pub struct FluidParams {
     pub xsph: f32,
     /// pbf: vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
     pub vorticity: f32,
+    /// dfsph: neighbours kept per particle and step (0: none). The solves' iterations then
+    /// read a list instead of searching 27 grid cells; a particle with more neighbours is
+    /// searched as before (exact; counted in `stats.density_error.list_overflows`).
+    pub neighbor_list: u32,
 }
 
 impl Default for FluidParams {
@@ -118,9 +122,16 @@ impl Default for FluidParams {
             scorr_dq: 0.2,
             xsph: 0.01,
             vorticity: 0.01,
+            neighbor_list: DEFAULT_NEIGHBOR_LIST,
         }
     }
 }
+
+/// DFSPH's neighbour list length: a particle has about 20 neighbours at rest (h = 1.68
+/// spacings), 30 compressed by half.
+pub const DEFAULT_NEIGHBOR_LIST: u32 = 48;
+/// Longest neighbour list.
+pub const MAX_NEIGHBOR_LIST: u32 = 256;
 
 /// Most steps one frame may be split into.
 pub const MAX_SUBSTEPS: u32 = 1000;
@@ -217,6 +228,12 @@ impl FluidParams {
                 self.min_iterations, self.max_iterations
             )));
         }
+        if self.neighbor_list > MAX_NEIGHBOR_LIST {
+            return Err(Error::Param(format!(
+                "fluid.neighbor_list must be at most {MAX_NEIGHBOR_LIST} (0: off), got {}",
+                self.neighbor_list
+            )));
+        }
         if self.pbf_iterations > MAX_ITERATIONS {
             return Err(Error::Param(format!(
                 "fluid.pbf_iterations must be at most {MAX_ITERATIONS}, got {}",
@@ -283,6 +300,14 @@ impl FluidParams {
             .map_err(|e| Error::Param(format!("--fluid: {e}")))?;
         out.validate()?;
         Ok(out)
+    }
+
+    /// The neighbour list length the solver uses: dfsph's `neighbor_list`, else 0.
+    pub fn list_len(&self) -> u32 {
+        match self.solver {
+            crate::config::Solver::Dfsph => self.neighbor_list,
+            _ => 0,
+        }
     }
 
     /// Lattice spacing at rest density: (m / rho_0)^(1/3).
@@ -352,8 +377,13 @@ pub struct SphGpuParams {
     pub scorr_inv_w: f32,
     pub xsph: f32,
     pub vorticity: f32,
+    /// DFSPH's neighbour list length (0: off; see `FluidParams::list_len`).
+    pub list_max: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
-const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 160);
+const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 176);
 
 impl SphGpuParams {
     /// Byte offset of `live` (the emitter copies its GPU-side count there).
@@ -412,6 +442,10 @@ impl SphGpuParams {
             scorr_inv_w: (1.0 / w_dq) as f32,
             xsph: f.xsph,
             vorticity: f.vorticity,
+            list_max: f.list_len(),
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 }

@@ -17,7 +17,7 @@ crate::gpu_interface! {
     pub PressureIo / PressureBufs: "SPH", push NeighborPush {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
-        aux = 11, aux2 = 12, partials = 13, solve = 14,
+        aux = 11, aux2 = 12, partials = 13, solve = 14, nb_list = 15, overflow = 16,
     }
 }
 
@@ -47,8 +47,16 @@ const _: () = assert!(std::mem::size_of::<SolveState>() == 48);
 const LOOP_ARGS_OFFSET: u64 = 20;
 const _: () = assert!(std::mem::offset_of!(SolveState, lx) == LOOP_ARGS_OFFSET as usize);
 
-/// Bytes per particle the pressure solvers add (aux, aux2).
+/// Bytes per particle the pressure solvers add (aux, aux2), besides the neighbour list.
 pub const BYTES_PER_PARTICLE: u64 = 32;
+
+/// Bytes per particle of a neighbour list of `len` entries (and its count).
+pub fn list_bytes(len: u32) -> u64 {
+    match len {
+        0 => 0,
+        k => 4 * (k as u64 + 1),
+    }
+}
 
 /// A pass: (name, shader, PASS, DIVERGENCE).
 type PassDecl = (&'static str, &'static str, &'static str, bool);
@@ -68,6 +76,7 @@ pub fn passes(solver: Solver) -> Vec<PassDecl> {
             .collect(),
         Solver::Dfsph => vec![
             ("factor", "sph/dfsph.comp", "PASS_FACTOR", false),
+            ("forces", "sph/forces.comp", "PASS_FORCES", false),
             ("predict", "sph/dfsph.comp", "PASS_PREDICT", false),
             ("warm/density", "sph/dfsph.comp", "PASS_WARM", false),
             ("source/density", "sph/dfsph.comp", "PASS_SOURCE", false),
@@ -102,7 +111,7 @@ pub fn passes(solver: Solver) -> Vec<PassDecl> {
     v
 }
 
-const PASS_NAMES: [&str; 14] = [
+const PASS_NAMES: [&str; 15] = [
     "PASS_PREDICT",
     "PASS_PRESSURE",
     "PASS_ACCEL",
@@ -117,6 +126,7 @@ const PASS_NAMES: [&str; 14] = [
     "PASS_CONFINE",
     "PASS_LOOP",
     "PASS_EULER",
+    "PASS_FORCES",
 ];
 
 /// Local size of the loop pass (one workgroup).
@@ -292,10 +302,15 @@ pub struct PressureBuffers {
     aux2: Buffer,
     partials: Buffer,
     solve: Buffer,
+    /// The step's neighbour lists (dfsph, see glsl/sph/dfsph.comp): one u32 when off.
+    nb_list: Buffer,
+    /// Particle-steps whose neighbours overflowed their list, over the state's life.
+    overflow: Buffer,
 }
 
 impl PressureBuffers {
-    pub fn new(ctx: &Context, capacity: u64) -> Result<Self> {
+    /// For `capacity` particles, lists of `list_len` neighbours (0: none).
+    pub fn new(ctx: &Context, capacity: u64, list_len: u32) -> Result<Self> {
         let n = capacity.max(1);
         let aux = Guard::new(ctx, ctx.storage_buffer("pressure aux", n * 16)?);
         let aux2 = Guard::new(ctx, ctx.storage_buffer("pressure aux2", n * 16)?);
@@ -303,6 +318,20 @@ impl PressureBuffers {
             ctx,
             ctx.storage_buffer("pressure partials", n.div_ceil(LOCAL_SIZE as u64) * 16)?,
         );
+        let nb_list = Guard::new(
+            ctx,
+            ctx.storage_buffer("neighbour lists", (n * list_bytes(list_len)).max(4))?,
+        );
+        let overflow = Guard::new(
+            ctx,
+            ctx.create_buffer(
+                "neighbour list overflows",
+                4,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                crate::gpu::MemoryLocation::GpuToCpu,
+            )?,
+        );
+        ctx.one_shot(|cmd| ctx.fill(cmd, &overflow, 0))?;
         let solve = ctx.create_buffer(
             "pressure solve state",
             std::mem::size_of::<SolveState>() as u64,
@@ -317,6 +346,16 @@ impl PressureBuffers {
             aux2: aux2.take(),
             partials: partials.take(),
             solve,
+            nb_list: nb_list.take(),
+            overflow: overflow.take(),
+        })
+    }
+
+    /// Particle-steps whose neighbours overflowed their list so far (read after the
+    /// device is idle or the last step's fence; the counter is host-visible memory).
+    pub fn list_overflows(&self) -> u64 {
+        self.overflow.mapped().map_or(0, |raw| {
+            bytemuck::pod_read_unaligned::<u32>(&raw[..4]) as u64
         })
     }
 
@@ -339,6 +378,8 @@ impl PressureBuffers {
             &mut self.aux2,
             &mut self.partials,
             &mut self.solve,
+            &mut self.nb_list,
+            &mut self.overflow,
         ] {
             ctx.destroy_buffer(b);
         }
@@ -346,6 +387,11 @@ impl PressureBuffers {
 }
 
 impl SphState {
+    /// See [`PressureBuffers::list_overflows`]; 0 for wcsph.
+    pub fn list_overflows(&self) -> u64 {
+        self.pressure.as_ref().map_or(0, |p| p.list_overflows())
+    }
+
     pub fn pressure(&self) -> Result<&PressureBuffers> {
         self.pressure.as_ref().ok_or_else(|| {
             Error::Param(format!(
@@ -374,6 +420,8 @@ impl SphState {
             aux2: &p.aux2,
             partials: &p.partials,
             solve: &p.solve,
+            nb_list: &p.nb_list,
+            overflow: &p.overflow,
         })
     }
 }

@@ -74,6 +74,11 @@ pub const MAX_PARTICLES: u64 = 1 << 26;
 /// tests/sph.rs), for refusing scenes that cannot fit before anything is made.
 pub const BYTES_PER_PARTICLE: u64 = 320 + super::pressure::BYTES_PER_PARTICLE;
 
+/// [`BYTES_PER_PARTICLE`] with the fluid's neighbour lists.
+pub fn bytes_per_particle(f: &super::FluidParams) -> u64 {
+    BYTES_PER_PARTICLE + super::pressure::list_bytes(f.list_len())
+}
+
 /// Local size of the per-particle passes.
 pub const LOCAL_SIZE: u32 = 128;
 
@@ -342,7 +347,7 @@ impl SphSolver {
         self.prepare(ctx, f.solver)?;
         let pressure = match f.solver {
             Solver::Wcsph => None,
-            _ => Some(PressureBuffers::new(ctx, n as u64)?),
+            _ => Some(PressureBuffers::new(ctx, n as u64, f.list_len())?),
         };
         let pressure = Guard::new(ctx, pressure);
         let nb = self.search.buffers(ctx, n as u64, &grid, 0)?;
@@ -479,11 +484,13 @@ impl SphSolver {
         self.record_params(ctx, cmd, st);
         Self::run_hooks(&self.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
-        self.record_density(ctx, cmd, scopes, st);
-        if let (Some(p), Solver::Dfsph) = (p, solver) {
-            super::dfsph::record_divergence(p, ctx, cmd, scopes, st)?;
+        match (p, solver) {
+            (Some(p), Solver::Dfsph) => super::dfsph::record_divergence(p, ctx, cmd, scopes, st)?,
+            _ => {
+                self.record_density(ctx, cmd, scopes, st);
+                self.record_forces(ctx, cmd, scopes, st);
+            }
         }
-        self.record_forces(ctx, cmd, scopes, st);
         Self::run_hooks(&self.force_hooks, ctx, cmd, scopes, st)?;
         match (p, solver) {
             (Some(p), Solver::Pcisph) => super::pcisph::record(p, ctx, cmd, scopes, st)?,
