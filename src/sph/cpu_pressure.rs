@@ -1,7 +1,9 @@
 //! CPU reference in f64 of one step of the incompressible solvers, brute-force neighbours,
-//! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count and no
-//! wall in reach (the collision response is left out). Starts from a state with no
-//! warm-start stiffness (a scene's first step).
+//! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count.
+//! DFSPH's includes the domain's walls (their density and push in the solves, the
+//! collision response of the velocity passes and the positions); PCISPH's and PBF's leave
+//! the collision response out (no wall in reach). Starts from a state with no warm-start
+//! stiffness (a scene's first step).
 use super::params::{Eos, FluidParams, Kernels};
 use crate::config::Solver;
 
@@ -21,6 +23,84 @@ fn cross(a: V3, b: V3) -> V3 {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// The domain box: (min, max) corners, restitution, friction.
+pub struct Walls {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+    pub restitution: f32,
+    pub friction: f32,
+}
+
+impl Walls {
+    pub fn new(f: &FluidParams, min: [f32; 3], max: [f32; 3]) -> Self {
+        Self {
+            min,
+            max,
+            restitution: f.restitution,
+            friction: f.friction,
+        }
+    }
+
+    /// The walls' density / rho0 at x and their sum V grad W (glsl/sph/dfsph.comp).
+    fn solid(&self, h: f64, x: V3) -> (f64, V3) {
+        let density = |d: f64| {
+            let u = (d / h).clamp(0.0, 1.0);
+            let f = u - 4.0 / 3.0 * u.powi(3) + 6.0 / 5.0 * u.powi(5) - 4.0 / 7.0 * u.powi(7)
+                + u.powi(9) / 9.0;
+            0.5 - 315.0 / 256.0 * f
+        };
+        let push = |d: f64| {
+            let w = 1.0 - (d / h).clamp(0.0, 1.0);
+            30.0 / h * (w.powi(4) / 4.0 - w.powi(5) / 5.0)
+        };
+        let (mut rho, mut g) = (0.0, [0.0; 3]);
+        for k in 0..3 {
+            let lo = x[k] - self.min[k] as f64;
+            let hi = self.max[k] as f64 - x[k];
+            if lo < h {
+                rho += density(lo);
+                g[k] -= push(lo);
+            }
+            if hi < h {
+                rho += density(hi);
+                g[k] += push(hi);
+            }
+        }
+        (rho, g)
+    }
+
+    /// The collision response of glsl/sph/common.glsl's `collide` (box only): x clamped,
+    /// v's normal part into a wall reflected with restitution, its tangent damped.
+    fn collide(&self, x: &mut V3, v: &mut V3) {
+        let respond = |v: V3, k: usize, sign: f64| -> V3 {
+            let vn = v[k] * sign;
+            if vn >= 0.0 {
+                return v;
+            }
+            let mut out = v.map(|c| c * (1.0 - self.friction as f64));
+            out[k] = -(self.restitution as f64) * vn * sign;
+            out
+        };
+        for (k, xk) in x.iter_mut().enumerate() {
+            if *xk < self.min[k] as f64 {
+                *xk = self.min[k] as f64;
+                *v = respond(*v, k, 1.0);
+            }
+            if *xk > self.max[k] as f64 {
+                *xk = self.max[k] as f64;
+                *v = respond(*v, k, -1.0);
+            }
+        }
+    }
+
+    /// The velocity the response leaves to a particle at x moving with v for dt.
+    fn response(&self, x: V3, dt: f64, v: V3) -> V3 {
+        let (mut y, mut v) = (axpy(dt, v, x), v);
+        self.collide(&mut y, &mut v);
+        v
+    }
 }
 
 struct K {
@@ -72,6 +152,7 @@ impl K {
 /// Positions and velocities after one step of `f.solver` with `iterations` per solve.
 pub fn step(
     f: &FluidParams,
+    walls: &Walls,
     dt: f64,
     pos: &[[f32; 4]],
     vel: &[[f32; 4]],
@@ -143,9 +224,19 @@ pub fn step(
             (x, v)
         }
         Solver::Dfsph => {
+            let solid: Vec<(f64, V3)> = x.iter().map(|xi| walls.solid(kk.h, *xi)).collect();
             let alpha: Vec<f64> = (0..n)
                 .map(|i| {
-                    let d = kk.grad2(&x, i);
+                    let (mut sg, mut s2) = ([0.0; 3], 0.0);
+                    for j in 0..n {
+                        if j != i {
+                            let g = kk.vg(sub(x[i], x[j]));
+                            sg = axpy(1.0, g, sg);
+                            s2 += dot(g, g);
+                        }
+                    }
+                    sg = axpy(1.0, solid[i].1, sg);
+                    let d = dot(sg, sg) + s2;
                     if d > 1e-3 * proto {
                         1.0 / d
                     } else {
@@ -154,19 +245,24 @@ pub fn step(
                 })
                 .collect();
             let rate = |v: &[V3], i: usize| -> f64 {
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
-                    .sum()
+                dot(v[i], solid[i].1)
+                    + (0..n)
+                        .filter(|&j| j != i)
+                        .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
+                        .sum::<f64>()
             };
             let solve = |v: &mut Vec<V3>, divergence: bool| {
+                // The warm start's pass (no stiffness yet) answers velocities into walls.
+                for i in 0..n {
+                    v[i] = walls.response(x[i], dt, v[i]);
+                }
                 let source = |v: &[V3]| -> Vec<f64> {
                     (0..n)
                         .map(|i| {
                             if divergence {
                                 rate(v, i).max(0.0)
                             } else {
-                                (rho[i] / kk.rho0 + dt * rate(v, i) - 1.0).max(0.0)
+                                (rho[i] / kk.rho0 + solid[i].0 + dt * rate(v, i) - 1.0).max(0.0)
                             }
                         })
                         .collect()
@@ -177,23 +273,27 @@ pub fn step(
                     let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
                     let old = v.clone();
                     for i in 0..n {
+                        let mut vi = axpy(-dt * k[i], solid[i].1, old[i]);
                         for j in 0..n {
                             if j != i {
-                                v[i] = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), v[i]);
+                                vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);
                             }
                         }
+                        v[i] = walls.response(x[i], dt, vi);
                     }
-                    debug_assert_eq!(old.len(), v.len());
                     s = source(v);
                 }
             };
             solve(&mut v, true);
             let a = a_np(&v);
             for i in 0..n {
-                v[i] = axpy(dt, a[i], v[i]);
+                v[i] = walls.response(x[i], dt, axpy(dt, a[i], v[i]));
             }
             solve(&mut v, false);
-            let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+            let mut x: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+            for i in 0..n {
+                walls.collide(&mut x[i], &mut v[i]);
+            }
             (x, v)
         }
         Solver::Pbf => {
