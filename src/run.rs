@@ -499,10 +499,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         Err(_) => None,
     };
     let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
-    let density_error = crate::sph::errors::DensityErrorStats {
-        list_overflows: work.st.list_overflows(),
-        ..work.stepper.density_error.clone()
-    };
+    let density_error = work.stepper.error_stats(&work.st);
     let steps_csv = work.stepper.write_csv(&opts.out.join("steps.csv"));
     let render_stats = work.view.stats();
     let character_stats = work.targets.character_stats();

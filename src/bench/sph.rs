@@ -173,10 +173,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);
     let (steps, simulated) = (stepper.steps_taken, stepper.sim_time);
-    let density_error = DensityErrorStats {
-        list_overflows: st.list_overflows(),
-        ..stepper.density_error.clone()
-    };
+    let density_error = stepper.error_stats(&st);
     drop(stepper);
     drop(st);
     drop(solver);

@@ -135,8 +135,8 @@ impl K {
                 .map(|y| self.w(dot(sub(x[i], *y), sub(x[i], *y))))
                 .sum::<f64>()
     }
-    /// (|sum V grad W|^2 + sum |V grad W|^2) at x_i.
-    fn grad2(&self, x: &[V3], i: usize) -> f64 {
+    /// (sum V grad W, sum |V grad W|^2) at x_i.
+    fn grad_sums(&self, x: &[V3], i: usize) -> (V3, f64) {
         let (mut sg, mut s2) = ([0.0; 3], 0.0);
         for (j, y) in x.iter().enumerate() {
             if j != i {
@@ -145,6 +145,11 @@ impl K {
                 s2 += dot(g, g);
             }
         }
+        (sg, s2)
+    }
+    /// (|sum V grad W|^2 + sum |V grad W|^2) at x_i.
+    fn grad2(&self, x: &[V3], i: usize) -> f64 {
+        let (sg, s2) = self.grad_sums(x, i);
         dot(sg, sg) + s2
     }
 }
@@ -227,15 +232,9 @@ pub fn step(
             let solid: Vec<(f64, V3)> = x.iter().map(|xi| walls.solid(kk.h, *xi)).collect();
             let alpha: Vec<f64> = (0..n)
                 .map(|i| {
-                    let (mut sg, mut s2) = ([0.0; 3], 0.0);
-                    for j in 0..n {
-                        if j != i {
-                            let g = kk.vg(sub(x[i], x[j]));
-                            sg = axpy(1.0, g, sg);
-                            s2 += dot(g, g);
-                        }
-                    }
-                    sg = axpy(1.0, solid[i].1, sg);
+                    // The walls add to the gradient sum (not to the sum of squares).
+                    let (sg, s2) = kk.grad_sums(&x, i);
+                    let sg = axpy(1.0, solid[i].1, sg);
                     let d = dot(sg, sg) + s2;
                     if d > 1e-3 * proto {
                         1.0 / d

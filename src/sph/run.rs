@@ -103,6 +103,15 @@ impl Stepper {
         Ok(())
     }
 
+    /// The run's density error statistics, with the state's neighbour list overflows
+    /// (read once the device is idle).
+    pub fn error_stats(&self, st: &SphState) -> DensityErrorStats {
+        DensityErrorStats {
+            list_overflows: st.list_overflows(),
+            ..self.density_error.clone()
+        }
+    }
+
     /// After a slot's fence: stop on an unstable frame; update v_max for CFL and the
     /// iterations the next frame records.
     ///
