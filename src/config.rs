@@ -76,6 +76,8 @@ switch_enum!(Placement {
 switch_enum!(Skinning { Lbs, Dqs });
 switch_enum!(OnOff { On, Off });
 switch_enum!(Adaptive { Off, On, Smooth });
+switch_enum!(ControlPreset { Thesis, Fidelity });
+switch_enum!(ControlMotion { Frames, Skin });
 switch_enum!(BoneWeights { Eq8, Eq9, Skin });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
@@ -270,6 +272,31 @@ pub struct ControlArgs {
     /// K of a velocity term pulling the fluid to the control particles' velocity (0: off)
     #[arg(long)]
     pub control_velocity: Option<f32>,
+    /// Defaults of the control techniques not set otherwise: thesis (eq. 7 alone, as seed
+    /// 000) or fidelity (ours: adds the deficit attraction, velocity matching and damping;
+    /// the default)
+    #[arg(long, value_enum)]
+    pub control_preset: Option<ControlPreset>,
+    /// Deficit attraction in m/s^2 (after Thuerey et al. 2006): fluid is pulled towards the
+    /// control particles within --control-reach still short of rest density (0: off)
+    #[arg(long)]
+    pub control_attraction: Option<f32>,
+    /// Reach of the deficit attraction and the damping in metres (default 3 h_c)
+    #[arg(long)]
+    pub control_reach: Option<f32>,
+    /// Damping (1/s) of the fluid's velocity relative to the character's near it, within
+    /// the reach (0: off)
+    #[arg(long)]
+    pub control_damping: Option<f32>,
+    /// Velocity of the control particles for the velocity term and the damping: frames
+    /// (the last two frames' poses, a frame behind) or skin (the skin's motion over the
+    /// frame ahead)
+    #[arg(long, value_enum)]
+    pub control_motion: Option<ControlMotion>,
+    /// Scene time in seconds from which the fidelity metrics are summarised in
+    /// summary.json (default: the second half of the run)
+    #[arg(long, value_name = "T")]
+    pub metrics_from: Option<f64>,
     /// Bone weights of control particles: eq8 (the thesis), eq9 (the thesis's eq. 9 is
     /// lost: normalised inverse squared distance stands in), or skin (the nearest vertex's
     /// skin weights)

@@ -27,6 +27,9 @@ pub enum Error {
     Unstable(String),
     #[error("invalid parameter: {0}")]
     Param(String),
+    /// An internal invariant failed: a bug in fluidform, not the user's input.
+    #[error("internal error (a bug, please report it): {0}")]
+    Bug(String),
     #[error("{0}")]
     Unsupported(String),
     #[error("{path}: {source}")]

@@ -143,6 +143,9 @@ impl<'a> Frames<'a> {
     }
 }
 
+/// The metaball radius at the default particle spacing (MetaballSettings' default).
+const DEFAULT_RADIUS: f32 = 0.04;
+
 pub fn run(opts: &RunOptions) -> Result<RunResult> {
     if opts.frames == Some(0) {
         return Err(Error::Param("--frames must be at least 1".into()));
@@ -387,8 +390,14 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
-    let sw = &scene.look.apply(sw);
+    let mut sw = scene.look.apply(sw);
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
+    // The metaballs' radius follows the particle spacing (0.04 m at the default spacing).
+    if sw.metaball.radius.is_none() && scene.fluid.spacing.is_some() {
+        let s0 = crate::sph::FluidParams::default().spacing();
+        sw.metaball.radius = Some(DEFAULT_RADIUS * scene.fluid.spacing() / s0);
+    }
+    let sw = &sw;
     crate::psys::scenes::set_integrator_draw(
         &mut scene.system,
         sw.particle.integrator,

@@ -1,5 +1,6 @@
 //! The driving force (eq. 7) on the GPU against an f64 CPU reference: control densities
-//! and the acceleration it adds, for every adaptive mode and a controlled group.
+//! and the acceleration it adds, for every adaptive mode and a controlled group, and with
+//! the deficit attraction and damping of the fidelity preset.
 mod common;
 use fluidform::character::Mesh;
 use fluidform::config::{Adaptive, Neighbors, Skinning};
@@ -90,7 +91,7 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             1,
             settings.clone(),
             (sc.domain.min, sc.domain.max),
-            None,
+            (None, Skinning::Lbs),
         )
         .unwrap(),
     );
@@ -105,6 +106,7 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             control.set_pose(Pose {
                 joints: joints.clone(),
                 frame_dt: 1.0 / 30.0,
+                next: None,
             });
         }
         ctx.one_shot(|cmd| {
@@ -189,7 +191,29 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
                 }
             }
         }
-        let want = fsum / d1.rho_p[i][0] as f64;
+        let mut want = fsum / d1.rho_p[i][0] as f64;
+        // Deficit attraction and damping (the control particles stand still: their first
+        // pose is also their previous one).
+        let reach = settings.reach as f64;
+        let (mut pull, mut wall) = (glam::DVec3::ZERO, 0.0);
+        if controlled(&d1.attr[i]) {
+            for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
+                let d = c.as_dvec3() - x;
+                let r = d.length();
+                if r < reach {
+                    let w = (1.0 - r / reach).powi(2);
+                    if r > 1e-6 {
+                        pull += w * (1.0 - rho_j / rho0).max(0.0) / r * d;
+                    }
+                    wall += w;
+                }
+            }
+        }
+        if wall > 0.0 {
+            let v = glam::DVec3::from_array([0, 1, 2].map(|k| d1.vel[i][k] as f64));
+            want += settings.attraction as f64 * pull / wall.max(1.0);
+            want -= settings.damping as f64 * v;
+        }
         let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - d0.acc[i][k]) as f64));
         rows.push((want, got));
         scale = scale.max(want.length());
@@ -217,7 +241,32 @@ fn settings(adaptive: Adaptive, group: u32) -> ControlSettings {
         up: 2.0,
         down: 0.5,
         velocity: 0.0,
+        attraction: 0.0,
+        reach: 0.18,
+        damping: 0.0,
+        motion: fluidform::config::ControlMotion::Frames,
         group,
+    }
+}
+
+#[test]
+fn deficit_attraction_and_damping_match_the_f64_reference() {
+    for (a, g) in [(Adaptive::Off, ALL_GROUPS), (Adaptive::Smooth, 0)] {
+        let s = ControlSettings {
+            attraction: 20.0,
+            reach: 0.1,
+            damping: 3.0,
+            ..settings(a, g)
+        };
+        let (err, err_rho) = compare(s);
+        assert!(
+            err_rho < 1e-4,
+            "{a:?} group {g}: control density error {err_rho}"
+        );
+        assert!(
+            err < 1e-3,
+            "{a:?} group {g}: acceleration error {err} of the largest"
+        );
     }
 }
 

@@ -31,6 +31,10 @@ struct ControlParams {
     float inv_frame;  // 1 / frame time: control velocity from two poses
     uint group;       // controlled group, or 0xFFFFFFFF: all
     uint live;        // control particles this step (rays: the GPU's count)
+    float attraction; // deficit attraction (m/s^2, 0: off)
+    float reach;      // its reach and the damping's (metres) ...
+    uint reach_cells; // ... in control-grid cells
+    float damping;    // damping relative to the character's velocity (1/s, 0: off)
 };
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
 layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
@@ -42,6 +46,10 @@ layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     
 
 const uint ALL_GROUPS = 0xFFFFFFFFu;
 bool controlled(uint i) { return C.group == ALL_GROUPS || floatBitsToUint(attr[i].w) == C.group; }
+
+// A control particle's velocity: from its previous pose (inv_frame > 0) or from its pose a
+// frame ahead (skin motion: cprev holds that pose and inv_frame < 0).
+vec3 control_velocity(uint j) { return (cpos[j].xyz - cprev[j].xyz) * C.inv_frame; }
 
 // Adaptive control pressure (3.1.2) from the fluid density at a control particle.
 float adaptive_factor(float rho) {

@@ -3,6 +3,11 @@
 // control particles j within h_c (their own grid), each term scaled by the adaptive
 // factor; added to the acceleration as f_i / rho_i. With K > 0, a velocity term pulls the
 // fluid velocity towards the control particles' (kernel-weighted mean).
+// Ours, after Thuerey et al. 2006: a deficit attraction towards the control particles
+// within the reach R that hold less than rest density (each weighted by its deficit
+// 1 - rho_j / rho0 and (1 - r/R)^2, normalised by the weights' sum or 1, so a filled
+// neighbourhood pulls nothing and a lone far one little), and a damping of the velocity
+// relative to the character's there (the same weights' mean control velocity).
 #include "common.glsl"
 void main() {
     uint i = global_id();
@@ -29,7 +34,7 @@ void main() {
             f += (C.pressure * crho[j] * adaptive_factor(crho[j])) * (C.spiky_grad * q * q / r) * d;
             if (C.velocity > 0.0) {
                 float w = q * q * q;
-                vsum += w * (cpos[j].xyz - cprev[j].xyz) * C.inv_frame;
+                vsum += w * control_velocity(j);
                 wsum += w;
             }
         }
@@ -37,5 +42,31 @@ void main() {
     float rho = max(rho_p[i].x, 1e-6);
     vec3 a = f / rho;
     if (wsum > 0.0) a += C.velocity * (vsum / wsum - vel[i].xyz);
+    if (C.attraction > 0.0 || C.damping > 0.0) {
+        int k = int(C.reach_cells);
+        float R = C.reach;
+        vec3 pull = vec3(0.0), vchar = vec3(0.0);
+        float wall = 0.0;
+        for (int dz = -k; dz <= k; ++dz) for (int dy = -k; dy <= k; ++dy) for (int dx = -k; dx <= k; ++dx) {
+            ivec3 c = c0 + ivec3(dx, dy, dz);
+            if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
+            uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
+            uint s = cstart[id], e = s + ccount[id];
+            for (uint j = s; j < e; ++j) {
+                vec3 d = cpos[j].xyz - xi;
+                float r = length(d);
+                if (r >= R) continue;
+                float w = (1.0 - r / R) * (1.0 - r / R);
+                float deficit = max(1.0 - crho[j] / P.rest_density, 0.0);
+                if (r > 1e-6) pull += (w * deficit / r) * d;
+                vchar += w * control_velocity(j);
+                wall += w;
+            }
+        }
+        if (wall > 0.0) {
+            a += C.attraction * pull / max(wall, 1.0);
+            a += C.damping * (vchar / wall - vel[i].xyz);
+        }
+    }
     acc[i].xyz += a;
 }

@@ -87,11 +87,13 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
                     None => "no clip".into(),
                 });
             eprintln!(
-                "{variant:<28} control particles {:>6}  to 80% {}  to 90% {}  coverage {:.3}  inside over the last cycle {cycle}",
+                "{variant:<28} control particles {:>6}  coverage to 80% {}  to 90% {}  coverage {:.3}  fill {:.3}  fill to 90% {}  inside over the last cycle {cycle}",
                 c.control_particles,
-                secs(c.time_to_80, last.time),
+                secs(c.coverage_time_to_80, last.time),
+                secs(c.coverage_time_to_90, last.time),
+                last.coverage,
+                last.fill,
                 secs(c.time_to_90, last.time),
-                last.coverage
             );
             rows.push(Row {
                 variant,
@@ -100,8 +102,16 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
                 passes,
                 reps: r.summary.frames as u64,
                 extra: vec![
-                    ("time to 80% s".into(), secs(c.time_to_80, last.time)),
-                    ("time to 90% s".into(), secs(c.time_to_90, last.time)),
+                    (
+                        "time to 80% s".into(),
+                        secs(c.coverage_time_to_80, last.time),
+                    ),
+                    (
+                        "time to 90% s".into(),
+                        secs(c.coverage_time_to_90, last.time),
+                    ),
+                    ("fill to 90% s".into(), secs(c.time_to_90, last.time)),
+                    ("final fill".into(), format!("{:.3}", last.fill)),
                     ("final coverage".into(), format!("{:.3}", last.coverage)),
                     (
                         "final inside".into(),

@@ -7,7 +7,7 @@
 use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
-use crate::config::{Adaptive, Neighbors, SortAlgo};
+use crate::config::{Adaptive, ControlMotion, Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::primitives::counting::GatherPass;
@@ -48,8 +48,13 @@ pub struct ControlGpuParams {
     pub group: u32,
     /// Control particles this step: m for bound sets, the GPU's count for rays.
     pub live: u32,
+    /// Deficit attraction (m/s^2), its reach (metres, and in control-grid cells), damping.
+    pub attraction: f32,
+    pub reach: f32,
+    pub reach_cells: u32,
+    pub damping: f32,
 }
-const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 80);
+const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 96);
 /// Byte offset of `live` (the rays placement copies its count there).
 pub const LIVE_OFFSET: u64 = std::mem::offset_of!(ControlGpuParams, live) as u64;
 
@@ -71,6 +76,12 @@ pub struct ControlSettings {
     pub down: f32,
     /// K of the velocity term (0: off, the thesis).
     pub velocity: f32,
+    /// Deficit attraction (m/s^2, 0: off), its reach (metres), damping relative to the
+    /// character (1/s, 0: off), and where control velocities come from.
+    pub attraction: f32,
+    pub reach: f32,
+    pub damping: f32,
+    pub motion: ControlMotion,
     /// The controlled group, or ALL_GROUPS.
     pub group: u32,
 }
@@ -86,10 +97,21 @@ impl ControlSettings {
                 return Err(Error::Param(format!("{k} must be positive, got {v}")));
             }
         }
-        if !(self.velocity.is_finite() && self.velocity >= 0.0) {
+        let non_negative = [
+            ("--control-velocity", self.velocity),
+            ("--control-attraction", self.attraction),
+            ("--control-damping", self.damping),
+        ];
+        for (k, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Param(format!("{k} must be at least 0, got {v}")));
+            }
+        }
+        if !(self.reach.is_finite() && self.reach > 0.0 && self.reach <= 16.0 * self.radius) {
             return Err(Error::Param(format!(
-                "--control-velocity must be at least 0, got {}",
-                self.velocity
+                "--control-reach must be positive and at most 16 control radii ({} m), got {}",
+                16.0 * self.radius,
+                self.reach
             )));
         }
         if !(0.0 < self.low && self.low < self.high && self.up > 0.0 && self.down > 0.0) {
@@ -125,6 +147,9 @@ impl ControlSettings {
 pub struct Pose {
     pub joints: Vec<GpuJoint>,
     pub frame_dt: f32,
+    /// `--control-motion skin`: the joints a frame ahead (the velocity is the skin's motion
+    /// over the frame the steps cover, not the last frame's).
+    pub next: Option<Vec<GpuJoint>>,
 }
 
 /// GPU state of a control set.
@@ -188,8 +213,8 @@ pub struct ControlForce {
 impl ControlForce {
     /// For control particles at rest positions `mesh.positions`, bound by its joints and
     /// weights (normals unused), skinned by `joints` joints, for fluid searched by
-    /// `solver`, in the domain [lo, hi]. With `rays` (spacing, capacity), `mesh` is the
-    /// target's surface, skinned and re-placed by rays every frame.
+    /// `solver`, in the domain [lo, hi], skinned by `skinning`. With `rays` (spacing,
+    /// capacity), `mesh` is the target's surface, skinned and re-placed by rays every frame.
     pub fn new(
         ctx: &Context,
         solver: &crate::sph::SphSolver,
@@ -197,7 +222,7 @@ impl ControlForce {
         joints: usize,
         settings: ControlSettings,
         domain: ([f32; 3], [f32; 3]),
-        rays: Option<(f32, u32)>,
+        (rays, skinning): (Option<(f32, u32)>, crate::config::Skinning),
     ) -> Result<Self> {
         settings.validate()?;
         let m = match rays {
@@ -207,9 +232,9 @@ impl ControlForce {
         if m == 0 {
             return Err(Error::Param("no control particles".into()));
         }
-        if rays.is_some() && settings.velocity > 0.0 {
+        if rays.is_some() && (settings.velocity > 0.0 || settings.damping > 0.0) {
             return Err(Error::Param(
-                "--control-velocity needs control particles that persist between frames: --placement rays re-places them every frame (use vertices or random)".into(),
+                "--control-velocity and --control-damping need control particles that persist between frames: --placement rays re-places them every frame (use vertices or random, or set both to 0)".into(),
             ));
         }
         // The control grid: the grid strategy with the counting sort (cell counts).
@@ -258,7 +283,7 @@ impl ControlForce {
         };
         let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
         let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
-        let skin = SkinPass::new(ctx, crate::config::Skinning::Lbs, mesh.influence_sets)?;
+        let skin = SkinPass::new(ctx, skinning, mesh.influence_sets)?;
         let skin = Guard::new(ctx, skin);
         let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
         let gather = Guard::new(ctx, GatherPass::new(ctx)?);
@@ -322,7 +347,9 @@ impl ControlForce {
         self.attached.get()
     }
 
-    fn gpu_params(&self, g: &ControlGpu, frame_dt: f32) -> ControlGpuParams {
+    /// `ahead`: the previous-pose buffer holds the pose a frame ahead (skin motion), so
+    /// the velocity (cpos - cprev) / frame_dt changes sign.
+    fn gpu_params(&self, g: &ControlGpu, frame_dt: f32, ahead: bool) -> ControlGpuParams {
         let s = &self.settings;
         let h = s.radius;
         ControlGpuParams {
@@ -342,9 +369,17 @@ impl ControlForce {
             high: s.high,
             up: s.up,
             down: s.down,
-            inv_frame: if frame_dt > 0.0 { 1.0 / frame_dt } else { 0.0 },
+            inv_frame: match (frame_dt > 0.0, ahead) {
+                (false, _) => 0.0,
+                (true, false) => 1.0 / frame_dt,
+                (true, true) => -1.0 / frame_dt,
+            },
             group: s.group,
             live: self.m,
+            attraction: s.attraction,
+            reach: s.reach,
+            reach_cells: (s.reach / g.grid.cell).ceil() as u32,
+            damping: s.damping,
         }
     }
 
@@ -359,6 +394,8 @@ impl ControlForce {
     ) -> Result<()> {
         let bytes = self.m as u64 * 16;
         let first = std::mem::replace(&mut *self.first.borrow_mut(), false);
+        // (Rays: the surface is skinned, not the particles; they have no other pose.)
+        let ahead = pose.next.as_ref().filter(|_| g.rays.is_none());
         scopes.begin(ctx, cmd, "skin");
         // The last pose becomes the previous one; earlier steps' passes read both.
         ctx.barrier(
@@ -366,11 +403,28 @@ impl ControlForce {
             sync::COMPUTE_READ | sync::COMPUTE_WRITE,
             sync::TRANSFER_READ | sync::TRANSFER_WRITE,
         );
-        // (Rays: the surface is skinned, not the particles; they have no previous pose.)
-        if !first && g.rays.is_none() {
+        if !first && g.rays.is_none() && ahead.is_none() {
             ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
         }
-        ctx.update(cmd, &g.params, 0, &[self.gpu_params(g, pose.frame_dt)]);
+        let params = self.gpu_params(g, pose.frame_dt, ahead.is_some());
+        ctx.update(cmd, &g.params, 0, &[params]);
+        if let Some(next) = ahead {
+            // The pose a frame ahead, skinned into `prev`, then the frame's own.
+            g.mesh.set_pose(ctx, cmd, next)?;
+            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
+            g.skin.record(ctx, cmd, &g.mesh)?;
+            ctx.barrier(
+                cmd,
+                sync::COMPUTE_WRITE | sync::COMPUTE_READ,
+                sync::TRANSFER_READ | sync::TRANSFER_WRITE,
+            );
+            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            ctx.barrier(
+                cmd,
+                sync::TRANSFER_READ,
+                sync::TRANSFER_WRITE | sync::COMPUTE_WRITE,
+            );
+        }
         g.mesh.set_pose(ctx, cmd, &pose.joints)?;
         ctx.barrier(
             cmd,
@@ -404,7 +458,7 @@ impl ControlForce {
                 (&r.out, &r.out)
             }
             None => {
-                if first {
+                if first && ahead.is_none() {
                     ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
                     ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
                     ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);

@@ -1,10 +1,12 @@
 //! Control particles (seed 000, section 3): placement inside a character's mesh, binding to
 //! its skeleton, and the inside tests they need.
 pub mod binding;
+pub mod fidelity;
 pub mod force;
 pub mod inside;
 pub mod metrics;
 pub mod placement;
 pub mod rays;
+pub mod surface;
 pub mod target;
 pub mod timeline;

@@ -5,7 +5,9 @@ use super::binding;
 use super::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
 use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
-use crate::config::{Adaptive, BoneWeights, Placement, Skinning, Switches};
+use crate::config::{
+    Adaptive, BoneWeights, ControlMotion, ControlPreset, Placement, Skinning, Switches,
+};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use glam::{Mat4, Vec3};
@@ -30,6 +32,12 @@ fn factors() -> [f32; 2] {
 fn default_pressure() -> f32 {
     DEFAULT_PRESSURE
 }
+
+/// The fidelity preset's velocity term K (1/s), deficit attraction (m/s^2) and damping
+/// (1/s), chosen from the runs in results/<device>/fidelity.md.
+pub const FIDELITY_VELOCITY: f32 = 10.0;
+pub const FIDELITY_ATTRACTION: f32 = 30.0;
+pub const FIDELITY_DAMPING: f32 = 2.0;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
 /// built-in walker fills from a pool in about two seconds).
@@ -58,8 +66,21 @@ pub struct ControlDesc {
     pub thresholds: [f32; 2],
     #[serde(default = "factors")]
     pub factors: [f32; 2],
+    /// K of the velocity term (default: the preset's).
     #[serde(default)]
-    pub velocity: f32,
+    pub velocity: Option<f32>,
+    /// Defaults of the techniques below and of `velocity` (default: fidelity).
+    #[serde(default)]
+    pub preset: Option<ControlPreset>,
+    /// Deficit attraction (m/s^2), its reach and the damping (1/s) (default: the preset's).
+    #[serde(default)]
+    pub attraction: Option<f32>,
+    #[serde(default)]
+    pub reach: Option<f32>,
+    #[serde(default)]
+    pub damping: Option<f32>,
+    #[serde(default)]
+    pub motion: Option<ControlMotion>,
     /// The controlled group (default: all).
     #[serde(default)]
     pub group: Option<u32>,
@@ -76,7 +97,12 @@ impl Default for ControlDesc {
             adaptive: off(),
             thresholds: thresholds(),
             factors: factors(),
-            velocity: 0.0,
+            velocity: None,
+            preset: None,
+            attraction: None,
+            reach: None,
+            damping: None,
+            motion: None,
             group: None,
         }
     }
@@ -109,22 +135,64 @@ impl ControlDesc {
             adaptive: c.adaptive.unwrap_or(self.adaptive),
             thresholds: thresholds.unwrap_or(self.thresholds),
             factors: factors.unwrap_or(self.factors),
-            velocity: c.control_velocity.unwrap_or(self.velocity),
+            velocity: c.control_velocity.or(self.velocity),
+            preset: c.control_preset.or(self.preset),
+            attraction: c.control_attraction.or(self.attraction),
+            reach: c.control_reach.or(self.reach),
+            damping: c.control_damping.or(self.damping),
+            motion: c.control_motion.or(self.motion),
             group: self.group,
         })
     }
 
     pub fn settings(&self, h: f32) -> ControlSettings {
+        let radius = self.radius.unwrap_or(2.0 * h);
+        let d = Preset::of(self.preset.unwrap_or(ControlPreset::Fidelity));
         ControlSettings {
             pressure: self.pressure,
-            radius: self.radius.unwrap_or(2.0 * h),
+            radius,
             adaptive: self.adaptive,
             low: self.thresholds[0],
             high: self.thresholds[1],
             up: self.factors[0],
             down: self.factors[1],
-            velocity: self.velocity,
+            velocity: self.velocity.unwrap_or(d.velocity),
+            attraction: self.attraction.unwrap_or(d.attraction),
+            reach: self.reach.unwrap_or(d.reach * radius),
+            damping: self.damping.unwrap_or(d.damping),
+            motion: self.motion.unwrap_or(d.motion),
             group: self.group.unwrap_or(ALL_GROUPS),
+        }
+    }
+}
+
+/// The defaults a control preset gives the techniques a target does not set.
+struct Preset {
+    velocity: f32,
+    attraction: f32,
+    /// In control radii h_c.
+    reach: f32,
+    damping: f32,
+    motion: ControlMotion,
+}
+
+impl Preset {
+    fn of(p: ControlPreset) -> Self {
+        match p {
+            ControlPreset::Thesis => Self {
+                velocity: 0.0,
+                attraction: 0.0,
+                reach: 3.0,
+                damping: 0.0,
+                motion: ControlMotion::Frames,
+            },
+            ControlPreset::Fidelity => Self {
+                velocity: FIDELITY_VELOCITY,
+                attraction: FIDELITY_ATTRACTION,
+                reach: 3.0,
+                damping: FIDELITY_DAMPING,
+                motion: ControlMotion::Skin,
+            },
         }
     }
 }
@@ -146,6 +214,8 @@ pub struct ControlTarget {
     pub desc: ControlDesc,
     /// Placed rest-pose joint matrices (the bind of the control particles).
     rest_inv: Vec<Mat4>,
+    /// How the control particles (or the rays' surface) are skinned.
+    skinning: Skinning,
 }
 
 impl ControlTarget {
@@ -160,7 +230,7 @@ impl ControlTarget {
         desc: &ControlDesc,
         fluid: &crate::sph::FluidParams,
         domain: ([f32; 3], [f32; 3]),
-        seed: u64,
+        (seed, skinning): (u64, Skinning),
     ) -> Result<Self> {
         let placed_rest: Vec<Mat4> = ch
             .rest_matrices()
@@ -183,7 +253,8 @@ impl ControlTarget {
             )));
         }
         if desc.placement == Placement::Rays {
-            return Self::rays(ctx, solver, ch, desc, fluid, domain, spacing, points.len());
+            let rest = (spacing, points.len());
+            return Self::rays(ctx, solver, ch, desc, fluid, domain, rest, skinning);
         }
         let globals: Vec<Mat4> = ch
             .skeleton
@@ -231,13 +302,14 @@ impl ControlTarget {
             ch.skeleton.joints.len(),
             settings,
             domain,
-            None,
+            (None, skinning),
         )?);
         solver.add_force(Box::new(ControlHook(force.clone())));
         Ok(Self {
             force,
             desc: desc.clone(),
             rest_inv,
+            skinning,
         })
     }
 
@@ -252,8 +324,8 @@ impl ControlTarget {
         desc: &ControlDesc,
         fluid: &crate::sph::FluidParams,
         domain: ([f32; 3], [f32; 3]),
-        spacing: f32,
-        rest: usize,
+        (spacing, rest): (f32, usize),
+        skinning: Skinning,
     ) -> Result<Self> {
         let capacity = (3 * rest + 1024).min(u32::MAX as usize / 16) as u32;
         let force = Rc::new(ControlForce::new(
@@ -263,32 +335,45 @@ impl ControlTarget {
             ch.skeleton.joints.len(),
             desc.settings(fluid.h),
             domain,
-            Some((spacing, capacity)),
+            (Some((spacing, capacity)), skinning),
         )?);
         solver.add_force(Box::new(ControlHook(force.clone())));
         Ok(Self {
             force,
             desc: desc.clone(),
             rest_inv: Vec::new(),
+            skinning,
         })
     }
 
     /// Set the pose of scene time `t` (the animator's joint matrices, placed) for the next
-    /// frame's steps, `frame_dt` seconds after the previous pose.
-    pub fn set_pose(&self, ch: &Character, mats: &[Mat4], frame_dt: f32) -> Result<()> {
-        if self.desc.placement == Placement::Rays {
-            // The surface itself is skinned (its bind pose is the file's).
-            let joints = pose::gpu_joints(mats, Skinning::Lbs, &|j| ch.joint_name(j))?;
-            self.force.set_pose(Pose { joints, frame_dt });
-            return Ok(());
-        }
-        let rel: Vec<Mat4> = mats
-            .iter()
-            .zip(&self.rest_inv)
-            .map(|(m, r)| *m * *r)
-            .collect();
-        let joints = pose::gpu_joints(&rel, Skinning::Lbs, &|j| ch.joint_name(j))?;
-        self.force.set_pose(Pose { joints, frame_dt });
+    /// frame's steps, `frame_dt` seconds after the previous pose; `next`: the pose a frame
+    /// ahead (`--control-motion skin`).
+    pub fn set_pose(
+        &self,
+        ch: &Character,
+        mats: &[Mat4],
+        next: Option<&[Mat4]>,
+        frame_dt: f32,
+    ) -> Result<()> {
+        let name = |j: usize| ch.joint_name(j);
+        let joints = |m: &[Mat4]| -> Result<_> {
+            if self.desc.placement == Placement::Rays {
+                // The surface itself is skinned (its bind pose is the file's).
+                return pose::gpu_joints(m, self.skinning, &name);
+            }
+            let rel: Vec<Mat4> = m.iter().zip(&self.rest_inv).map(|(m, r)| *m * *r).collect();
+            pose::gpu_joints(&rel, self.skinning, &name)
+        };
+        let next = match next {
+            Some(n) if self.desc.placement != Placement::Rays => Some(joints(n)?),
+            _ => None,
+        };
+        self.force.set_pose(Pose {
+            joints: joints(mats)?,
+            frame_dt,
+            next,
+        });
         Ok(())
     }
 

@@ -5,7 +5,7 @@
 use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
 use super::emission::{EmissionMetrics, EmissionStats, SceneEmission};
 use crate::character::capsules::{self, BoneCapsule};
-use crate::config::{ShowMesh, Skinning, Switches};
+use crate::config::{ControlMotion, ShowMesh, Skinning, Switches};
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
@@ -29,13 +29,20 @@ pub struct ControlSummary {
     pub events: Vec<FiredEvent>,
 }
 
+/// A frame's placed joint matrices, those a moment before, and the scene time.
+type FramePose = (Vec<Mat4>, Vec<Mat4>, f64);
+
 struct Live {
     name: String,
     character: SceneCharacter,
     control: Option<(ControlTarget, ControlMetrics)>,
-    /// Per slot: the placed joint matrices and scene time of the frame, when attached.
-    poses: Vec<Option<(Vec<Mat4>, f64)>>,
+    /// Per slot: the placed joint matrices of the frame and of a moment before it (the
+    /// skin's speed), and the scene time, when attached.
+    poses: Vec<Option<FramePose>>,
 }
+
+/// The skin's speed is its motion over this many seconds before the frame.
+const SKIN_SPEED_DT: f64 = 1.0 / 240.0;
 
 pub struct SceneTargets {
     live: Vec<Live>,
@@ -52,6 +59,9 @@ pub struct SceneTargets {
     /// Per control target being let go: (start time, strength then, fade seconds).
     fading: Vec<Option<(f64, f32, f32)>>,
     quiet: bool,
+    /// The floor's height (the domain's bottom) and the metrics window's start.
+    floor: f32,
+    metrics_from: Option<f64>,
 }
 
 impl SceneTargets {
@@ -90,6 +100,8 @@ impl SceneTargets {
                 fired: Vec::new(),
                 fading: Vec::new(),
                 quiet: sw.common.quiet,
+                floor: scene.domain.min[1],
+                metrics_from: sw.control.metrics_from,
             },
         );
         for (name, cdesc, control) in descs {
@@ -109,7 +121,7 @@ impl SceneTargets {
                         &d.with_switches(sw)?,
                         &scene.fluid,
                         (scene.domain.min, scene.domain.max),
-                        sw.common.seed,
+                        (sw.common.seed, method),
                     )?;
                     let m = ControlMetrics::new(ctx, st.n, t.count(), &name, slots)?;
                     let i = out.live.len();
@@ -239,8 +251,11 @@ impl SceneTargets {
             };
             let ch = &l.character;
             let mats = ch.matrices(t);
-            c.set_pose(&ch.ch, &mats, frame_dt)?;
-            l.poses[slot] = Some((mats, t));
+            let next = (c.force.settings.motion == ControlMotion::Skin)
+                .then(|| ch.matrices(t + frame_dt as f64));
+            c.set_pose(&ch.ch, &mats, next.as_deref(), frame_dt)?;
+            let before = ch.matrices(t - SKIN_SPEED_DT);
+            l.poses[slot] = Some((mats, before, t));
         }
         Ok(())
     }
@@ -355,21 +370,34 @@ impl SceneTargets {
             e.metrics.retire(slot);
         }
         for l in &mut self.live {
-            let (Some((c, m)), Some((mats, time))) = (&mut l.control, l.poses[slot].take()) else {
+            let (Some((c, m)), Some((mats, before, time))) = (&mut l.control, l.poses[slot].take())
+            else {
                 continue;
             };
             let ch = &l.character;
             let (mesh, _) = ch.ch.skinned_at(&mats, ch.method)?;
-            let spacing = c.desc.spacing.unwrap_or(fluid.spacing());
+            let (prev, _) = ch.ch.skinned_at(&before, ch.method)?;
+            let skin_speed = mesh
+                .iter()
+                .zip(&prev)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f32::max)
+                / SKIN_SPEED_DT as f32;
+            let constants = crate::control::fidelity::Fluid {
+                h: fluid.h,
+                mass: fluid.mass,
+                rest_density: fluid.rest_density,
+                spacing: fluid.spacing(),
+                floor: self.floor,
+            };
             m.retire(
                 slot,
                 frame,
                 time,
-                (&mesh, &ch.ch.mesh.indices),
+                ((&mesh, &ch.ch.mesh.indices), skin_speed),
                 &c.force,
                 c.force.settings.group,
-                fluid.rest_density,
-                spacing,
+                &constants,
             )?;
         }
         Ok(())
@@ -393,6 +421,7 @@ impl SceneTargets {
                 .map(|d| d / ch.speed as f64);
             if let Some((_, m)) = &mut l.control {
                 m.finish_cycle(cycle);
+                m.finish_window(self.metrics_from);
             }
         }
         if self.controlled.is_empty() {

@@ -87,6 +87,10 @@ pub struct FluidParams {
     /// read a list instead of searching 27 grid cells; a particle with more neighbours is
     /// searched as before (exact; counted in `stats.density_error.list_overflows`).
     pub neighbor_list: u32,
+    /// Particle spacing at rest, m (`--fluid spacing=S`): when set, the mass becomes
+    /// rho_0 S^3 and h, dt and the steps per frame scale with S from the values given, so
+    /// the frame time, h in spacings and the CFL number stay as they were.
+    pub spacing: Option<f32>,
 }
 
 impl Default for FluidParams {
@@ -123,6 +127,7 @@ impl Default for FluidParams {
             xsph: 0.01,
             vorticity: 0.01,
             neighbor_list: DEFAULT_NEIGHBOR_LIST,
+            spacing: None,
         }
     }
 }
@@ -272,7 +277,36 @@ impl FluidParams {
             out.solver = s;
             out.validate()?;
         }
+        out.resolve_spacing()?;
         Ok(out)
+    }
+
+    /// Apply `spacing` (see the field): mass, h, dt and steps per frame follow it. Once
+    /// applied the implied spacing is S, so applying again changes nothing.
+    pub fn resolve_spacing(&mut self) -> Result<()> {
+        let Some(s) = self.spacing else {
+            return Ok(());
+        };
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::Param(format!(
+                "--fluid spacing must be positive, got {s}"
+            )));
+        }
+        let r = s / self.spacing();
+        if (r - 1.0).abs() < 1e-5 {
+            return Ok(());
+        }
+        let frame = self.dt * self.substeps as f32;
+        self.mass = self.rest_density * s * s * s;
+        self.h *= r;
+        self.dt *= r;
+        // Whole steps per frame, the step no longer than the scaled one.
+        self.substeps = (frame / self.dt).ceil().max(1.0) as u32;
+        self.dt = frame / self.substeps as f32;
+        if let Some(m) = &mut self.dt_max {
+            *m *= r;
+        }
+        self.validate()
     }
 
     fn with_values(&self, overrides: &[String]) -> Result<Self> {
