@@ -119,7 +119,11 @@ pub fn variants() -> Vec<Variant> {
                         .into_iter()
                         .map(|(k, v)| (k.to_string(), v)),
                 );
-                for f in ["control/density.comp", "control/force.comp"] {
+                for f in [
+                    "control/density.comp",
+                    "control/aggregate.comp",
+                    "control/force.comp",
+                ] {
                     v.push(with::<ControlIo>(f, &c));
                 }
             }

@@ -193,25 +193,57 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
         }
         let mut want = fsum / d1.rho_p[i][0] as f64;
         // Deficit attraction and damping (the control particles stand still: their first
-        // pose is also their previous one).
+        // pose is also their previous one), each control-grid cell's particles taken
+        // together at their deficit-weighted centre (cell h_c from the domain's corner).
         let reach = settings.reach as f64;
-        let (mut pull, mut wall) = (glam::DVec3::ZERO, 0.0);
-        if controlled(&d1.attr[i]) {
-            for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
-                let d = c.as_dvec3() - x;
+        let dims = ((0.5 / hc).ceil()) as i64;
+        let key = |p: glam::DVec3| {
+            (p / hc)
+                .floor()
+                .as_i64vec3()
+                .clamp(glam::I64Vec3::ZERO, glam::I64Vec3::splat(dims - 1))
+        };
+        let mut cells: std::collections::HashMap<
+            glam::I64Vec3,
+            (glam::DVec3, f64, glam::DVec3, f64),
+        > = Default::default();
+        for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
+            let e = cells.entry(key(c.as_dvec3())).or_default();
+            let d = (1.0 - rho_j / rho0).max(0.0);
+            e.0 += d * c.as_dvec3();
+            e.1 += d;
+            e.2 += c.as_dvec3();
+            e.3 += 1.0;
+        }
+        let k = (reach / hc).ceil() as i64;
+        let c0 = key(x);
+        let (mut pull, mut wall, mut wdef) = (glam::DVec3::ZERO, 0.0, 0.0);
+        for (cell, (dc, dsum, csum, n)) in &cells {
+            let off = *cell - c0;
+            if !controlled(&d1.attr[i]) || off.abs().max_element() > k {
+                continue;
+            }
+            if *dsum > 0.0 {
+                let d = *dc / *dsum - x;
                 let r = d.length();
                 if r < reach {
-                    let w = (1.0 - r / reach).powi(2);
+                    let w = (1.0 - r / reach).powi(2) * dsum;
                     if r > 1e-6 {
-                        pull += w * (1.0 - rho_j / rho0).max(0.0) / r * d;
+                        pull += w / r * d;
                     }
-                    wall += w;
+                    wdef += w;
                 }
             }
+            let r = (*csum / *n - x).length();
+            if r < reach {
+                wall += (1.0 - r / reach).powi(2) * n;
+            }
+        }
+        if wdef > 0.0 {
+            want += settings.attraction as f64 * pull / wdef.max(1.0);
         }
         if wall > 0.0 {
             let v = glam::DVec3::from_array([0, 1, 2].map(|k| d1.vel[i][k] as f64));
-            want += settings.attraction as f64 * pull / wall.max(1.0);
             want -= settings.damping as f64 * v;
         }
         let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - d0.acc[i][k]) as f64));

@@ -147,13 +147,15 @@ fade = 0.0
         fell < 0.75 * 0.5 * 9.81 * t0 * t0,
         "fell {fell} m in {t0} s while attached"
     );
-    let rows: Vec<Vec<String>> = std::fs::read_to_string(out.join("control.csv"))
-        .unwrap()
+    let text = std::fs::read_to_string(out.join("control.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "inside_fraction").unwrap();
+    let rows: Vec<Vec<String>> = text
         .lines()
         .skip(1)
         .map(|l| l.split(',').map(String::from).collect())
         .collect();
-    let inside: f64 = rows.last().unwrap()[3].parse().unwrap();
+    let inside: f64 = rows.last().unwrap()[col].parse().unwrap();
     assert!(inside > 0.9, "inside fraction {inside} when released");
     // Released: y'' = -g (second differences 3 frames apart, before the first drops
     // thrown out while attached reach the floor).

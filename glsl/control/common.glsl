@@ -43,6 +43,8 @@ layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };            /
 layout(std430, binding = CTL_B_CSTART) readonly buffer Cstart { uint cstart[]; };
 layout(std430, binding = CTL_B_CCOUNT) readonly buffer Ccount { uint ccount[]; };
 layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     // rgb, w = group
+// Per control-grid cell (aggregate.comp): sum d c, sum d (d = deficit); sum c, count; sum v.
+layout(std430, binding = CTL_B_CAGG) buffer Cagg { vec4 cagg[]; };
 
 const uint ALL_GROUPS = 0xFFFFFFFFu;
 bool controlled(uint i) { return C.group == ALL_GROUPS || floatBitsToUint(attr[i].w) == C.group; }

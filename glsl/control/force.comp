@@ -5,9 +5,10 @@
 // fluid velocity towards the control particles' (kernel-weighted mean).
 // Ours, after Thuerey et al. 2006: a deficit attraction towards the control particles
 // within the reach R that hold less than rest density (each weighted by its deficit
-// 1 - rho_j / rho0 and (1 - r/R)^2, normalised by the weights' sum or 1, so a filled
-// neighbourhood pulls nothing and a lone far one little), and a damping of the velocity
-// relative to the character's there (the same weights' mean control velocity).
+// 1 - rho_j / rho0 and (1 - r/R)^2, normalised by the deficits' weight or 1: a filled
+// neighbourhood pulls nothing, a few empty particles nearby pull at full strength, a lone
+// far one a little), and a damping of the velocity relative to the character's there
+// (the mean control velocity, weighted alike). Both read per-cell sums (aggregate.comp).
 #include "common.glsl"
 void main() {
     uint i = global_id();
@@ -43,30 +44,37 @@ void main() {
     vec3 a = f / rho;
     if (wsum > 0.0) a += C.velocity * (vsum / wsum - vel[i].xyz);
     if (C.attraction > 0.0 || C.damping > 0.0) {
+        // Over the cells within the reach, each cell's control particles taken together:
+        // the deficit at their deficit-weighted centre, the velocity at their centre.
         int k = int(C.reach_cells);
         float R = C.reach;
         vec3 pull = vec3(0.0), vchar = vec3(0.0);
-        float wall = 0.0;
+        float wall = 0.0, wdef = 0.0;
         for (int dz = -k; dz <= k; ++dz) for (int dy = -k; dy <= k; ++dy) for (int dx = -k; dx <= k; ++dx) {
             ivec3 c = c0 + ivec3(dx, dy, dz);
             if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
             uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
-            uint s = cstart[id], e = s + ccount[id];
-            for (uint j = s; j < e; ++j) {
-                vec3 d = cpos[j].xyz - xi;
+            vec4 at = cagg[3 * id + 1];
+            if (at.w == 0.0) continue;
+            vec4 def = cagg[3 * id];
+            if (def.w > 0.0) {
+                vec3 d = def.xyz / def.w - xi;
                 float r = length(d);
-                if (r >= R) continue;
+                if (r < R) {
+                    float w = (1.0 - r / R) * (1.0 - r / R) * def.w;
+                    if (r > 1e-6) pull += (w / r) * d;
+                    wdef += w;
+                }
+            }
+            float r = length(at.xyz / at.w - xi);
+            if (r < R) {
                 float w = (1.0 - r / R) * (1.0 - r / R);
-                float deficit = max(1.0 - crho[j] / P.rest_density, 0.0);
-                if (r > 1e-6) pull += (w * deficit / r) * d;
-                vchar += w * control_velocity(j);
-                wall += w;
+                vchar += w * cagg[3 * id + 2].xyz;
+                wall += w * at.w;
             }
         }
-        if (wall > 0.0) {
-            a += C.attraction * pull / max(wall, 1.0);
-            a += C.damping * (vchar / wall - vel[i].xyz);
-        }
+        if (wdef > 0.0) a += C.attraction * pull / max(wdef, 1.0);
+        if (wall > 0.0) a += C.damping * (vchar / wall - vel[i].xyz);
     }
     acc[i].xyz += a;
 }

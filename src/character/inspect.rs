@@ -32,7 +32,34 @@ pub struct Inspection {
     pub flipped: bool,
     pub normals: &'static str,
     pub uvs: bool,
+    /// The thinnest part: the narrowest bone capsule (None: no capsules).
+    pub thinnest: Option<Thinnest>,
     pub warnings: Vec<String>,
+}
+
+/// The narrowest bone capsule of a character, in the file's units, against the fluid's
+/// default particle spacing.
+#[derive(Clone, Debug, Serialize)]
+pub struct Thinnest {
+    pub joint: String,
+    pub diameter: f32,
+    /// The diameter in default particle spacings (fluid at the file's own scale).
+    pub spacings_at_default: f32,
+    /// The spacing that puts three particles across it.
+    pub spacing_for_three: f32,
+}
+
+/// The thinnest part of `ch` (its narrowest capsule; see `capsules::of`).
+pub fn thinnest(ch: &Character) -> Option<Thinnest> {
+    let caps = super::capsules::of(ch);
+    let c = caps.iter().min_by(|a, b| a.r.total_cmp(&b.r))?;
+    let d = 2.0 * c.r;
+    Some(Thinnest {
+        joint: ch.joint_name(c.joint),
+        diameter: d,
+        spacings_at_default: d / crate::sph::FluidParams::default().spacing(),
+        spacing_for_three: d / 3.0,
+    })
 }
 
 pub fn inspect(ch: &Character) -> Result<Inspection> {
@@ -74,6 +101,7 @@ pub fn inspect(ch: &Character) -> Result<Inspection> {
             "from the file"
         },
         uvs: !ch.mesh.uvs.is_empty(),
+        thinnest: thinnest(ch),
         warnings: ch.warnings.clone(),
     })
 }
@@ -140,6 +168,15 @@ impl Inspection {
         );
         line("normals", self.normals.to_string());
         line("uvs", if self.uvs { "yes" } else { "no" }.to_string());
+        if let Some(t) = &self.thinnest {
+            line(
+                "thinnest part",
+                format!(
+                    "{:.4} across at joint '{}': {:.2} spacings at the default spacing; --fluid spacing={:.4} puts three particles across (at the file's scale)",
+                    t.diameter, t.joint, t.spacings_at_default, t.spacing_for_three
+                ),
+            );
+        }
         for w in &self.warnings {
             s.push_str(&format!("  warning: {w}\n"));
         }

@@ -4,10 +4,11 @@
 //! (`control-density`, over the fluid grid) and the force on each fluid particle
 //! (`control-force`, over the control grid), with adaptive control pressure and an
 //! optional velocity term.
+pub use super::settings::ControlSettings;
 use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
-use crate::config::{Adaptive, ControlMotion, Neighbors, SortAlgo};
+use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::primitives::counting::GatherPass;
@@ -16,7 +17,6 @@ use crate::sph::hooks::SphHook;
 use crate::sph::solver::SphState;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
@@ -26,6 +26,7 @@ crate::gpu_interface! {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
         control = 11, cpos = 12, cprev = 13, crho = 14, cstart = 15, ccount = 16, attr = 17,
+        cagg = 18,
     }
 }
 
@@ -61,87 +62,6 @@ pub const LIVE_OFFSET: u64 = std::mem::offset_of!(ControlGpuParams, live) as u64
 /// Every group is controlled.
 pub const ALL_GROUPS: u32 = u32::MAX;
 
-/// The control switches and their defaults.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ControlSettings {
-    /// c_cp (eq. 7).
-    pub pressure: f32,
-    /// h_c (metres).
-    pub radius: f32,
-    pub adaptive: Adaptive,
-    /// Thresholds (fractions of rho_0) and factors of adaptive control pressure.
-    pub low: f32,
-    pub high: f32,
-    pub up: f32,
-    pub down: f32,
-    /// K of the velocity term (0: off, the thesis).
-    pub velocity: f32,
-    /// Deficit attraction (m/s^2, 0: off), its reach (metres), damping relative to the
-    /// character (1/s, 0: off), and where control velocities come from.
-    pub attraction: f32,
-    pub reach: f32,
-    pub damping: f32,
-    pub motion: ControlMotion,
-    /// The controlled group, or ALL_GROUPS.
-    pub group: u32,
-}
-
-impl ControlSettings {
-    pub fn validate(&self) -> Result<()> {
-        let pos = [
-            ("--control-pressure", self.pressure),
-            ("--control-radius", self.radius),
-        ];
-        for (k, v) in pos {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(Error::Param(format!("{k} must be positive, got {v}")));
-            }
-        }
-        let non_negative = [
-            ("--control-velocity", self.velocity),
-            ("--control-attraction", self.attraction),
-            ("--control-damping", self.damping),
-        ];
-        for (k, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::Param(format!("{k} must be at least 0, got {v}")));
-            }
-        }
-        if !(self.reach.is_finite() && self.reach > 0.0 && self.reach <= 16.0 * self.radius) {
-            return Err(Error::Param(format!(
-                "--control-reach must be positive and at most 16 control radii ({} m), got {}",
-                16.0 * self.radius,
-                self.reach
-            )));
-        }
-        if !(0.0 < self.low && self.low < self.high && self.up > 0.0 && self.down > 0.0) {
-            return Err(Error::Param(format!(
-                "adaptive pressure needs 0 < low < high and positive factors, got low {} high {} up {} down {}",
-                self.low, self.high, self.up, self.down
-            )));
-        }
-        Ok(())
-    }
-
-    pub fn adaptive_id(a: Adaptive) -> u32 {
-        match a {
-            Adaptive::Off => 0,
-            Adaptive::On => 1,
-            Adaptive::Smooth => 2,
-        }
-    }
-
-    /// The shader defines of adaptive mode `a`.
-    pub fn defines(a: Adaptive) -> Vec<(&'static str, String)> {
-        vec![
-            ("ADAPTIVE_OFF", "0".into()),
-            ("ADAPTIVE_ON", "1".into()),
-            ("ADAPTIVE_SMOOTH", "2".into()),
-            ("ADAPTIVE", Self::adaptive_id(a).to_string()),
-        ]
-    }
-}
-
 /// A frame's pose for the control particles: rest-relative joint matrices and the frame
 /// time (for their velocity).
 pub struct Pose {
@@ -155,6 +75,7 @@ pub struct Pose {
 /// GPU state of a control set.
 struct ControlGpu {
     density: ComputePipeline<ControlIo>,
+    aggregate: ComputePipeline<ControlIo>,
     force: ComputePipeline<ControlIo>,
     skin: SkinPass,
     mesh: SkinnedMesh,
@@ -166,6 +87,8 @@ struct ControlGpu {
     sorted_pos: Buffer,
     sorted_prev: Buffer,
     crho: Buffer,
+    /// Per control-grid cell: the sums of aggregate.comp (3 vec4).
+    cagg: Buffer,
     params: Buffer,
     /// `--placement rays`: re-placed from the skinned mesh (`mesh`) every frame.
     rays: Option<super::rays::RaysPlacer>,
@@ -175,6 +98,7 @@ crate::impl_destroy!(ControlGpu);
 impl ControlGpu {
     fn destroy(&mut self, ctx: &Context) {
         self.density.destroy(ctx);
+        self.aggregate.destroy(ctx);
         self.force.destroy(ctx);
         self.skin.destroy(ctx);
         self.mesh.destroy(ctx);
@@ -189,6 +113,7 @@ impl ControlGpu {
             &mut self.sorted_pos,
             &mut self.sorted_prev,
             &mut self.crho,
+            &mut self.cagg,
             &mut self.params,
         ] {
             ctx.destroy_buffer(b);
@@ -254,6 +179,7 @@ impl ControlForce {
                 .map(|p| Guard::new(ctx, p))
         };
         let density = pipeline("control-density", "control/density.comp")?;
+        let aggregate = pipeline("control-aggregate", "control/aggregate.comp")?;
         let force = pipeline("control-force", "control/force.comp")?;
         // Rays: three more layers above the domain in z, the last one parking the unused
         // slots two cells away from any fluid particle's.
@@ -295,6 +221,7 @@ impl ControlForce {
         let sorted_pos = buf("control sorted positions", v4)?;
         let sorted_prev = buf("control sorted previous", v4)?;
         let crho = buf("control densities", m as u64 * 4)?;
+        let cagg = buf("control cell sums", grid.cells() * 48)?;
         let params = buf(
             "control params",
             std::mem::size_of::<ControlGpuParams>() as u64,
@@ -302,6 +229,7 @@ impl ControlForce {
         Ok(Self {
             gpu: RefCell::new(Some(ControlGpu {
                 density: density.take(),
+                aggregate: aggregate.take(),
                 force: force.take(),
                 skin: skin.take(),
                 mesh: cmesh.take(),
@@ -313,6 +241,7 @@ impl ControlForce {
                 sorted_pos: sorted_pos.take(),
                 sorted_prev: sorted_prev.take(),
                 crho: crho.take(),
+                cagg: cagg.take(),
                 params: params.take(),
                 rays: rays.map(|r| r.take()),
             })),
@@ -503,6 +432,7 @@ impl ControlForce {
             cstart,
             ccount,
             attr: st.attr(),
+            cagg: &g.cagg,
         }
     }
 
@@ -597,7 +527,14 @@ impl SphHook for ControlHook {
         scopes.begin(ctx, cmd, "control-density");
         g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd); // control densities -> force
+        ctx.compute_barrier(cmd); // control densities -> cell sums and force
+        let s = &c.settings;
+        if s.attraction > 0.0 || s.damping > 0.0 {
+            scopes.begin(ctx, cmd, "control-aggregate");
+            g.aggregate.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
+            scopes.end(ctx, cmd);
+            ctx.compute_barrier(cmd); // cell sums -> force
+        }
         scopes.begin(ctx, cmd, "control-force");
         g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
         scopes.end(ctx, cmd);

@@ -7,6 +7,7 @@ pub mod inside;
 pub mod metrics;
 pub mod placement;
 pub mod rays;
+pub mod settings;
 pub mod surface;
 pub mod target;
 pub mod timeline;

@@ -139,10 +139,13 @@ pub fn place(
         }
     };
     if pts.is_empty() {
+        // Its thinnest part holds about three at a third of its width.
+        let (lo, hi) = super::super::character::check::bounds(rest);
+        let fits = (hi - lo).min_element() / 3.0;
         return Err(Error::Model {
             path: ch.source.clone(),
             message: format!(
-                "gives no control particles at spacing {spacing} (the mesh is smaller than the spacing)"
+                "gives no control particles at spacing {spacing} (the mesh is smaller than the spacing): a spacing of {fits:.3e} or less (--fluid spacing or --control-spacing) would place some"
             ),
         });
     }

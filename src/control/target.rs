@@ -147,7 +147,12 @@ impl ControlDesc {
 
     pub fn settings(&self, h: f32) -> ControlSettings {
         let radius = self.radius.unwrap_or(2.0 * h);
-        let d = Preset::of(self.preset.unwrap_or(ControlPreset::Fidelity));
+        let mut d = Preset::of(self.preset.unwrap_or(ControlPreset::Fidelity));
+        if self.placement == Placement::Rays {
+            // Re-placed particles have no velocity: the preset's velocity terms stay off
+            // (asked for explicitly, they are refused).
+            (d.velocity, d.damping) = (0.0, 0.0);
+        }
         ControlSettings {
             pressure: self.pressure,
             radius,
