@@ -251,6 +251,18 @@ pub fn coverage(
     device: &str,
     series: &[(String, Vec<(f64, f64)>)],
 ) -> Result<()> {
+    let y = "coverage (control particles with rho >= 0.5 rho0)";
+    over_time(path, title, y, device, series)
+}
+
+/// Fractions (0..1) against scene time, one line per series, with a grey line at 0.9.
+pub fn over_time(
+    path: &Path,
+    title: &str,
+    y_desc: &str,
+    device: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
     font()?;
     let caption = format!("{title}: {device}, {}", today());
     let tmax = series
@@ -270,7 +282,7 @@ pub fn coverage(
     chart
         .configure_mesh()
         .x_desc("scene time (s)")
-        .y_desc("coverage (control particles with rho >= 0.5 rho0)")
+        .y_desc(y_desc)
         .draw()
         .map_err(|e| err(path, e))?;
     for (i, (name, pts)) in series.iter().enumerate() {

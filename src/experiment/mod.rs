@@ -2,6 +2,7 @@
 //! Each writes `<out>/<name>.csv`, `<name>.md` and `<name>.png` with the paper's numbers
 //! beside ours, and its verdicts on the papers' findings into `<name>.findings.json`, from
 //! which `findings.md` is rebuilt (so single experiments and `all` leave the same file).
+pub mod fidelity;
 pub mod findings;
 pub mod measure;
 pub mod sweeps;
@@ -20,7 +21,7 @@ use std::time::Instant;
 
 pub const NAMES: &[&str] = &[
     "table2", "table3", "table4", "table5", "table6", "table7", "table8", "fig9", "adaptive",
-    "scaling",
+    "scaling", "fidelity",
 ];
 
 pub struct ExperimentOptions {
@@ -338,6 +339,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>>
             "fig9" => sweeps::fig9(ctx, env)?,
             "adaptive" => sweeps::adaptive(env)?,
             "scaling" => sweeps::scaling(ctx, env)?,
+            "fidelity" => fidelity::fidelity(env)?,
             table => {
                 let def = tables::def(table).expect("a table name");
                 measure::table(ctx, env, def)?

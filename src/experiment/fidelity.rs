@@ -1,0 +1,206 @@
+//! `fluidform experiment fidelity`: each liquid-character scene (the default walker,
+//! CesiumMan from tests/scenes, the giraffe) with the thesis's control and with the
+//! fidelity preset: the fidelity metrics side by side (means over the second half of each
+//! run), the last saved frame of each (same scene time), and fill and IoU over time.
+use super::findings::Finding;
+use super::{write, Env, Steps};
+use crate::config::{ControlPreset, RenderKind};
+use crate::control::metrics::ControlRow;
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// (label, scene, frames with --quick).
+const SCENES: &[(&str, &str, u64)] = &[
+    ("walker (default)", "character", 24),
+    ("CesiumMan", "tests/scenes/cesium_man_liquid.toml", 24),
+    ("giraffe", "giraffe", 24),
+];
+const PRESETS: [ControlPreset; 2] = [ControlPreset::Thesis, ControlPreset::Fidelity];
+
+/// One run's numbers.
+struct Outcome {
+    summary: serde_json::Value,
+    rows: Vec<ControlRow>,
+    frame: Option<PathBuf>,
+}
+
+fn play(
+    env: &Env,
+    scene: &str,
+    preset: ControlPreset,
+    frames: Option<u64>,
+    out: &Path,
+) -> Result<Outcome> {
+    let mut sw = env.switches.clone();
+    sw.common.quiet = true;
+    sw.control.control_preset = Some(preset);
+    sw.view.render = Some(RenderKind::Metaballs);
+    let opts = crate::run::RunOptions {
+        scene: scene.into(),
+        frames,
+        out: out.to_path_buf(),
+        save_every: 10,
+        switches: sw,
+    };
+    let r = crate::run::run(&opts)?;
+    let text = std::fs::read_to_string(out.join("summary.json")).map_err(|e| super::io(out, e))?;
+    let summary: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))?;
+    let csv = out.join("control.csv");
+    let mut rows = Vec::new();
+    let mut rd = csv::Reader::from_path(&csv)
+        .map_err(|e| Error::Param(format!("{}: {e}", csv.display())))?;
+    for row in rd.deserialize() {
+        rows.push(row.map_err(|e| Error::Param(format!("{}: {e}", csv.display())))?);
+    }
+    Ok(Outcome {
+        summary,
+        rows,
+        frame: r.pngs.last().cloned(),
+    })
+}
+
+fn cell(v: &serde_json::Value, digits: usize) -> String {
+    v.as_f64().map_or("-".into(), |x| format!("{x:.digits$}"))
+}
+
+pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
+    let mut steps = Steps::new(
+        "fidelity",
+        (SCENES.len() * PRESETS.len()) as u64,
+        env.switches.common.quiet,
+    );
+    let mut md = String::from(
+        "# Liquid-character fidelity: the thesis's control against the fidelity preset\n\n\
+         Each scene played twice (`fluidform run --scene S --control-preset thesis|fidelity`, \
+         metaballs at the scene's look). Metrics as the README defines them (\"Fidelity \
+         metrics\"), mean over the second half of each run (min in brackets); control share: \
+         the `sph/control` scopes over the `sph` scope (GPU medians per frame).\n\n\
+         | scene | control | frames | fill | iou | spray | surface p95 | density in shape | speed excess m/s | time to 90% s | control share |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut csv = String::from("scene,preset,frames,fill_mean,fill_min,iou_mean,iou_min,spray_mean,surface_p95_mean,density_in_shape_mean,speed_excess_mean,time_to_90_s,control_share\n");
+    let mut files = Vec::new();
+    let mut pictures = Vec::new();
+    let (mut fill_series, mut iou_series) = (Vec::new(), Vec::new());
+    for &(label, scene, quick_frames) in SCENES {
+        if scene.ends_with(".toml") && !Path::new(scene).exists() {
+            md.push_str(&format!("| {label} | - | - | not run: {scene} is not here (run from the repository root with ../shared beside it) | | | | | | | |\n"));
+            continue;
+        }
+        let frames = env.quick.then_some(quick_frames);
+        let mut shots = Vec::new();
+        for preset in PRESETS {
+            let name = format!(
+                "{}-{}",
+                scene
+                    .rsplit('/')
+                    .next()
+                    .unwrap_or(scene)
+                    .trim_end_matches(".toml"),
+                preset.as_str()
+            );
+            steps.start(&name);
+            let o = play(
+                env,
+                scene,
+                preset,
+                frames,
+                &env.runs("fidelity").join(&name),
+            )?;
+            steps.tick();
+            let t = &o.summary["stats"]["control"]["targets"][0];
+            let w = &t["fidelity"];
+            let m = |k: &str| (cell(&w[k]["mean"], 3), cell(&w[k]["min"], 3));
+            let p = &o.summary["pass_ms"];
+            let share = match (
+                p["sph/control"]["median"].as_f64(),
+                p["sph"]["median"].as_f64(),
+            ) {
+                (Some(c), Some(s)) if s > 0.0 => format!("{:.2}", c / s),
+                _ => "-".into(),
+            };
+            let t90 = cell(&t["time_to_90"], 2);
+            let n = o.rows.len();
+            md.push_str(&format!(
+                "| {label} | {} | {n} | {} ({}) | {} ({}) | {} | {} | {} | {} | {t90} | {share} |\n",
+                preset.as_str(),
+                m("fill").0,
+                m("fill").1,
+                m("iou").0,
+                m("iou").1,
+                cell(&w["spray"]["mean"], 4),
+                cell(&w["surface_p95"]["mean"], 2),
+                m("density_in_shape").0,
+                cell(&w["speed_excess"]["mean"], 2),
+            ));
+            csv.push_str(&format!(
+                "{label},{},{n},{},{},{},{},{},{},{},{},{t90},{share}\n",
+                preset.as_str(),
+                m("fill").0,
+                m("fill").1,
+                m("iou").0,
+                m("iou").1,
+                cell(&w["spray"]["mean"], 4),
+                cell(&w["surface_p95"]["mean"], 2),
+                m("density_in_shape").0,
+                cell(&w["speed_excess"]["mean"], 2),
+            ));
+            let series = |f: fn(&ControlRow) -> f64| {
+                o.rows.iter().map(|r| (r.time, f(r))).collect::<Vec<_>>()
+            };
+            fill_series.push((format!("{label} {}", preset.as_str()), series(|r| r.fill)));
+            iou_series.push((format!("{label} {}", preset.as_str()), series(|r| r.iou)));
+            if let Some(f) = o.frame {
+                shots.push((preset, f));
+            }
+        }
+        // The two frames side by side (thesis left).
+        if shots.len() == 2 {
+            let slug: String = label
+                .chars()
+                .take_while(|c| c.is_alphanumeric())
+                .collect::<String>()
+                .to_lowercase();
+            let png = env.out.join(format!("fidelity-{slug}.png"));
+            side_by_side(&shots[0].1, &shots[1].1, &png)?;
+            pictures.push((label, png.clone()));
+            files.push(png);
+        }
+    }
+    steps.finish();
+    let device = env.meta.device.clone();
+    let fill_png = env.out.join("fidelity.png");
+    let y = "fill (interior voxels with rho >= 0.5 rho0)";
+    crate::bench::plot::over_time(&fill_png, "fill over time", y, &device, &fill_series)?;
+    let iou_png = env.out.join("fidelity-iou.png");
+    let y = "IoU near the target";
+    crate::bench::plot::over_time(&iou_png, "IoU over time", y, &device, &iou_series)?;
+    md.push_str("\n![fill over time](fidelity.png)\n\n![IoU over time](fidelity-iou.png)\n\n");
+    for (label, png) in &pictures {
+        let f = png.file_name().and_then(|f| f.to_str()).unwrap_or_default();
+        md.push_str(&format!(
+            "{label}, the last saved frame: thesis (left), fidelity (right)\n\n![{label}]({f})\n\n"
+        ));
+    }
+    let p_csv = env.out.join("fidelity.csv");
+    write(&p_csv, &csv)?;
+    let p_md = super::finish_md(env, "fidelity", md, &[])?;
+    files.extend([p_csv, p_md, fill_png, iou_png]);
+    Ok((files, Vec::new()))
+}
+
+/// `a` and `b` side by side in one PNG (a on the left), each at its own size.
+fn side_by_side(a: &Path, b: &Path, out: &Path) -> Result<()> {
+    let load = |p: &Path| {
+        image::open(p)
+            .map(|i| i.to_rgba8())
+            .map_err(|e| Error::Param(format!("{}: {e}", p.display())))
+    };
+    let (a, b) = (load(a)?, load(b)?);
+    let mut img = image::RgbaImage::new(a.width() + b.width(), a.height().max(b.height()));
+    image::imageops::replace(&mut img, &a, 0, 0);
+    image::imageops::replace(&mut img, &b, a.width() as i64, 0);
+    img.save(out)
+        .map_err(|e| Error::Param(format!("{}: {e}", out.display())))
+}
