@@ -3,7 +3,8 @@
 # metrics (README "Fidelity metrics") per control-switch combination on the built-in
 # walker (tests/scenes/walker_liquid.toml, 2 s: metrics over the second 1 s walk cycle),
 # and the thesis's control against the fidelity preset on CesiumMan
-# (tests/scenes/cesium_man_liquid.toml, needs ../shared/assets). Points view (the
+# (tests/scenes/cesium_man_pool.toml: only the file, animation, height and a pool; needs
+# ../shared/assets). Points view (the
 # metrics do not depend on the picture). Usage: scripts/fidelity.sh [--device N|NAME]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,15 +12,17 @@ source scripts/bench_common.sh "$@"
 md=$dir/fidelity.md
 csv=$dir/fidelity.csv
 walker=tests/scenes/walker_liquid.toml
-cesium=tests/scenes/cesium_man_liquid.toml
+cesium=tests/scenes/cesium_man_pool.toml
 runs=(
   "walker|thesis|--control-preset thesis"
   "walker|fidelity (default)|"
   "walker|fidelity, attraction 0|--control-attraction 0"
+  "walker|fidelity, attraction 30|--control-attraction 30"
+  "walker|fidelity, attraction 90|--control-attraction 90"
   "walker|fidelity, velocity 0|--control-velocity 0"
   "walker|fidelity, damping 0|--control-damping 0"
+  "walker|fidelity, damping 2|--control-damping 2"
   "walker|fidelity, motion frames|--control-motion frames"
-  "walker|fidelity, attraction 60|--control-attraction 60"
   "walker|fidelity, reach 2 h_c|--control-reach 0.1828"
   "walker|fidelity, adaptive smooth|--adaptive smooth"
   "walker|thesis + attraction 30|--control-preset thesis --control-attraction 30"
@@ -63,7 +66,7 @@ done
   echo "Made by \`scripts/fidelity.sh ${*}\` on $(date -u +%F). Each row is one \`fluidform run"
   echo "--scene FILE --render points SWITCHES\`; metrics as the README defines them, mean (and"
   echo "minimum) over the second half of the run (the walker: its second 1 s walk cycle;"
-  echo "CesiumMan at half speed: the second half of his first cycle). control share: the"
+  echo "CesiumMan: the second half of his first 2 s cycle). control share: the"
   echo "\`sph/control\` scopes over the \`sph\` scope (GPU medians per frame). Targets (issue 29):"
   echo "fill >= 0.9, iou >= 0.7, spray <= 0.02, density in shape 0.9-1.1, speed excess <= 1 m/s,"
   echo "time to 90% <= 1.5 s, control share <= 0.30."

@@ -692,6 +692,12 @@ impl Scene {
         })?;
         let mut s: Scene =
             toml::from_str(&text).map_err(|e| toml_error(name_or_path, &text, &e))?;
+        // A liquid character's file that leaves [fluid] out gets the built-in liquid
+        // characters' water (Kelager's defaults take 10 ms ideal-gas steps).
+        let has_fluid = toml::from_str::<toml::Table>(&text).is_ok_and(|t| t.contains_key("fluid"));
+        if !has_fluid && (s.control.is_some() || !s.targets.is_empty()) {
+            s.fluid = released_water();
+        }
         // A character file is named relative to the scene file.
         let dir = path.parent().unwrap_or(Path::new("."));
         let chars = s.character.iter_mut();
