@@ -122,30 +122,25 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
             };
             let t90 = cell(&t["time_to_90"], 2);
             let n = o.rows.len();
-            md.push_str(&format!(
-                "| {label} | {} | {n} | {} ({}) | {} ({}) | {} | {} | {} | {} | {t90} | {share} |\n",
-                preset.as_str(),
-                m("fill").0,
-                m("fill").1,
-                m("iou").0,
-                m("iou").1,
+            let cells = [
+                label.to_string(),
+                preset.as_str().to_string(),
+                n.to_string(),
+                format!("{} ({})", m("fill").0, m("fill").1),
+                format!("{} ({})", m("iou").0, m("iou").1),
                 cell(&w["spray"]["mean"], 4),
                 cell(&w["surface_p95"]["mean"], 2),
                 m("density_in_shape").0,
                 cell(&w["speed_excess"]["mean"], 2),
-            ));
-            csv.push_str(&format!(
-                "{label},{},{n},{},{},{},{},{},{},{},{},{t90},{share}\n",
-                preset.as_str(),
-                m("fill").0,
-                m("fill").1,
-                m("iou").0,
-                m("iou").1,
-                cell(&w["spray"]["mean"], 4),
-                cell(&w["surface_p95"]["mean"], 2),
-                m("density_in_shape").0,
-                cell(&w["speed_excess"]["mean"], 2),
-            ));
+                t90,
+                share,
+            ];
+            md.push_str(&format!("| {} |\n", cells.join(" | ")));
+            // (The csv splits mean and min.)
+            let mut c = cells.to_vec();
+            c[3] = format!("{},{}", m("fill").0, m("fill").1);
+            c[4] = format!("{},{}", m("iou").0, m("iou").1);
+            csv.push_str(&format!("{}\n", c.join(",")));
             let series = |f: fn(&ControlRow) -> f64| {
                 o.rows.iter().map(|r| (r.time, f(r))).collect::<Vec<_>>()
             };

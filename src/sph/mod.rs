@@ -13,6 +13,7 @@ pub mod pressure;
 pub mod run;
 pub mod scene;
 pub mod solver;
+pub mod spacing;
 
 pub use params::{Collider, Eos, FluidParams};
 pub use scene::Scene;
