@@ -16,15 +16,15 @@ cesium=tests/scenes/cesium_man_pool.toml
 runs=(
   "walker|thesis|--control-preset thesis"
   "walker|fidelity (default)|"
-  "walker|fidelity, attraction 0|--control-attraction 0"
-  "walker|fidelity, attraction 30|--control-attraction 30"
-  "walker|fidelity, attraction 90|--control-attraction 90"
-  "walker|fidelity, velocity 0|--control-velocity 0"
-  "walker|fidelity, damping 0|--control-damping 0"
-  "walker|fidelity, damping 2|--control-damping 2"
-  "walker|fidelity, motion frames|--control-motion frames"
-  "walker|fidelity, reach 2 h_c|--control-reach 0.1828"
-  "walker|fidelity, adaptive smooth|--adaptive smooth"
+  "walker|fidelity with attraction 0|--control-attraction 0"
+  "walker|fidelity with attraction 30|--control-attraction 30"
+  "walker|fidelity with attraction 90|--control-attraction 90"
+  "walker|fidelity with velocity 0|--control-velocity 0"
+  "walker|fidelity with damping 0|--control-damping 0"
+  "walker|fidelity with damping 2|--control-damping 2"
+  "walker|fidelity with motion frames|--control-motion frames"
+  "walker|fidelity with reach 2 h_c|--control-reach 0.1828"
+  "walker|fidelity with adaptive smooth|--adaptive smooth"
   "walker|thesis + attraction 30|--control-preset thesis --control-attraction 30"
   "cesium|thesis|--control-preset thesis"
   "cesium|fidelity (default)|"
@@ -40,6 +40,7 @@ for r in "${runs[@]}"; do
   k=$((k + 1))
   # shellcheck disable=SC2086
   if ! "$bin" run --scene "$file" --render points --quiet --out "$out" "${dev[@]}" $sw > "$out.log" 2>&1; then
+    # (The unstable run's message, its commas made semicolons, fills the first column.)
     echo "$scene,$name,FAILED: $(tail -1 "$out.log" | tr ',' ';'),,,,,,,,,,,$sw" >> "$csv"
     continue
   fi
