@@ -122,6 +122,7 @@ pub fn variants() -> Vec<Variant> {
                 for f in [
                     "control/density.comp",
                     "control/aggregate.comp",
+                    "control/field.comp",
                     "control/force.comp",
                 ] {
                     v.push(with::<ControlIo>(f, &c));

@@ -174,6 +174,65 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             }
         }
     };
+    // The attraction and damping field at the control grid's cell centres (cell h_c from
+    // the domain's corner), each cell's control particles taken together at their
+    // deficit-weighted centre; the control particles stand still (their first pose is
+    // also their previous one), so the character's velocity there is zero.
+    let reach = settings.reach as f64;
+    let dims = ((0.5 / hc).ceil()) as i64;
+    let key = |p: glam::DVec3| {
+        (p / hc)
+            .floor()
+            .as_i64vec3()
+            .clamp(glam::I64Vec3::ZERO, glam::I64Vec3::splat(dims - 1))
+    };
+    let mut cells: std::collections::HashMap<glam::I64Vec3, (glam::DVec3, f64, glam::DVec3, f64)> =
+        Default::default();
+    for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
+        let e = cells.entry(key(c.as_dvec3())).or_default();
+        let d = (1.0 - rho_j / rho0).max(0.0);
+        e.0 += d * c.as_dvec3();
+        e.1 += d;
+        e.2 += c.as_dvec3();
+        e.3 += 1.0;
+    }
+    let k = (reach / hc).ceil() as i64;
+    let mut field = std::collections::HashMap::new();
+    for z in 0..dims {
+        for y in 0..dims {
+            for x in 0..dims {
+                let c0 = glam::I64Vec3::new(x, y, z);
+                let xc = (c0.as_dvec3() + 0.5) * hc;
+                let (mut pull, mut wall, mut wdef) = (glam::DVec3::ZERO, 0.0, 0.0);
+                for (cell, (dc, dsum, csum, n)) in &cells {
+                    if (*cell - c0).abs().max_element() > k {
+                        continue;
+                    }
+                    if *dsum > 0.0 {
+                        let d = *dc / *dsum - xc;
+                        let r = d.length();
+                        if r < reach {
+                            let w = (1.0 - r / reach).powi(2) * dsum;
+                            if r > 1e-6 {
+                                pull += w / r * d;
+                            }
+                            wdef += w;
+                        }
+                    }
+                    let r = (*csum / *n - xc).length();
+                    if r < reach {
+                        wall += (1.0 - r / reach).powi(2) * n;
+                    }
+                }
+                let a = if wdef > 0.0 {
+                    settings.attraction as f64 * pull / f64::max(wdef, 1.0)
+                } else {
+                    glam::DVec3::ZERO
+                };
+                field.insert(c0, (a, if wall > 0.0 { 1.0 } else { 0.0 }));
+            }
+        }
+    }
     let spiky = -45.0 / (std::f64::consts::PI * hc.powi(6));
     let (mut err, mut scale, mut touched) = (0.0f64, 0.0f64, 0);
     let mut rows = Vec::new();
@@ -192,59 +251,21 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             }
         }
         let mut want = fsum / d1.rho_p[i][0] as f64;
-        // Deficit attraction and damping (the control particles stand still: their first
-        // pose is also their previous one), each control-grid cell's particles taken
-        // together at their deficit-weighted centre (cell h_c from the domain's corner).
-        let reach = settings.reach as f64;
-        let dims = ((0.5 / hc).ceil()) as i64;
-        let key = |p: glam::DVec3| {
-            (p / hc)
-                .floor()
-                .as_i64vec3()
-                .clamp(glam::I64Vec3::ZERO, glam::I64Vec3::splat(dims - 1))
-        };
-        let mut cells: std::collections::HashMap<
-            glam::I64Vec3,
-            (glam::DVec3, f64, glam::DVec3, f64),
-        > = Default::default();
-        for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
-            let e = cells.entry(key(c.as_dvec3())).or_default();
-            let d = (1.0 - rho_j / rho0).max(0.0);
-            e.0 += d * c.as_dvec3();
-            e.1 += d;
-            e.2 += c.as_dvec3();
-            e.3 += 1.0;
-        }
-        let k = (reach / hc).ceil() as i64;
-        let c0 = key(x);
-        let (mut pull, mut wall, mut wdef) = (glam::DVec3::ZERO, 0.0, 0.0);
-        for (cell, (dc, dsum, csum, n)) in &cells {
-            let off = *cell - c0;
-            if !controlled(&d1.attr[i]) || off.abs().max_element() > k {
-                continue;
-            }
-            if *dsum > 0.0 {
-                let d = *dc / *dsum - x;
-                let r = d.length();
-                if r < reach {
-                    let w = (1.0 - r / reach).powi(2) * dsum;
-                    if r > 1e-6 {
-                        pull += w / r * d;
-                    }
-                    wdef += w;
-                }
-            }
-            let r = (*csum / *n - x).length();
-            if r < reach {
-                wall += (1.0 - r / reach).powi(2) * n;
-            }
-        }
-        if wdef > 0.0 {
-            want += settings.attraction as f64 * pull / wdef.max(1.0);
-        }
-        if wall > 0.0 {
+        // Deficit attraction and damping: the node field, trilinear between cell centres.
+        if controlled(&d1.attr[i]) {
+            let u = x / hc - 0.5;
+            let hi = glam::I64Vec3::splat(dims - 1);
+            let b = u.floor().as_i64vec3().clamp(glam::I64Vec3::ZERO, hi);
+            let t = (u - b.as_dvec3()).clamp(glam::DVec3::ZERO, glam::DVec3::ONE);
             let v = glam::DVec3::from_array([0, 1, 2].map(|k| d1.vel[i][k] as f64));
-            want -= settings.damping as f64 * v;
+            for n in 0..8 {
+                let o = glam::I64Vec3::new(n & 1, (n >> 1) & 1, n >> 2);
+                let c = (b + o).min(hi);
+                let of = o.as_dvec3();
+                let wt = (glam::DVec3::ONE - t) * (glam::DVec3::ONE - of) + t * of;
+                let (pull, mask) = field[&c];
+                want += wt.x * wt.y * wt.z * (pull - settings.damping as f64 * mask * v);
+            }
         }
         let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - d0.acc[i][k]) as f64));
         rows.push((want, got));

@@ -8,7 +8,8 @@
 // 1 - rho_j / rho0 and (1 - r/R)^2, normalised by the deficits' weight or 1: a filled
 // neighbourhood pulls nothing, a few empty particles nearby pull at full strength, a lone
 // far one a little), and a damping of the velocity relative to the character's there
-// (the mean control velocity, weighted alike). Both read per-cell sums (aggregate.comp).
+// (the mean control velocity, weighted alike). Both are a field on the control grid
+// (aggregate.comp sums each cell, field.comp evaluates at cell centres) read trilinearly.
 #include "common.glsl"
 void main() {
     uint i = global_id();
@@ -44,37 +45,24 @@ void main() {
     vec3 a = f / rho;
     if (wsum > 0.0) a += C.velocity * (vsum / wsum - vel[i].xyz);
     if (C.attraction > 0.0 || C.damping > 0.0) {
-        // Over the cells within the reach, each cell's control particles taken together:
-        // the deficit at their deficit-weighted centre, the velocity at their centre.
-        int k = int(C.reach_cells);
-        float R = C.reach;
-        vec3 pull = vec3(0.0), vchar = vec3(0.0);
-        float wall = 0.0, wdef = 0.0;
-        for (int dz = -k; dz <= k; ++dz) for (int dy = -k; dy <= k; ++dy) for (int dx = -k; dx <= k; ++dx) {
-            ivec3 c = c0 + ivec3(dx, dy, dz);
-            if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
+        // The field of field.comp at xi, trilinear between cell centres (clamped at the
+        // grid's faces); the damping fades with the interpolated mask.
+        vec3 u = (xi - C.grid.xyz) / C.grid.w - 0.5;
+        ivec3 hi = ivec3(C.dims.xyz) - 1;
+        ivec3 b = clamp(ivec3(floor(u)), ivec3(0), hi);
+        vec3 t = clamp(u - vec3(b), 0.0, 1.0);
+        vec3 pull = vec3(0.0);
+        vec4 vchar = vec4(0.0);
+        for (int n = 0; n < 8; ++n) {
+            ivec3 o = ivec3(n & 1, (n >> 1) & 1, n >> 2);
+            ivec3 c = min(b + o, hi);
+            vec3 wt = mix(1.0 - t, t, vec3(o));
+            float w = wt.x * wt.y * wt.z;
             uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
-            vec4 at = cagg[3 * id + 1];
-            if (at.w == 0.0) continue;
-            vec4 def = cagg[3 * id];
-            if (def.w > 0.0) {
-                vec3 d = def.xyz / def.w - xi;
-                float r = length(d);
-                if (r < R) {
-                    float w = (1.0 - r / R) * (1.0 - r / R) * def.w;
-                    if (r > 1e-6) pull += (w / r) * d;
-                    wdef += w;
-                }
-            }
-            float r = length(at.xyz / at.w - xi);
-            if (r < R) {
-                float w = (1.0 - r / R) * (1.0 - r / R);
-                vchar += w * cagg[3 * id + 2].xyz;
-                wall += w * at.w;
-            }
+            pull += w * cfield[2 * id].xyz;
+            vchar += w * cfield[2 * id + 1];
         }
-        if (wdef > 0.0) a += C.attraction * pull / max(wdef, 1.0);
-        if (wall > 0.0) a += C.damping * (vchar / wall - vel[i].xyz);
+        a += pull + C.damping * (vchar.xyz - vchar.w * vel[i].xyz);
     }
     acc[i].xyz += a;
 }

@@ -26,7 +26,7 @@ crate::gpu_interface! {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
         control = 11, cpos = 12, cprev = 13, crho = 14, cstart = 15, ccount = 16, attr = 17,
-        cagg = 18,
+        cagg = 18, cfield = 19,
     }
 }
 
@@ -76,6 +76,7 @@ pub struct Pose {
 struct ControlGpu {
     density: ComputePipeline<ControlIo>,
     aggregate: ComputePipeline<ControlIo>,
+    field: ComputePipeline<ControlIo>,
     force: ComputePipeline<ControlIo>,
     skin: SkinPass,
     mesh: SkinnedMesh,
@@ -89,6 +90,8 @@ struct ControlGpu {
     crho: Buffer,
     /// Per control-grid cell: the sums of aggregate.comp (3 vec4).
     cagg: Buffer,
+    /// Per cell centre: the attraction and damping field of field.comp (2 vec4).
+    cfield: Buffer,
     params: Buffer,
     /// `--placement rays`: re-placed from the skinned mesh (`mesh`) every frame.
     rays: Option<super::rays::RaysPlacer>,
@@ -99,6 +102,7 @@ impl ControlGpu {
     fn destroy(&mut self, ctx: &Context) {
         self.density.destroy(ctx);
         self.aggregate.destroy(ctx);
+        self.field.destroy(ctx);
         self.force.destroy(ctx);
         self.skin.destroy(ctx);
         self.mesh.destroy(ctx);
@@ -114,6 +118,7 @@ impl ControlGpu {
             &mut self.sorted_prev,
             &mut self.crho,
             &mut self.cagg,
+            &mut self.cfield,
             &mut self.params,
         ] {
             ctx.destroy_buffer(b);
@@ -180,6 +185,7 @@ impl ControlForce {
         };
         let density = pipeline("control-density", "control/density.comp")?;
         let aggregate = pipeline("control-aggregate", "control/aggregate.comp")?;
+        let field = pipeline("control-field", "control/field.comp")?;
         let force = pipeline("control-force", "control/force.comp")?;
         // Rays: three more layers above the domain in z, the last one parking the unused
         // slots two cells away from any fluid particle's.
@@ -222,6 +228,7 @@ impl ControlForce {
         let sorted_prev = buf("control sorted previous", v4)?;
         let crho = buf("control densities", m as u64 * 4)?;
         let cagg = buf("control cell sums", grid.cells() * 48)?;
+        let cfield = buf("control field", grid.cells() * 32)?;
         let params = buf(
             "control params",
             std::mem::size_of::<ControlGpuParams>() as u64,
@@ -230,6 +237,7 @@ impl ControlForce {
             gpu: RefCell::new(Some(ControlGpu {
                 density: density.take(),
                 aggregate: aggregate.take(),
+                field: field.take(),
                 force: force.take(),
                 skin: skin.take(),
                 mesh: cmesh.take(),
@@ -242,6 +250,7 @@ impl ControlForce {
                 sorted_prev: sorted_prev.take(),
                 crho: crho.take(),
                 cagg: cagg.take(),
+                cfield: cfield.take(),
                 params: params.take(),
                 rays: rays.map(|r| r.take()),
             })),
@@ -433,6 +442,7 @@ impl ControlForce {
             ccount,
             attr: st.attr(),
             cagg: &g.cagg,
+            cfield: &g.cfield,
         }
     }
 
@@ -533,7 +543,11 @@ impl SphHook for ControlHook {
             scopes.begin(ctx, cmd, "control-aggregate");
             g.aggregate.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
             scopes.end(ctx, cmd);
-            ctx.compute_barrier(cmd); // cell sums -> force
+            ctx.compute_barrier(cmd); // cell sums -> field
+            scopes.begin(ctx, cmd, "control-field");
+            g.field.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
+            scopes.end(ctx, cmd);
+            ctx.compute_barrier(cmd); // field -> force
         }
         scopes.begin(ctx, cmd, "control-force");
         g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
