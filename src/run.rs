@@ -392,6 +392,12 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     // The scene's look where the switches leave it open; summary.json records the result.
     let mut sw = scene.look.apply(sw);
     scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
+    // A liquid character's spacing and pool from its character (scene::fit).
+    for line in crate::scene::fit::fit(&mut scene)?.describe() {
+        if !sw.common.quiet {
+            eprintln!("{}: {line}", scene.name);
+        }
+    }
     // The metaballs' radius follows the particle spacing (0.04 m at the default spacing).
     if sw.metaball.radius.is_none() && scene.fluid.spacing.is_some() {
         let s0 = crate::sph::FluidParams::default().spacing();

@@ -44,6 +44,7 @@ fn scene() -> Scene {
         timeline: vec![],
         emission: None,
         system: vec![],
+        pool: None,
     }
 }
 

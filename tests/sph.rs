@@ -46,6 +46,7 @@ fn block_scene(fluid: FluidParams) -> Scene {
         timeline: vec![],
         emission: None,
         system: vec![],
+        pool: None,
     }
 }
 

@@ -145,8 +145,16 @@ impl ControlDesc {
         })
     }
 
-    pub fn settings(&self, h: f32) -> ControlSettings {
-        let radius = self.radius.unwrap_or(2.0 * h);
+    /// The settings for `fluid`. At a chosen spacing S (`--fluid spacing`, or the one a
+    /// character scene picks) c_cp is scaled by (S / S0)^4 against the default spacing
+    /// S0: eq. 7's acceleration goes as c_cp / (s_c^3 h_c), so the pull per unit of fluid
+    /// stays what it is at S0.
+    pub fn settings(&self, fluid: &crate::sph::FluidParams) -> ControlSettings {
+        let radius = self.radius.unwrap_or(2.0 * fluid.h);
+        let scale = match fluid.spacing {
+            Some(s) => (s / crate::sph::FluidParams::default().spacing()).powi(4),
+            None => 1.0,
+        };
         let mut d = Preset::of(self.preset.unwrap_or(ControlPreset::Fidelity));
         if self.placement == Placement::Rays {
             // Re-placed particles have no velocity: the preset's velocity terms stay off
@@ -154,7 +162,7 @@ impl ControlDesc {
             (d.velocity, d.damping) = (0.0, 0.0);
         }
         ControlSettings {
-            pressure: self.pressure,
+            pressure: self.pressure * scale,
             radius,
             adaptive: self.adaptive,
             low: self.thresholds[0],
@@ -299,7 +307,7 @@ impl ControlTarget {
                 }
             })
             .collect::<Result<Vec<_>>>()?;
-        let settings = desc.settings(fluid.h);
+        let settings = desc.settings(fluid);
         let force = Rc::new(ControlForce::new(
             ctx,
             solver,
@@ -338,7 +346,7 @@ impl ControlTarget {
             solver,
             &ch.mesh,
             ch.skeleton.joints.len(),
-            desc.settings(fluid.h),
+            desc.settings(fluid),
             domain,
             (Some((spacing, capacity)), skinning),
         )?);

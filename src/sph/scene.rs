@@ -106,6 +106,10 @@ pub struct Scene {
     /// by depth; stepped once per frame of `frame_time`.
     #[serde(default)]
     pub system: Vec<crate::psys::spec::SystemSpec>,
+    /// The water a liquid character is made of, sized from `character` (see
+    /// `scene::fit`): added to `blocks` when the run starts.
+    #[serde(default)]
+    pub pool: Option<crate::scene::fit::PoolDesc>,
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
@@ -266,6 +270,7 @@ fn liquid(
         timeline: vec![],
         emission: None,
         system: vec![],
+        pool: None,
     }
 }
 
@@ -376,6 +381,7 @@ fn trail(
             ..crate::scene::emission::EmissionDesc::new(slots)
         }),
         system: vec![],
+        pool: None,
     }
 }
 
@@ -411,6 +417,7 @@ fn dam_break(name: &str, tank: [f32; 3], column: [f32; 3], view: [f32; 2]) -> Sc
         timeline: vec![],
         emission: None,
         system: vec![],
+        pool: None,
     }
 }
 
@@ -491,6 +498,7 @@ impl Scene {
                 timeline: vec![],
                 emission: None,
                 system: vec![],
+                pool: None,
             },
             // Kelager's water exactly (ideal gas, k = 3 J, dt = 0.01 s), resting on the floor.
             "resting-block" => Scene {
@@ -522,13 +530,18 @@ impl Scene {
                 timeline: vec![],
                 emission: None,
                 system: vec![],
+                pool: None,
             },
-            // A liquid character: a pool rises into the built-in walker (control particles,
+            // A liquid character: its pool rises into the built-in walker (control particles,
             // adaptive pressure, the fidelity preset) and follows its walk at half speed.
             // (Released, the collapse's pool went unstable near 2 s with WCSPH: not shown.)
             "character" => Scene {
                 frames: 200,
                 fluid: released_water(),
+                // The water it is made of, under its feet (scene::fit); the spacing comes
+                // from its thinnest part.
+                blocks: vec![],
+                pool: Some(crate::scene::fit::PoolDesc::default()),
                 timeline: vec![Event::new(0.0, Action::Attach, Some(MAIN_TARGET))],
                 look: Look {
                     material: Some(crate::config::Material::Tinted),
@@ -668,6 +681,7 @@ impl Scene {
                 timeline: vec![],
                 emission: None,
                 system: vec![],
+                pool: None,
             },
             _ => return None,
         })
@@ -850,7 +864,9 @@ impl Scene {
 
     /// Blocks or balls of fluid, or emission (a scene may hold a character alone).
     pub fn has_fluid(&self) -> bool {
-        !(self.blocks.is_empty() && self.balls.is_empty()) || self.emission.is_some()
+        !(self.blocks.is_empty() && self.balls.is_empty())
+            || self.emission.is_some()
+            || self.pool.is_some()
     }
 
     /// The scene scaled about the origin by `s` (geometry and camera; the fluid's

@@ -1,0 +1,90 @@
+//! A liquid character's scene fitted to its character (scene::fit): the spacing from the
+//! thinnest part, and `[pool]` holding the asked multiple of the character's volume under
+//! its first pose. Checked against the character's own numbers (inspect), on the CPU.
+use fluidform::character::inspect::thinnest;
+use fluidform::scene::fit::{fit, ACROSS, COARSEST, FINEST};
+use fluidform::sph::Scene;
+
+fn scene(dir: &std::path::Path, body: &str) -> fluidform::Result<Scene> {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, body).unwrap();
+    Scene::load(path.to_str().unwrap())
+}
+
+const HEAD: &str = r#"
+name = "fit"
+[domain]
+min = [-0.6, 0.0, -0.4]
+max = [0.6, 1.3, 0.4]
+[character]
+file = "builtin:walker"
+"#;
+
+#[test]
+fn spacing_and_pool_follow_the_character() {
+    let dir = std::env::temp_dir().join("fluidform-fit-1");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut s = scene(
+        &dir,
+        &format!("{HEAD}height = 1.2\n[control]\n[pool]\nvolume = 1.5\n"),
+    )
+    .unwrap();
+    let f = fit(&mut s).unwrap();
+    let (ch, anim) = s.character.as_ref().unwrap().load().unwrap();
+    let (lo, hi) = ch.rest_bounds().unwrap();
+    let scale = 1.2 / (hi.y - lo.y);
+    assert!((anim.placement.x_axis.length() - scale).abs() < 1e-4);
+    let d = thinnest(&ch).unwrap().diameter * scale;
+    let want = (d / ACROSS).clamp(1.2 / FINEST, 1.2 / COARSEST);
+    let (got, why) = f.spacing.clone().unwrap();
+    assert!((got - want).abs() < 1e-6, "spacing {got} against {want}");
+    assert!(why.contains("thinnest"), "{why}");
+    let sp = s.fluid.spacing();
+    assert!((sp - want).abs() < 1e-4 * want, "the fluid's spacing {sp}");
+    // The pool: one block on the floor, under the walker, holding 1.5 times his volume
+    // (to within one layer of particles).
+    assert!(s.pool.is_none(), "the pool becomes a block");
+    assert_eq!(s.blocks.len(), 1);
+    let b = &s.blocks[0];
+    assert_eq!(b.min[1], 0.0);
+    assert!(b.min[0] < 0.0 && b.max[0] > 0.0 && b.min[2] < 0.0 && b.max[2] > 0.0);
+    let n = s.particles(1).len() as f64;
+    let (_, count) = f.pool.clone().unwrap();
+    assert_eq!(count as f64, n, "the reported count is the lattice's");
+    let vol = ch.check.signed_volume.abs() * (scale as f64).powi(3) * 1.5;
+    let layer = ((b.max[0] - b.min[0]) * (b.max[2] - b.min[2]) * sp) as f64;
+    let held = n * (sp as f64).powi(3);
+    assert!(
+        held >= vol - 1e-9 && held <= vol + layer,
+        "pool holds {held} m^3 for {vol} (layer {layer})"
+    );
+    // Metaballs and control follow the spacing: h scaled with it.
+    let d0 = fluidform::sph::FluidParams::default();
+    assert!((s.fluid.h / d0.h - sp / d0.spacing()).abs() < 1e-3);
+}
+
+#[test]
+fn a_given_spacing_stays_and_bad_pools_are_refused() {
+    let dir = std::env::temp_dir().join("fluidform-fit-2");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut s = scene(&dir, &format!("{HEAD}[control]\n[fluid]\nspacing = 0.03\n[[blocks]]\nmin = [-0.6, 0.0, -0.4]\nmax = [0.6, 0.1, 0.4]\n")).unwrap();
+    let f = fit(&mut s).unwrap();
+    assert!(f.spacing.is_none() && f.pool.is_none());
+    assert_eq!(s.fluid.spacing, Some(0.03), "the scene's spacing is kept");
+    // A pool deeper than the domain.
+    let mut s = scene(&dir, &format!("{HEAD}[control]\n[pool]\nvolume = 19\n")).unwrap();
+    let e = fit(&mut s).unwrap_err().to_string();
+    assert!(e.contains("higher than the domain"), "{e}");
+    let mut s = scene(&dir, &format!("{HEAD}[control]\n[pool]\nvolume = -1\n")).unwrap();
+    let e = fit(&mut s).unwrap_err().to_string();
+    assert!(e.contains("volume"), "{e}");
+    // A pool needs the character it is sized from.
+    let e = scene(
+        &dir,
+        "name = \"p\"\n[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n[pool]\n",
+    )
+    .and_then(|mut s| fit(&mut s).map(|_| ()))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("[pool]"), "{e}");
+}
