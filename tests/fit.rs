@@ -71,6 +71,15 @@ fn a_given_spacing_stays_and_bad_pools_are_refused() {
     let f = fit(&mut s).unwrap();
     assert!(f.spacing.is_none() && f.pool.is_none());
     assert_eq!(s.fluid.spacing, Some(0.03), "the scene's spacing is kept");
+    // A mass other than the default's says the spacing too.
+    let mut s = scene(
+        &dir,
+        &format!("{HEAD}[control]\n[fluid]\nmass = 0.01\n[pool]\n"),
+    )
+    .unwrap();
+    let f = fit(&mut s).unwrap();
+    assert!(f.spacing.is_none() && f.pool.is_some());
+    assert_eq!(s.fluid.mass, 0.01);
     // A pool deeper than the domain.
     let mut s = scene(&dir, &format!("{HEAD}[control]\n[pool]\nvolume = 19\n")).unwrap();
     let e = fit(&mut s).unwrap_err().to_string();

@@ -69,7 +69,8 @@ impl Fitted {
 }
 
 /// Fit `scene` (its fluid already has the switches' overrides) to its `[character]` when
-/// it has control targets: a spacing unless one is set, then the pool.
+/// it has control targets: a spacing unless one is set (or a mass other than the
+/// default's), then the pool.
 pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let mut out = Fitted {
         spacing: None,
@@ -91,7 +92,9 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let (lo, hi) = ch.rest_bounds()?;
     let scale = anim.placement.x_axis.truncate().length();
     let height = (hi.y - lo.y) * scale;
-    if scene.fluid.spacing.is_none() {
+    // (A mass other than the default's already says the spacing: mass = rho_0 S^3.)
+    let default_mass = scene.fluid.mass == crate::sph::FluidParams::default().mass;
+    if scene.fluid.spacing.is_none() && default_mass {
         let (s, why) = match thinnest(&ch) {
             Some(t) => {
                 let d = t.diameter * scale;
