@@ -312,7 +312,16 @@ fn group_only_control(solver: &[&str]) {
     let free = scene(d, "free", "", 9e-4, 12);
     let held = scene(d, "held", "[control]\ngroup = 0", 9e-4, 12);
     let frames = 20;
-    let mut ex = vec!["--export", "ply", "--export-every", "19"];
+    // Both at the default spacing (a controlled scene would otherwise choose its own
+    // from the character: scene::fit).
+    let mut ex = vec![
+        "--export",
+        "ply",
+        "--export-every",
+        "19",
+        "--fluid",
+        "spacing=0.027144176",
+    ];
     ex.extend_from_slice(solver);
     let a = play(&free, &d.join("free"), frames, &ex);
     let b = play(&held, &d.join("held"), frames, &ex);
