@@ -78,6 +78,26 @@ pub fn path_pose(points: &[Vec3], speed: f32, t: f64) -> (Vec3, f32) {
     (points[0], 0.0)
 }
 
+/// The placed joint matrices of `ch` at scene time `t`: the clip at `speed`, then along
+/// `path` (waypoints, metres per second) when it has one.
+pub fn placed_matrices(
+    ch: &Character,
+    anim: &Animator,
+    speed: f32,
+    path: Option<&(Vec<Vec3>, f32)>,
+    t: f64,
+) -> Vec<Mat4> {
+    let mats = anim.joint_matrices(ch, (t * speed as f64) as f32);
+    match path {
+        None => mats,
+        Some((points, speed)) => {
+            let (at, yaw) = path_pose(points, *speed, t);
+            let m = Mat4::from_translation(at) * Mat4::from_rotation_y(yaw);
+            mats.into_iter().map(|x| m * x).collect()
+        }
+    }
+}
+
 impl CharacterDesc {
     /// `file` at its own size at the origin, its first clip looping at its own rate.
     pub fn new(file: &str) -> Self {
@@ -93,6 +113,16 @@ impl CharacterDesc {
             path: Vec::new(),
             path_speed: 0.0,
         }
+    }
+
+    /// The path's waypoints and speed, when it has one.
+    pub fn path(&self) -> Option<(Vec<Vec3>, f32)> {
+        (!self.path.is_empty()).then(|| {
+            (
+                self.path.iter().map(|p| Vec3::from(*p)).collect(),
+                self.path_speed,
+            )
+        })
     }
 
     pub fn validate(&self, scene: &str) -> Result<()> {
@@ -221,29 +251,14 @@ impl SceneCharacter {
             method,
             speed: desc.speed,
             show,
-            path: (!desc.path.is_empty()).then(|| {
-                (
-                    desc.path.iter().map(|p| Vec3::from(*p)).collect(),
-                    desc.path_speed,
-                )
-            }),
+            path: desc.path(),
             skinner: skinner.take(),
         })
     }
 
     /// The placed joint matrices at scene time `t` (clip at `speed`, along the path).
     pub fn matrices(&self, t: f64) -> Vec<Mat4> {
-        let mats = self
-            .anim
-            .joint_matrices(&self.ch, (t * self.speed as f64) as f32);
-        match &self.path {
-            None => mats,
-            Some((points, speed)) => {
-                let (at, yaw) = path_pose(points, *speed, t);
-                let m = Mat4::from_translation(at) * Mat4::from_rotation_y(yaw);
-                mats.into_iter().map(|x| m * x).collect()
-            }
-        }
+        placed_matrices(&self.ch, &self.anim, self.speed, self.path.as_ref(), t)
     }
 
     /// The skinned positions (vec4 per vertex) of the last `record`.

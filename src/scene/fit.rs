@@ -1,10 +1,11 @@
 //! A liquid character's scene fitted to its character: the particle spacing from the
 //! character's thinnest part when the scene and the switches give none, and `[pool]`, the
 //! water it is made of, sized from its volume and laid under its first pose.
+use super::character::placed_matrices;
 use crate::character::inspect::thinnest;
 use crate::error::{Error, Result};
-use crate::sph::scene::{Block, Scene};
-use glam::{Mat4, Vec3};
+use crate::sph::scene::{white, Block, Scene};
+use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// Particles across the thinnest part at the chosen spacing.
@@ -15,10 +16,6 @@ pub const COARSEST: f32 = 35.0;
 
 fn volume() -> f32 {
     1.3
-}
-
-fn white() -> [f32; 3] {
-    [0.25, 0.55, 1.0]
 }
 
 /// `[pool]`: a block of water on the floor under the character's first pose (its
@@ -119,7 +116,9 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
                 scene.name, pool.volume
             )));
         }
-        let first = first_pose(&ch, &anim, &desc)?;
+        // The placed skin at scene time 0 (the path's start included).
+        let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
+        let first = ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0;
         let (plo, phi) = crate::character::check::bounds(&first);
         let want = (ch.check.signed_volume.abs() as f32) * scale.powi(3) * pool.volume;
         let b = pool_block(scene, (plo, phi), want, pool.color)?;
@@ -131,37 +130,6 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         out.pool = Some((b, n));
     }
     Ok(out)
-}
-
-/// The placed skin at scene time 0 (the path's start included).
-fn first_pose(
-    ch: &crate::character::Character,
-    anim: &crate::character::anim::Animator,
-    desc: &super::character::CharacterDesc,
-) -> Result<Vec<Vec3>> {
-    let at = match desc.path.is_empty() {
-        true => Mat4::IDENTITY,
-        false => {
-            let pts: Vec<Vec3> = desc.path.iter().map(|&p| p.into()).collect();
-            let (p, yaw) = super::character::path_pose(&pts, desc.path_speed, 0.0);
-            Mat4::from_translation(p) * Mat4::from_rotation_y(yaw)
-        }
-    };
-    if ch.skinned {
-        let mats: Vec<Mat4> = anim
-            .joint_matrices(ch, 0.0)
-            .into_iter()
-            .map(|m| at * m)
-            .collect();
-        Ok(ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0)
-    } else {
-        let m = at * anim.placement;
-        Ok(ch
-            .rest_positions()?
-            .into_iter()
-            .map(|p| m.transform_point3(p))
-            .collect())
-    }
 }
 
 /// A block on the domain's floor under [lo, hi] (grown by h) deep enough for `want` m^3

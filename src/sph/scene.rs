@@ -14,7 +14,7 @@ pub struct Domain {
     pub max: [f32; 3],
 }
 
-fn white() -> [f32; 3] {
+pub(crate) fn white() -> [f32; 3] {
     [0.25, 0.55, 1.0]
 }
 
