@@ -1,33 +1,33 @@
 #!/usr/bin/env bash
 # Regenerate results/<device-slug>/fidelity.md (+ .csv): the liquid-character fidelity
 # metrics (README "Fidelity metrics") per control-switch combination on the built-in
-# walker (tests/scenes/walker_liquid.toml, 2 s: metrics over the second 1 s walk cycle),
-# and the thesis's control against the fidelity preset on CesiumMan
-# (tests/scenes/cesium_man_pool.toml: only the file, animation, height and a pool; needs
-# ../shared/assets). Points view (the
+# walker standing in his own pool (tests/scenes/walker_pool.toml, 2 s: metrics over the
+# second 1 s walk cycle), and the thesis's control against the fidelity preset on
+# CesiumMan (tests/scenes/cesium_man_pool.toml, 4 s: his second 2 s cycle; only the file,
+# animation, height and a pool; needs ../shared/assets). Points view (the
 # metrics do not depend on the picture). Usage: scripts/fidelity.sh [--device N|NAME]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/bench_common.sh "$@"
 md=$dir/fidelity.md
 csv=$dir/fidelity.csv
-walker=tests/scenes/walker_liquid.toml
+walker=tests/scenes/walker_pool.toml
 cesium=tests/scenes/cesium_man_pool.toml
 runs=(
   "walker|thesis|--control-preset thesis"
   "walker|fidelity (default)|"
   "walker|fidelity with attraction 0|--control-attraction 0"
-  "walker|fidelity with attraction 30|--control-attraction 30"
-  "walker|fidelity with attraction 90|--control-attraction 90"
+  "walker|fidelity with attraction 60|--control-attraction 60"
   "walker|fidelity with velocity 0|--control-velocity 0"
   "walker|fidelity with damping 0|--control-damping 0"
-  "walker|fidelity with damping 2|--control-damping 2"
+  "walker|fidelity without eq. 7|--control-pressure 0"
+  "walker|fidelity without eq. 7 or velocity, damping 11|--control-pressure 0 --control-velocity 0 --control-damping 11"
+  "walker|fidelity with frictionless walls|--fluid friction=0"
   "walker|fidelity with motion frames|--control-motion frames"
-  "walker|fidelity with reach 2 h_c|--control-reach 0.1828"
   "walker|fidelity with adaptive smooth|--adaptive smooth"
-  "walker|thesis + attraction 30|--control-preset thesis --control-attraction 30"
   "cesium|thesis|--control-preset thesis"
   "cesium|fidelity (default)|"
+  "cesium|fidelity with frictionless walls|--fluid friction=0"
 )
 echo "scene,combination,fill_mean,fill_min,iou_mean,iou_min,spray_mean,surface_p95_mean,density_in_shape_mean,speed_excess_mean,time_to_90_s,control_share,sph_ms_per_frame,switches" > "$csv"
 mkdir -p out/fidelity

@@ -529,7 +529,7 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
         ),
         (
             &["--scene", "character", "--control-pressure=-1"],
-            "--control-pressure must be positive",
+            "--control-pressure must be at least 0",
         ),
         (
             &["--scene", "drop", "--adaptive", "on"],

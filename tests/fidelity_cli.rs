@@ -98,14 +98,19 @@ fn metrics_presets_and_spacing_work_from_the_command_line() {
         (h / 0.02 - 0.0457 / (0.02f64 / 998.29).cbrt()).abs() < 1e-3,
         "h {h}"
     );
-    // The pool (0.9 x 0.6 x 0.1 m) on a lattice at the spacing.
-    let want = 0.054 / 0.02f64.powi(3);
+    // The pool ([pool]: 1.3 x the walker's volume) holds the same water at either spacing:
+    // particles x spacing cubed agree to within a lattice layer of its depth.
+    let sc = coarse["config"]["fluid"]["spacing"].as_f64().unwrap();
     assert!(
-        (n(&fine) / want - 1.0).abs() < 0.1,
-        "{} particles, pool over spacing cubed {want}",
-        n(&fine)
+        sc > 0.021,
+        "the default spacing chosen for the walker: {sc}"
     );
-    assert!(n(&fine) > 2.0 * n(&coarse));
+    let (vf, vc) = (n(&fine) * 0.02f64.powi(3), n(&coarse) * sc.powi(3));
+    assert!(
+        (vf / vc - 1.0).abs() < 0.15,
+        "pool water {vf} m^3 at spacing 0.02 against {vc} at {sc}"
+    );
+    assert!(n(&fine) > n(&coarse));
     let steps = |s: &serde_json::Value| s["stats"]["steps"].as_u64().unwrap();
     assert!(
         steps(&fine) > steps(&coarse),

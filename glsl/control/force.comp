@@ -20,7 +20,10 @@ void main() {
     vec3 f = vec3(0.0);
     vec3 vsum = vec3(0.0);
     float wsum = 0.0;
-    for (int dz = -1; dz <= 1; ++dz) for (int dy = -1; dy <= 1; ++dy) for (int dx = -1; dx <= 1; ++dx) {
+    // Eq. 7 and the velocity term walk the control particles within h_c; with both off
+    // (c_cp = K = 0) the walk is skipped.
+    int n = (C.pressure != 0.0 || C.velocity > 0.0) ? 1 : -2;
+    for (int dz = -n; dz <= n; ++dz) for (int dy = -n; dy <= n; ++dy) for (int dx = -n; dx <= n; ++dx) {
         ivec3 c = c0 + ivec3(dx, dy, dz);
         if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
         uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);

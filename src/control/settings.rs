@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 /// The control switches and their defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ControlSettings {
-    /// c_cp (eq. 7).
+    /// c_cp (eq. 7; 0: off).
     pub pressure: f32,
     /// h_c (metres).
     pub radius: f32,
@@ -31,16 +31,15 @@ pub struct ControlSettings {
 
 impl ControlSettings {
     pub fn validate(&self) -> Result<()> {
-        let pos = [
-            ("--control-pressure", self.pressure),
-            ("--control-radius", self.radius),
-        ];
-        for (k, v) in pos {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(Error::Param(format!("{k} must be positive, got {v}")));
-            }
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return Err(Error::Param(format!(
+                "--control-radius must be positive, got {}",
+                self.radius
+            )));
         }
+        // c_cp = 0 turns eq. 7 off (the force pass then skips its walk over h_c).
         let non_negative = [
+            ("--control-pressure", self.pressure),
             ("--control-velocity", self.velocity),
             ("--control-attraction", self.attraction),
             ("--control-damping", self.damping),

@@ -36,7 +36,7 @@ fn default_pressure() -> f32 {
 /// The fidelity preset's velocity term K (1/s), deficit attraction (m/s^2) and damping
 /// (1/s), chosen from the runs in results/<device>/fidelity.md.
 pub const FIDELITY_VELOCITY: f32 = 10.0;
-pub const FIDELITY_ATTRACTION: f32 = 60.0;
+pub const FIDELITY_ATTRACTION: f32 = 120.0;
 pub const FIDELITY_DAMPING: f32 = 1.0;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
