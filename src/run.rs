@@ -284,8 +284,9 @@ impl FrameWork for SphWork<'_> {
         let t0 = self.stepper.sim_time;
         self.targets
             .record_before(ctx, cmd, prof, &mut self.st, t0, frame_dt, steps)?;
+        let hooks = &mut self.targets.hooks();
         self.stepper
-            .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, slot)?;
+            .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, (slot, hooks))?;
         let t = self.stepper.sim_time;
         self.targets
             .record_after(ctx, cmd, prof, &self.st, t, (frame, slot))?;
@@ -421,7 +422,7 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
     let ctx = open(sw)?;
     scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
     let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
-    let solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
+    let mut solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
     let parts = scene.particles(sw.common.seed);
     let mut st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
     let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
@@ -442,7 +443,6 @@ fn run_sph(opts: &RunOptions, scene: crate::sph::Scene) -> Result<RunResult> {
         }
     };
     let cam = camera_with_switches(cam, sw);
-    let mut solver = solver;
     let targets = crate::scene::targets::SceneTargets::new(
         &ctx,
         &scene,

@@ -4,13 +4,12 @@
 mod common;
 use fluidform::character::Mesh;
 use fluidform::config::{Adaptive, Neighbors, Skinning};
-use fluidform::control::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
+use fluidform::control::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use fluidform::gpu::Labels;
 use fluidform::sph::hooks::SphHook;
 use fluidform::sph::scene::{Ball, Block, Domain, Scene};
 use fluidform::sph::{FluidParams, SphSolver};
 use glam::{Mat4, Vec3};
-use std::rc::Rc;
 
 fn scene() -> Scene {
     Scene {
@@ -81,22 +80,19 @@ fn poly6(r2: f64, h: f64) -> f64 {
 fn compare(settings: ControlSettings) -> (f64, f64) {
     let ctx = common::ctx();
     let sc = scene();
-    let solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
     let parts = sc.particles(1);
     let mesh = control_mesh(0.03);
-    let control = Rc::new(
-        ControlForce::new(
-            &ctx,
-            &solver,
-            &mesh,
-            1,
-            settings.clone(),
-            (sc.domain.min, sc.domain.max),
-            (None, Skinning::Lbs),
-        )
-        .unwrap(),
-    );
-    let hook = ControlHook(control.clone());
+    let mut control = ControlForce::new(
+        &ctx,
+        &solver,
+        &mesh,
+        1,
+        settings.clone(),
+        (sc.domain.min, sc.domain.max),
+        (None, Skinning::Lbs),
+    )
+    .unwrap();
     let mut st = solver.state(&ctx, &sc, &parts).unwrap();
     let joints =
         fluidform::character::pose::gpu_joints(&[Mat4::IDENTITY], Skinning::Lbs, &|_| "j".into())
@@ -116,7 +112,7 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
             solver.record_density(&ctx, cmd, &mut Labels, &st);
             solver.record_forces(&ctx, cmd, &mut Labels, &st);
             if with {
-                hook.record(&ctx, cmd, &mut Labels, &st)?;
+                control.record(&ctx, cmd, &mut Labels, &st)?;
             }
             Ok::<_, fluidform::Error>(())
         })

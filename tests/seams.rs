@@ -4,7 +4,7 @@ mod common;
 use bytemuck::{Pod, Zeroable};
 use fluidform::gpu::{ComputeDesc, ComputePipeline, Labels};
 use fluidform::particles::{AttributeDecl, LiveArgsPass, LiveCount, ParticleStore};
-use fluidform::sph::hooks::{ConstantForce, SphHook};
+use fluidform::sph::hooks::{ConstantForce, Hooks, SphHook};
 use fluidform::sph::{Scene, SphSolver};
 
 #[repr(C)]
@@ -159,17 +159,24 @@ fn constant_force_hook_moves_particles_as_gravity_would() {
     let extra = [0.0f32, 3.0, 0.0];
     let run = |scene: &Scene, hook: bool| {
         let mut solver = SphSolver::new(&ctx, fluidform::config::Neighbors::Grid, None).unwrap();
-        if hook {
-            solver.add_force(Box::new(ConstantForce::new(&ctx, extra).unwrap()));
-        }
+        let mut force = ConstantForce::new(&ctx, extra).unwrap();
         let parts = scene.particles(1);
         let mut st = solver.state(&ctx, scene, &parts).unwrap();
         for _ in 0..5 {
-            ctx.one_shot(|cmd| solver.record_step(&ctx, cmd, &mut Labels, &mut st).unwrap())
-                .unwrap();
+            let mut hooks = Hooks::none();
+            if hook {
+                hooks.force.push(&mut force);
+            }
+            ctx.one_shot(|cmd| {
+                solver
+                    .record_hooked_step(&ctx, cmd, &mut Labels, &mut st, &mut hooks)
+                    .unwrap()
+            })
+            .unwrap();
         }
         let d = st.read(&ctx).unwrap();
         st.destroy(&ctx);
+        force.destroy(&ctx);
         solver.destroy(&ctx);
         d
     };
@@ -200,7 +207,7 @@ fn constant_force_hook_moves_particles_as_gravity_would() {
 #[test]
 fn registered_attribute_survives_reorder() {
     let ctx = common::ctx();
-    let solver = SphSolver::new(&ctx, fluidform::config::Neighbors::Grid, None).unwrap();
+    let mut solver = SphSolver::new(&ctx, fluidform::config::Neighbors::Grid, None).unwrap();
     let scene = block();
     let parts = scene.particles(3);
     let mut st = solver.state(&ctx, &scene, &parts).unwrap();
@@ -226,7 +233,6 @@ fn registered_attribute_survives_reorder() {
         .upload(&ctx, fluidform::sph::solver::POS, &pos)
         .unwrap();
     st.particles.upload(&ctx, tag, &pos).unwrap();
-    let mut solver = solver;
     ctx.one_shot(|cmd| {
         solver.record_params(&ctx, cmd, &st);
         solver

@@ -110,7 +110,7 @@ fn by_tag(d: fluidform::sph::solver::StateDump) -> fluidform::sph::solver::State
 #[test]
 fn one_step_of_each_solver_matches_the_f64_reference() {
     let ctx = common::ctx();
-    let solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     // (solver, particles in a corner of the domain): DFSPH's walls act in its solves.
     let cases = SOLVERS
         .iter()
@@ -155,7 +155,6 @@ fn one_step_of_each_solver_matches_the_f64_reference() {
             "{s:?}{at}: velocities off by {ev:.3e} m/s"
         );
     }
-    let mut solver = solver;
     solver.destroy(&ctx);
     common::finish(&ctx);
 }
@@ -166,7 +165,7 @@ fn one_step_of_each_solver_matches_the_f64_reference() {
 #[test]
 fn dfsph_neighbor_lists_match_the_grid_search() {
     let ctx = common::ctx();
-    let solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     let mut runs = Vec::new();
     for list in [0u32, 4, 96] {
         let f = FluidParams {
@@ -209,7 +208,6 @@ fn dfsph_neighbor_lists_match_the_grid_search() {
             _ => assert_eq!(*overflows, 0, "a list of {list} overflowed"),
         }
     }
-    let mut solver = solver;
     solver.destroy(&ctx);
     common::finish(&ctx);
 }
@@ -217,7 +215,7 @@ fn dfsph_neighbor_lists_match_the_grid_search() {
 #[test]
 fn momentum_is_conserved_without_walls() {
     let ctx = common::ctx();
-    let solver = SphSolver::new(&ctx, Neighbors::Hash, Some(SortAlgo::Bitonic)).unwrap();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Hash, Some(SortAlgo::Bitonic)).unwrap();
     for s in SOLVERS {
         // Pair-symmetric terms only: no gravity, viscosity (its m / rho_j weights), surface
         // tension or vorticity confinement (an external force by design).
@@ -268,7 +266,6 @@ fn momentum_is_conserved_without_walls() {
             "{s:?}: momentum drifted by {drift:.3e}"
         );
     }
-    let mut solver = solver;
     solver.destroy(&ctx);
     common::finish(&ctx);
 }
@@ -281,7 +278,7 @@ fn momentum_is_conserved_without_walls() {
 #[test]
 fn a_resting_pool_stays_at_rest_under_the_target() {
     let ctx = common::ctx();
-    let solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     let mut bad = Vec::new();
     for s in SOLVERS {
         let f = FluidParams {
@@ -352,7 +349,6 @@ fn a_resting_pool_stays_at_rest_under_the_target() {
         }
     }
     assert!(bad.is_empty(), "pools not at rest: {bad:?}");
-    let mut solver = solver;
     solver.destroy(&ctx);
     common::finish(&ctx);
 }

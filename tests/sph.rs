@@ -59,7 +59,7 @@ fn random_particles(scene: &Scene, n: usize, seed: u64) -> Particles {
 
 /// One arrange + density + forces on the GPU; compare with the reference on the same
 /// (sorted) particles. Returns the largest relative errors (density, acceleration).
-fn compare(ctx: &Context, solver: &SphSolver, scene: &Scene, parts: &Particles) -> (f64, f64) {
+fn compare(ctx: &Context, solver: &mut SphSolver, scene: &Scene, parts: &Particles) -> (f64, f64) {
     let mut st = solver.state(ctx, scene, parts).unwrap();
     ctx.one_shot(|cmd| {
         solver.record_params(ctx, cmd, &st);
@@ -114,7 +114,7 @@ fn gpu_density_and_acceleration_match_f64_reference() {
             let lattice = scene.particles(3);
             let random = random_particles(&scene, 1500, 9);
             for (kind, parts) in [("lattice", &lattice), ("random", &random)] {
-                let (e_rho, e_a) = compare(&ctx, &solver, &scene, parts);
+                let (e_rho, e_a) = compare(&ctx, &mut solver, &scene, parts);
                 assert!(
                     e_rho < 1e-3,
                     "{strategy:?}/{sort:?} {what} {kind}: density error {e_rho:e}"

@@ -66,12 +66,11 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let mut scene = scene(n);
             scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
             let parts = scene.particles(sw.common.seed);
-            // A solver per N: the emitter hooks into it.
             let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
             let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
             let mut targets = Guard::new(
                 ctx,
-                SceneTargets::new(ctx, &scene, sw, &mut solver, &mut st, &parts.pos, 1)?,
+                SceneTargets::new(ctx, &scene, sw, &solver, &mut st, &parts.pos, 1)?,
             );
             let actual = st.n as u64;
             let dt = st.dt;
@@ -95,7 +94,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 |prof, cmd| {
                     prof.begin(ctx, cmd, "frame");
                     targets.record_before(ctx, cmd, prof, &mut st, t, dt, 1)?;
-                    solver.record_step(ctx, cmd, prof, &mut st)?;
+                    solver.record_hooked_step(ctx, cmd, prof, &mut st, &mut targets.hooks())?;
                     prof.end(ctx, cmd);
                     t += dt as f64;
                     Ok(())

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
 use crate::report::stat;
 use crate::sph::errors::DensityErrorStats;
+use crate::sph::hooks::Hooks;
 use crate::sph::params::{Eos, FluidParams};
 use crate::sph::run::Stepper;
 use crate::sph::{Scene, SphSolver, SphState};
@@ -132,8 +133,14 @@ impl FrameWork for Play<'_> {
         _frame: u64,
         slot: usize,
     ) -> Result<()> {
-        self.stepper
-            .record_frame(ctx, cmd, prof, self.solver, self.st, slot)
+        self.stepper.record_frame(
+            ctx,
+            cmd,
+            prof,
+            self.solver,
+            self.st,
+            (slot, &mut Hooks::none()),
+        )
     }
     fn retire(&mut self, _ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         self.stepper.retire_slot(slot, frame)
@@ -144,7 +151,7 @@ impl FrameWork for Play<'_> {
 /// unstable run is an outcome (the row says so), not an error.
 pub fn play(
     ctx: &Context,
-    solver: &SphSolver,
+    solver: &mut SphSolver,
     scene: &Scene,
     opts: &BenchOptions,
     label: &str,
@@ -252,7 +259,7 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             crate::config::SortAlgo::Counting,
         )],
     )[0];
-    let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
+    let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
     let counts = super::counts_or(opts, COUNTS);
     let mut rows = Vec::new();
     let mut points = Vec::new();
@@ -271,7 +278,7 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 ..scene.clone()
             };
             let label = format!("{} n={n} {}", f.solver.as_str(), setting(f));
-            let o = play(ctx, &solver, &sc, opts, &label)?;
+            let o = play(ctx, &mut solver, &sc, opts, &label)?;
             eprintln!(
                 "{label}: {} steps, {:.3} ms/step, {:.4} sim s per GPU s, {:.1} + {:.1} iterations, error mean {:.3}% max {:.2}%{}",
                 o.steps,

@@ -38,7 +38,7 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         ],
     ) {
         // Guards release the solver and state on every path, an early `?` included.
-        let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
+        let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
         for n in counts(opts) {
             let scene = base.with_particles(n);
             let parts = scene.particles(opts.switches.common.seed);
@@ -130,7 +130,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             (Neighbors::Morton, SortAlgo::OddEven),
         ],
     )[0];
-    let solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
+    let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
     let parts = scene.particles(opts.switches.common.seed);
     let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
     let st_n = st.n as usize;

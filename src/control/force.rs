@@ -17,8 +17,6 @@ use crate::sph::hooks::SphHook;
 use crate::sph::solver::SphState;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use std::cell::{Cell, RefCell};
-use std::rc::Rc;
 
 crate::gpu_interface! {
     /// glsl/control/common.glsl: the SPH bindings, then the control set's.
@@ -126,15 +124,16 @@ impl ControlGpu {
     }
 }
 
-/// The control force: shared by the solver's hook and the scene that feeds it poses.
+/// The control force: owned by the scene, which feeds it poses and lends it to the
+/// frame's steps as a force hook.
 pub struct ControlForce {
-    gpu: RefCell<Option<ControlGpu>>,
-    pending: RefCell<Option<Pose>>,
+    gpu: ControlGpu,
+    pending: Option<Pose>,
     /// No pose recorded yet: the first one is also the previous (zero velocity).
-    first: RefCell<bool>,
+    first: bool,
     /// Attached (the hook records nothing while released) and the factor on c_cp.
-    attached: Cell<bool>,
-    strength: Cell<f32>,
+    attached: bool,
+    strength: f32,
     pub settings: ControlSettings,
     /// Control particles.
     pub m: u32,
@@ -234,7 +233,7 @@ impl ControlForce {
             std::mem::size_of::<ControlGpuParams>() as u64,
         )?;
         Ok(Self {
-            gpu: RefCell::new(Some(ControlGpu {
+            gpu: ControlGpu {
                 density: density.take(),
                 aggregate: aggregate.take(),
                 field: field.take(),
@@ -253,36 +252,36 @@ impl ControlForce {
                 cfield: cfield.take(),
                 params: params.take(),
                 rays: rays.map(|r| r.take()),
-            })),
-            pending: RefCell::new(None),
-            first: RefCell::new(true),
-            attached: Cell::new(true),
-            strength: Cell::new(1.0),
+            },
+            pending: None,
+            first: true,
+            attached: true,
+            strength: 1.0,
             settings,
             m: m as u32,
         })
     }
 
     /// The pose the next step uses (once per frame).
-    pub fn set_pose(&self, pose: Pose) {
-        *self.pending.borrow_mut() = Some(pose);
+    pub fn set_pose(&mut self, pose: Pose) {
+        self.pending = Some(pose);
     }
 
     /// Attach or release (a released set records no passes; when attached again its
     /// first pose has zero velocity) at `strength` times c_cp, from the next pose on.
-    pub fn set_attached(&self, attached: bool, strength: f32) {
-        if attached && !self.attached.get() {
-            *self.first.borrow_mut() = true;
+    pub fn set_attached(&mut self, attached: bool, strength: f32) {
+        if attached && !self.attached {
+            self.first = true;
         }
         if !attached {
-            self.pending.borrow_mut().take();
+            self.pending = None;
         }
-        self.attached.set(attached);
-        self.strength.set(strength);
+        self.attached = attached;
+        self.strength = strength;
     }
 
     pub fn attached(&self) -> bool {
-        self.attached.get()
+        self.attached
     }
 
     /// `ahead`: the previous-pose buffer holds the pose a frame ahead (skin motion), so
@@ -298,7 +297,7 @@ impl ControlForce {
                 g.grid.cell,
             ],
             dims: [g.grid.dims[0], g.grid.dims[1], g.grid.dims[2], self.m],
-            pressure: s.pressure * self.strength.get(),
+            pressure: s.pressure * self.strength,
             radius: h,
             spiky_grad: -45.0 / (std::f32::consts::PI * h.powi(6)),
             velocity: s.velocity,
@@ -321,17 +320,18 @@ impl ControlForce {
         }
     }
 
-    /// Skin to the pending pose, bin, and sort the control set (once per frame).
+    /// Skin to `pose`, bin, and sort the control set (once per frame); `first`: the
+    /// first pose since attached (it is its own previous pose).
     fn record_pose(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
-        g: &ControlGpu,
         pose: &Pose,
+        first: bool,
     ) -> Result<()> {
+        let g = &self.gpu;
         let bytes = self.m as u64 * 16;
-        let first = std::mem::replace(&mut *self.first.borrow_mut(), false);
         // (Rays: the surface is skinned, not the particles; they have no other pose.)
         let ahead = pose.next.as_ref().filter(|_| g.rays.is_none());
         scopes.begin(ctx, cmd, "skin");
@@ -449,10 +449,7 @@ impl ControlForce {
     /// Fluid density at the control particles of the last step (sorted by the control
     /// grid), read after the frame's fence.
     pub fn densities(&self, ctx: &Context) -> Result<Vec<f32>> {
-        match &*self.gpu.borrow() {
-            Some(g) => ctx.readback(&g.crho, 0, self.m as usize),
-            None => Err(Error::Param("the control set is destroyed".into())),
-        }
+        ctx.readback(&self.gpu.crho, 0, self.m as usize)
     }
 
     /// Record copies of the control densities into `crho` and of the counts into
@@ -466,72 +463,59 @@ impl ControlForce {
         crho: &Buffer,
         counts: &Buffer,
     ) -> Result<()> {
-        match &*self.gpu.borrow() {
-            Some(g) => {
-                ctx.copy(cmd, &g.crho, 0, crho, 0, self.m as u64 * 4);
-                ctx.copy(cmd, &g.params, LIVE_OFFSET, counts, 0, 4);
-                if let Some(r) = &g.rays {
-                    ctx.copy(cmd, &r.stats, 0, counts, 4, 8);
-                }
-                Ok(())
-            }
-            None => Err(Error::Param("the control set is destroyed".into())),
+        let g = &self.gpu;
+        ctx.copy(cmd, &g.crho, 0, crho, 0, self.m as u64 * 4);
+        ctx.copy(cmd, &g.params, LIVE_OFFSET, counts, 0, 4);
+        if let Some(r) = &g.rays {
+            ctx.copy(cmd, &r.stats, 0, counts, 4, 8);
         }
+        Ok(())
     }
 
     /// The live control particles of a frame's counts (see `record_copy_readback`), or
     /// the rays placement's overflow.
     pub fn check_counts(&self, counts: [u32; 4]) -> Result<u32> {
-        if let Some(r) = &*self.gpu.borrow() {
-            if let Some(r) = &r.rays {
-                r.check(counts[1], counts[2])?;
-            }
+        if let Some(r) = &self.gpu.rays {
+            r.check(counts[1], counts[2])?;
         }
         Ok(counts[0].min(self.m))
     }
 
     /// Re-placed every frame (`--placement rays`).
     pub fn replaced(&self) -> bool {
-        matches!(&*self.gpu.borrow(), Some(g) if g.rays.is_some())
+        self.gpu.rays.is_some()
     }
 
-    pub fn destroy(&self, ctx: &Context) {
-        if let Some(mut g) = self.gpu.borrow_mut().take() {
-            g.destroy(ctx);
-        }
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.gpu.destroy(ctx);
     }
 }
 
-/// The solver's handle on a shared control force.
-pub struct ControlHook(pub Rc<ControlForce>);
-
-impl SphHook for ControlHook {
+/// The control force as a force hook of the SPH step (scope `sph/control`).
+impl SphHook for ControlForce {
     fn name(&self) -> &str {
         "control"
     }
 
     fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
     ) -> Result<()> {
-        let c = &self.0;
-        if !c.attached.get() {
+        if !self.attached {
             return Ok(());
         }
-        let gpu = c.gpu.borrow();
-        let g = gpu
-            .as_ref()
-            .ok_or_else(|| Error::Param("the control set is destroyed".into()))?;
-        if let Some(pose) = c.pending.borrow_mut().take() {
-            c.record_pose(ctx, cmd, scopes, g, &pose)?;
-        } else if *c.first.borrow() {
+        if let Some(pose) = self.pending.take() {
+            let first = std::mem::replace(&mut self.first, false);
+            self.record_pose(ctx, cmd, scopes, &pose, first)?;
+        } else if self.first {
             return Err(Error::Param(
                 "control particles stepped before their first pose".into(),
             ));
         }
+        let (c, g) = (&*self, &self.gpu);
         let push = st.neighbor_push();
         let bufs = c.bufs(g, st);
         scopes.begin(ctx, cmd, "control-density");
@@ -556,6 +540,6 @@ impl SphHook for ControlHook {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        self.0.destroy(ctx);
+        ControlForce::destroy(self, ctx);
     }
 }

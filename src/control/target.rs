@@ -2,7 +2,7 @@
 //! control particles placed and bound in the rest pose, and each frame's pose for them
 //! (joint matrices relative to the rest pose, so bound particles follow the animation).
 use super::binding;
-use super::force::{ControlForce, ControlHook, ControlSettings, Pose, ALL_GROUPS};
+use super::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
 use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
 use crate::config::{
@@ -12,7 +12,6 @@ use crate::error::{Error, Result};
 use crate::gpu::Context;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
-use std::rc::Rc;
 
 fn random() -> Placement {
     Placement::Random
@@ -221,9 +220,9 @@ pub struct TargetDesc {
     pub control: ControlDesc,
 }
 
-/// Control particles of a placed character, driving the fluid through the solver's hook.
+/// Control particles of a placed character, driving the fluid as a hook lent to the steps.
 pub struct ControlTarget {
-    pub force: Rc<ControlForce>,
+    pub force: ControlForce,
     pub desc: ControlDesc,
     /// Placed rest-pose joint matrices (the bind of the control particles).
     rest_inv: Vec<Mat4>,
@@ -232,12 +231,12 @@ pub struct ControlTarget {
 }
 
 impl ControlTarget {
-    /// Place and bind control particles in `ch` (posed by `anim`) and hook the force into
+    /// Place and bind control particles in `ch` (posed by `anim`) for fluid searched by
     /// `solver`.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
-        solver: &mut crate::sph::SphSolver,
+        solver: &crate::sph::SphSolver,
         ch: &Character,
         anim: &Animator,
         desc: &ControlDesc,
@@ -308,7 +307,7 @@ impl ControlTarget {
             })
             .collect::<Result<Vec<_>>>()?;
         let settings = desc.settings(fluid);
-        let force = Rc::new(ControlForce::new(
+        let force = ControlForce::new(
             ctx,
             solver,
             &mesh,
@@ -316,8 +315,7 @@ impl ControlTarget {
             settings,
             domain,
             (None, skinning),
-        )?);
-        solver.add_force(Box::new(ControlHook(force.clone())));
+        )?;
         Ok(Self {
             force,
             desc: desc.clone(),
@@ -332,7 +330,7 @@ impl ControlTarget {
     #[allow(clippy::too_many_arguments)]
     fn rays(
         ctx: &Context,
-        solver: &mut crate::sph::SphSolver,
+        solver: &crate::sph::SphSolver,
         ch: &Character,
         desc: &ControlDesc,
         fluid: &crate::sph::FluidParams,
@@ -341,7 +339,7 @@ impl ControlTarget {
         skinning: Skinning,
     ) -> Result<Self> {
         let capacity = (3 * rest + 1024).min(u32::MAX as usize / 16) as u32;
-        let force = Rc::new(ControlForce::new(
+        let force = ControlForce::new(
             ctx,
             solver,
             &ch.mesh,
@@ -349,8 +347,7 @@ impl ControlTarget {
             desc.settings(fluid),
             domain,
             (Some((spacing, capacity)), skinning),
-        )?);
-        solver.add_force(Box::new(ControlHook(force.clone())));
+        )?;
         Ok(Self {
             force,
             desc: desc.clone(),
@@ -363,7 +360,7 @@ impl ControlTarget {
     /// frame's steps, `frame_dt` seconds after the previous pose; `next`: the pose a frame
     /// ahead (`--control-motion skin`).
     pub fn set_pose(
-        &self,
+        &mut self,
         ch: &Character,
         mats: &[Mat4],
         next: Option<&[Mat4]>,

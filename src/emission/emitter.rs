@@ -15,8 +15,6 @@ use crate::sph::hooks::SphHook;
 use crate::sph::params::SphGpuParams;
 use crate::sph::SphState;
 use ash::vk;
-use std::cell::Cell;
-use std::rc::Weak;
 
 /// The vertex emitter's source: the skinned positions of this frame and the last.
 pub struct VertexSource {
@@ -24,7 +22,7 @@ pub struct VertexSource {
     /// 0 .. vertices (every vertex is a source).
     pub valid: Buffer,
     pub vertices: u32,
-    current: Cell<usize>,
+    current: usize,
 }
 
 #[allow(clippy::large_enum_variant)] // one per scene
@@ -62,7 +60,7 @@ impl EmitSource {
                     pos: [p0.take(), p1.take()],
                     valid: valid.take(),
                     vertices: n as u32,
-                    current: Cell::new(0),
+                    current: 0,
                 })
             }
         })
@@ -94,7 +92,7 @@ impl EmitSource {
     /// Take the skinned surface (`verts`, visible to vertex shaders, compute and copies)
     /// as the current frame; the current one becomes the previous.
     pub fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
@@ -103,7 +101,7 @@ impl EmitSource {
         match self {
             EmitSource::Uv(uv, _) => uv.record(ctx, cmd, scopes, verts),
             EmitSource::Vertices(v) => {
-                let next = 1 - v.current.get();
+                let next = 1 - v.current;
                 scopes.begin(ctx, cmd, "vertices");
                 // The skinned vertices -> the copy; earlier emits' reads -> its write.
                 ctx.barrier(
@@ -114,7 +112,7 @@ impl EmitSource {
                 ctx.copy(cmd, verts, 0, &v.pos[next], 0, v.vertices as u64 * 16);
                 ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
                 scopes.end(ctx, cmd);
-                v.current.set(next);
+                v.current = next;
                 Ok(())
             }
         }
@@ -128,7 +126,7 @@ impl EmitSource {
                 (&uv.pos[c], &uv.pos[1 - c], &uv.valid)
             }
             EmitSource::Vertices(v) => {
-                let c = v.current.get();
+                let c = v.current;
                 (&v.pos[c], &v.pos[1 - c], &v.valid)
             }
         }
@@ -164,12 +162,12 @@ pub struct Emitter {
     pub settings: EmitSettings,
     life: AttrId,
     seed: u64,
-    step: Cell<u64>,
+    step: u64,
     /// Fractional births carried to the next step (a rate limit).
-    carry: Cell<f64>,
+    carry: f64,
     /// (this step within the frame, steps in the frame).
-    substep: Cell<(u32, u32)>,
-    frame_dt: Cell<f32>,
+    substep: (u32, u32),
+    frame_dt: f32,
 }
 
 impl Emitter {
@@ -211,46 +209,52 @@ impl Emitter {
             settings,
             life,
             seed,
-            step: Cell::new(0),
-            carry: Cell::new(0.0),
-            substep: Cell::new((0, 1)),
-            frame_dt: Cell::new(0.0),
+            step: 0,
+            carry: 0.0,
+            substep: (0, 1),
+            frame_dt: 0.0,
         })
     }
 
     /// Before a frame of `steps` steps over `frame_dt` seconds (after the source took the
     /// frame's surface).
-    pub fn begin_frame(&self, steps: u32, frame_dt: f32) {
-        self.substep.set((0, steps.max(1)));
-        self.frame_dt.set(frame_dt);
+    pub fn begin_frame(&mut self, steps: u32, frame_dt: f32) {
+        self.substep = (0, steps.max(1));
+        self.frame_dt = frame_dt;
     }
 
     /// This step's budget: every due slot (Algorithm 1) or the rate's share.
-    fn budget(&self, dt: f32) -> u32 {
+    fn budget(&mut self, dt: f32) -> u32 {
         match self.settings.rate {
             None => u32::MAX,
             Some(r) => {
-                let want = r as f64 * dt as f64 + self.carry.get();
+                let want = r as f64 * dt as f64 + self.carry;
                 let whole = want.floor();
-                self.carry.set(want - whole);
+                self.carry = want - whole;
                 whole.min(u32::MAX as f64) as u32
             }
         }
     }
 
     /// Record one step's births and copy the alive count into the step's parameters.
-    pub fn record_step(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) -> Result<()> {
-        let step = self.step.get();
-        self.step.set(step + 1);
-        let (k, steps) = self.substep.get();
-        self.substep.set((k + 1, steps));
-        let frame_dt = self.frame_dt.get();
+    pub fn record_step(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        st: &SphState,
+    ) -> Result<()> {
+        let step = self.step;
+        self.step += 1;
+        let (k, steps) = self.substep;
+        self.substep = (k + 1, steps);
+        let frame_dt = self.frame_dt;
+        let budget = self.budget(st.dt);
         let s = &self.settings;
         let mixed = (self.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15)) as u32;
         let p = EmitGpuParams {
             n: st.n,
             sources: self.source.sources(),
-            budget: self.budget(st.dt),
+            budget,
             seed: mixed ^ (step >> 32) as u32,
             limit: s.limit,
             dt: st.dt,
@@ -302,27 +306,24 @@ impl Emitter {
     }
 }
 
-/// The emitter as the SPH step's pre-arrange hook (scope `sph/emit`); the scene owns it.
-pub struct EmitHook(pub Weak<Emitter>);
-
-impl SphHook for EmitHook {
+/// The emitter is the SPH step's pre-arrange hook (scope `sph/emit`); the scene owns it
+/// and lends it to each frame's steps.
+impl SphHook for Emitter {
     fn name(&self) -> &str {
         EmitPass::NAME
     }
 
     fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         _: &mut dyn Scopes,
         st: &SphState,
     ) -> Result<()> {
-        let e = self
-            .0
-            .upgrade()
-            .ok_or_else(|| Error::Param("the emitter is destroyed".into()))?;
-        e.record_step(ctx, cmd, st)
+        self.record_step(ctx, cmd, st)
     }
 
-    fn destroy(&mut self, _: &Context) {}
+    fn destroy(&mut self, ctx: &Context) {
+        Emitter::destroy(self, ctx);
+    }
 }

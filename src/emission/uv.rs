@@ -53,7 +53,7 @@ pub struct UvSurface {
     pub valid: Buffer,
     pub valid_count: u32,
     pub size: [u32; 2],
-    current: std::cell::Cell<usize>,
+    current: usize,
     push: UvPush,
     /// Per part: (atlas rect, first layout triangle, triangles).
     parts: Vec<([f32; 4], u32, u32)>,
@@ -136,7 +136,7 @@ impl UvSurface {
                 valid: valid.take(),
                 valid_count: 0,
                 size,
-                current: std::cell::Cell::new(0),
+                current: 0,
                 push: UvPush {
                     atlas: [1.0, 1.0, 0.0, 0.0],
                     size: [size[0], size[1], texels as u32, 0],
@@ -178,7 +178,7 @@ impl UvSurface {
 
     /// Index into `pos` of the latest frame's positions.
     pub fn current(&self) -> usize {
-        self.current.get()
+        self.current
     }
 
     fn bufs<'a>(&'a self, verts: &'a Buffer, pos: &'a Buffer) -> UvBufs<'a> {
@@ -197,13 +197,13 @@ impl UvSurface {
     /// visible to vertex shaders by the caller) into the next position buffer, which
     /// becomes the current one.
     pub fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         verts: &Buffer,
     ) -> Result<()> {
-        let next = 1 - self.current.get();
+        let next = 1 - self.current;
         scopes.begin(ctx, cmd, Self::NAME);
         ctx.barrier(
             cmd,
@@ -224,7 +224,7 @@ impl UvSurface {
             sync::COMPUTE_READ | sync::TRANSFER_READ,
         );
         scopes.end(ctx, cmd);
-        self.current.set(next);
+        self.current = next;
         Ok(())
     }
 
@@ -253,7 +253,7 @@ impl UvSurface {
     /// List the covered texels of the current positions (flags, scan, compaction).
     fn record_compact(&self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
         let texels = self.push.size[2] as u64;
-        let (v, i) = (&self.pos[self.current.get()], &self.uvs);
+        let (v, i) = (&self.pos[self.current], &self.uvs);
         // (The vertex buffer is not read by the compute passes.)
         let bufs = self.bufs(i, v);
         self.flags_pass

@@ -12,7 +12,6 @@ use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, Context, MemoryLocation};
 use ash::vk;
 use serde::{Deserialize, Serialize};
-use std::rc::Rc;
 
 fn yes() -> bool {
     true
@@ -366,10 +365,10 @@ impl EmissionMetrics {
 }
 crate::impl_destroy!(EmissionMetrics);
 
-/// The emitter shared with the solver's hook, its metrics, and which character sheds.
+/// The emitter (lent to the solver's steps as a hook), its metrics, and which character
+/// sheds.
 pub struct SceneEmission {
-    /// The only strong reference (the solver's hook holds a weak one); None once destroyed.
-    pub emitter: Option<Rc<Emitter>>,
+    pub emitter: Emitter,
     pub metrics: EmissionMetrics,
     /// Index of the emitting character in the scene's characters.
     pub character: usize,
@@ -379,15 +378,9 @@ pub struct SceneEmission {
 }
 
 impl SceneEmission {
-    pub fn emitter(&self) -> &Emitter {
-        self.emitter.as_ref().expect("a live emitter")
-    }
-
     pub fn destroy(&mut self, ctx: &Context) {
         self.metrics.destroy(ctx);
-        if let Some(Ok(mut e)) = self.emitter.take().map(Rc::try_unwrap) {
-            e.destroy(ctx);
-        }
+        self.emitter.destroy(ctx);
     }
 }
 crate::impl_destroy!(SceneEmission);

@@ -9,18 +9,18 @@ use crate::config::{ControlMotion, ShowMesh, Skinning, Switches};
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
-use crate::emission::emitter::{EmitHook, EmitSource, Emitter};
+use crate::emission::emitter::{EmitSource, Emitter};
 use crate::emission::layout::UvLayout;
 use crate::error::Result;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
+use crate::sph::hooks::Hooks;
 use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::scene::MAIN_TARGET;
 use crate::sph::{Scene, SphSolver, SphState};
 use ash::vk;
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
-use std::rc::Rc;
 
 /// `stats.control` of summary.json: each control target's metrics and the fired events.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -66,12 +66,12 @@ pub struct SceneTargets {
 
 impl SceneTargets {
     /// Load, place and bind every character and target of `scene` (errors before the
-    /// first frame), hooking each control target into `solver`.
+    /// first frame); each control target searches the fluid the way `solver` does.
     pub fn new(
         ctx: &Context,
         scene: &Scene,
         sw: &Switches,
-        solver: &mut SphSolver,
+        solver: &SphSolver,
         st: &mut SphState,
         initial: &[[f32; 4]],
         slots: usize,
@@ -162,21 +162,19 @@ impl SceneTargets {
             };
             let metrics = Guard::new(ctx, EmissionMetrics::new(ctx, slots)?);
             let source = EmitSource::new(ctx, kind, layout, &ch.mesh.positions, size)?;
-            let emitter = Rc::new(Emitter::new(
+            let emitter = Emitter::new(
                 ctx,
                 st,
                 initial,
                 source,
                 (settings, desc.recycle),
                 sw.common.seed,
-            )?);
-            // Hooked last: no error path leaves the solver a hook without its emitter.
-            solver.add_pre_arrange(Box::new(EmitHook(Rc::downgrade(&emitter))));
+            )?;
             if desc.collide {
                 out.capsules = caps;
             }
             out.emission = Some(SceneEmission {
-                emitter: Some(emitter),
+                emitter,
                 metrics: metrics.take(),
                 character: 0,
                 slots: desc.slots,
@@ -186,7 +184,7 @@ impl SceneTargets {
         let mut t = out.take();
         t.fading = vec![None; t.controlled.len()];
         for (k, &i) in t.controlled.iter().enumerate() {
-            let (c, _) = t.live[i].control.as_ref().expect("a control target");
+            let (c, _) = t.live[i].control.as_mut().expect("a control target");
             c.force
                 .set_attached(t.timeline.attached(k), t.timeline.strength(k));
         }
@@ -207,7 +205,7 @@ impl SceneTargets {
             for (k, attached, strength) in changes {
                 let (c, _) = self.live[self.controlled[k]]
                     .control
-                    .as_ref()
+                    .as_mut()
                     .expect("control");
                 match attached {
                     true => {
@@ -231,7 +229,7 @@ impl SceneTargets {
             let Some((t0, s0, d)) = *f else { continue };
             let (c, _) = self.live[self.controlled[k]]
                 .control
-                .as_ref()
+                .as_mut()
                 .expect("control");
             let left = match d > 0.0 {
                 true => 1.0 - (t - t0) as f32 / d,
@@ -246,7 +244,7 @@ impl SceneTargets {
         }
         for l in &mut self.live {
             l.poses[slot] = None;
-            let Some((c, _)) = l.control.as_ref().filter(|(c, _)| c.force.attached()) else {
+            let Some((c, _)) = l.control.as_mut().filter(|(c, _)| c.force.attached()) else {
                 continue;
             };
             let ch = &l.character;
@@ -280,7 +278,7 @@ impl SceneTargets {
         let ch = &self.live[e.character].character;
         let end = t + frame_dt as f64;
         prof.begin(ctx, cmd, "emission");
-        let emitter = e.emitter.as_deref().expect("a live emitter");
+        let emitter = &mut e.emitter;
         let times: &[f64] = match e.primed {
             true => &[end],
             false => &[t, end],
@@ -326,8 +324,7 @@ impl SceneTargets {
     ) -> Result<()> {
         let emitting = self.emission.as_ref().map(|e| e.character);
         if let Some(e) = &mut self.emission {
-            let emitter = e.emitter.as_deref().expect("a live emitter");
-            e.metrics.record(ctx, cmd, emitter, slot, frame, t);
+            e.metrics.record(ctx, cmd, &e.emitter, slot, frame, t);
         }
         for (i, l) in self.live.iter().enumerate() {
             if let (Some((c, m)), Some(_)) = (&l.control, &l.poses[slot]) {
@@ -458,15 +455,29 @@ impl SceneTargets {
             return Ok(None);
         };
         let mesh = &self.live[e.character].character.ch.mesh;
-        let emitter = e.emitter.as_deref().expect("a live emitter");
         e.metrics
-            .finish(ctx, emitter, mesh, (e.slots, seconds), out)
+            .finish(ctx, &e.emitter, mesh, (e.slots, seconds), out)
             .map(Some)
     }
 
     /// The emitter (tests and benches read its slots).
     pub fn emitter(&self) -> Option<&Emitter> {
-        self.emission.as_ref().map(|e| e.emitter())
+        self.emission.as_ref().map(|e| &e.emitter)
+    }
+
+    /// The frame's hooks into the SPH step, lent for its steps: the emitter before
+    /// arrange, each control target's force after the forces pass (in target order).
+    pub fn hooks(&mut self) -> Hooks<'_> {
+        let mut h = Hooks::default();
+        if let Some(e) = &mut self.emission {
+            h.pre_arrange.push(&mut e.emitter);
+        }
+        for l in &mut self.live {
+            if let Some((c, _)) = &mut l.control {
+                h.force.push(&mut c.force);
+            }
+        }
+        h
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -474,8 +485,9 @@ impl SceneTargets {
             e.destroy(ctx);
         }
         for l in &mut self.live {
-            if let Some((_, m)) = &mut l.control {
+            if let Some((c, m)) = &mut l.control {
                 m.destroy(ctx);
+                c.force.destroy(ctx);
             }
             l.character.destroy(ctx);
         }

@@ -1,6 +1,7 @@
 //! Named hooks into the SPH step: extra force terms (between forces and integrate; they add
 //! into `acc`) and extra per-particle passes (before arrange). A hook is its own module
-//! with its GLSL beside it; `SphSolver::add_force` / `add_pre_arrange` register it.
+//! with its GLSL beside it; whoever owns it (the scene: emitter, control targets) lends it
+//! to each step's recording in [`Hooks`], so it keeps its own state with `&mut self`.
 use super::solver::SphState;
 use crate::error::Result;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
@@ -13,13 +14,29 @@ pub trait SphHook {
     /// Record the hook's passes for the state's `n` particles (sub-scopes in `scopes`);
     /// the solver orders them after the previous pass and before the next.
     fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn crate::gpu::Scopes,
         st: &SphState,
     ) -> Result<()>;
     fn destroy(&mut self, ctx: &Context);
+}
+
+/// The hooks lent to one step's recording, each list in its order.
+#[derive(Default)]
+pub struct Hooks<'a> {
+    /// Per-particle passes run at the start of the step, before arrange (emission).
+    pub pre_arrange: Vec<&'a mut dyn SphHook>,
+    /// Extra force terms, run after the forces pass (they add into `acc`).
+    pub force: Vec<&'a mut dyn SphHook>,
+}
+
+impl Hooks<'_> {
+    /// No hooks: the plain step.
+    pub fn none() -> Self {
+        Self::default()
+    }
 }
 
 #[repr(C)]
@@ -81,7 +98,7 @@ impl SphHook for ConstantForce {
     }
 
     fn record(
-        &self,
+        &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         _: &mut dyn crate::gpu::Scopes,

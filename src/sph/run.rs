@@ -74,7 +74,8 @@ impl Stepper {
         }
     }
 
-    /// Record one frame of steps and the state's health for this slot.
+    /// Record one frame of steps (with the frame's `hooks`) and the state's health for
+    /// this slot.
     pub fn record_frame(
         &mut self,
         ctx: &Context,
@@ -82,14 +83,14 @@ impl Stepper {
         prof: &mut Profiler,
         solver: &SphSolver,
         st: &mut SphState,
-        slot: usize,
+        (slot, hooks): (usize, &mut super::hooks::Hooks),
     ) -> Result<()> {
         let (steps, dt) = self.plan(st);
         st.dt = dt;
         st.iteration_bound = self.bound;
         self.pending[slot] = (steps, self.sim_time, self.bound);
         for k in 0..steps {
-            solver.record_step(ctx, cmd, prof, st)?;
+            solver.record_hooked_step(ctx, cmd, prof, st, hooks)?;
             prof.begin(ctx, cmd, StepErrors::NAME);
             self.errors.record(ctx, cmd, st, slot, k)?;
             prof.end(ctx, cmd);

@@ -3,7 +3,7 @@
 //! Every pass a compute shader. Particle state is a registry (particles.rs): a hook adds
 //! its own attribute with one `register` call and its pass with `add_force` or
 //! `add_pre_arrange` (hooks.rs).
-use super::hooks::SphHook;
+use super::hooks::{Hooks, SphHook};
 use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
 use super::pressure::{PressureBuffers, PressurePasses};
 use super::scene::{Particles, Scene};
@@ -88,12 +88,8 @@ pub struct SphSolver {
     density: ComputePipeline<SphIo>,
     forces: ComputePipeline<SphIo>,
     integrate: ComputePipeline<SphIo>,
-    /// Extra force terms, between forces and integrate (control particles).
-    force_hooks: Vec<Box<dyn SphHook>>,
-    /// Extra per-particle passes before arrange (emission, skinning).
-    pre_arrange: Vec<Box<dyn SphHook>>,
     /// The incompressible solvers' passes, built by `state` for the scene's solver.
-    pressure: std::cell::RefCell<Vec<PressurePasses>>,
+    pressure: Vec<PressurePasses>,
     /// The neighbour search's and the EOS's defines (for those passes).
     defines: Vec<(String, String)>,
 }
@@ -274,35 +270,28 @@ impl SphSolver {
             integrate: integrate.take(),
             gather,
             search: search.take(),
-            force_hooks: Vec::new(),
-            pre_arrange: Vec::new(),
-            pressure: Default::default(),
+            pressure: Vec::new(),
             defines,
         })
     }
 
     /// Build the passes of `solver` (once).
-    fn prepare(&self, ctx: &Context, solver: Solver) -> Result<()> {
-        if solver == Solver::Wcsph || self.pressure.borrow().iter().any(|p| p.solver == solver) {
+    pub fn prepare(&mut self, ctx: &Context, solver: Solver) -> Result<()> {
+        if solver == Solver::Wcsph || self.pressure.iter().any(|p| p.solver == solver) {
             return Ok(());
         }
         let p = PressurePasses::new(ctx, solver, &crate::gpu::pipeline::as_refs(&self.defines))?;
-        self.pressure.borrow_mut().push(p);
+        self.pressure.push(p);
         Ok(())
     }
 
-    /// Add an extra force term, run after the forces pass (it adds into `acc`).
-    pub fn add_force(&mut self, hook: Box<dyn SphHook>) {
-        self.force_hooks.push(hook);
-    }
-
-    /// Add a per-particle pass run at the start of every step, before arrange.
-    pub fn add_pre_arrange(&mut self, hook: Box<dyn SphHook>) {
-        self.pre_arrange.push(hook);
-    }
-
     /// Buffers for the scene's particles, uploaded.
-    pub fn state(&self, ctx: &Context, scene: &Scene, particles: &Particles) -> Result<SphState> {
+    pub fn state(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        particles: &Particles,
+    ) -> Result<SphState> {
         scene.validate()?;
         let n = particles.len();
         if n == 0 {
@@ -450,7 +439,7 @@ impl SphSolver {
     }
 
     fn run_hooks(
-        hooks: &[Box<dyn SphHook>],
+        hooks: &mut [&mut dyn SphHook],
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
@@ -465,7 +454,7 @@ impl SphSolver {
         Ok(())
     }
 
-    /// One full step, in the scope `sph`.
+    /// One full step without hooks, in the scope `sph`.
     pub fn record_step(
         &self,
         ctx: &Context,
@@ -473,16 +462,31 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &mut SphState,
     ) -> Result<()> {
+        self.record_hooked_step(ctx, cmd, scopes, st, &mut Hooks::none())
+    }
+
+    /// One full step with the `hooks` lent to it, in the scope `sph`.
+    pub fn record_hooked_step(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &mut SphState,
+        hooks: &mut Hooks,
+    ) -> Result<()> {
         let solver = st.fluid.solver;
         if solver != Solver::Wcsph {
             st.pressure()?; // a state made for another solver: a clear error, nothing recorded
         }
-        self.prepare(ctx, solver)?;
-        let passes = self.pressure.borrow();
-        let p = passes.iter().find(|p| p.solver == solver);
+        let p = self.pressure.iter().find(|p| p.solver == solver);
+        if solver != Solver::Wcsph && p.is_none() {
+            return Err(Error::Param(format!(
+                "the {solver:?} passes were not built: make the state with SphSolver::state, or call prepare"
+            )));
+        }
         scopes.begin(ctx, cmd, "sph");
         self.record_params(ctx, cmd, st);
-        Self::run_hooks(&self.pre_arrange, ctx, cmd, scopes, st)?;
+        Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
         match (p, solver) {
             (Some(p), Solver::Dfsph) => super::dfsph::record_divergence(p, ctx, cmd, scopes, st)?,
@@ -491,7 +495,7 @@ impl SphSolver {
                 self.record_forces(ctx, cmd, scopes, st);
             }
         }
-        Self::run_hooks(&self.force_hooks, ctx, cmd, scopes, st)?;
+        Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
         match (p, solver) {
             (Some(p), Solver::Pcisph) => super::pcisph::record(p, ctx, cmd, scopes, st)?,
             (Some(p), Solver::Dfsph) => super::dfsph::record_density(p, ctx, cmd, scopes, st)?,
@@ -510,15 +514,8 @@ impl SphSolver {
         self.density.destroy(ctx);
         self.forces.destroy(ctx);
         self.integrate.destroy(ctx);
-        for p in self.pressure.get_mut() {
+        for p in &mut self.pressure {
             p.destroy(ctx);
-        }
-        for h in self
-            .force_hooks
-            .iter_mut()
-            .chain(self.pre_arrange.iter_mut())
-        {
-            h.destroy(ctx);
         }
     }
 }
