@@ -2,86 +2,11 @@
 //! Values are closed enums so an unknown value is rejected by the parser; a switch whose
 //! algorithm is not built yet is rejected by `reject_unused` with a clear message.
 use crate::error::{Error, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
 
-macro_rules! switch_enum {
-    ($(#[$m:meta])* $name:ident { $($v:ident),+ $(,)? }) => {
-        $(#[$m])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ValueEnum, Serialize, serde::Deserialize)]
-        #[serde(rename_all = "kebab-case")]
-        pub enum $name { $($v),+ }
-        impl $name {
-            /// The switch value as written on the command line.
-            pub fn as_str(self) -> String {
-                self.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default()
-            }
-        }
-    };
-}
-
-switch_enum!(SortAlgo {
-    OddEven,
-    Bitonic,
-    Counting,
-    None
-});
-switch_enum!(Integrator {
-    Euler,
-    Verlet,
-    Closed
-});
-switch_enum!(SpriteMode {
-    Points,
-    Streaks,
-    Sprites
-});
-switch_enum!(Neighbors { Morton, Grid, Hash });
-switch_enum!(
-    /// SPH pressure solver: weakly compressible (the papers'), or the incompressible
-    /// predictive-corrective, divergence-free and position-based ones.
-    Solver {
-        Wcsph,
-        Pcisph,
-        Dfsph,
-        Pbf
-    }
-);
-
-switch_enum!(ListKind {
-    None,
-    Abuffer,
-    Sbuffer
-});
-switch_enum!(DensityFn {
-    Blinn,
-    Wyvill,
-    Nishimura,
-    Murakami
-});
-switch_enum!(Material {
-    Phong,
-    Glass,
-    Tinted,
-    Gold,
-    Copper,
-    Aluminium
-});
-switch_enum!(EmitterKind { Uv, Vertices });
-switch_enum!(Placement {
-    Vertices,
-    Random,
-    Rays
-});
-switch_enum!(Skinning { Lbs, Dqs });
-switch_enum!(OnOff { On, Off });
-switch_enum!(Adaptive { Off, On, Smooth });
-switch_enum!(ControlPreset { Thesis, Fidelity });
-switch_enum!(ControlMotion { Frames, Skin });
-switch_enum!(BoneWeights { Eq8, Eq9, Skin });
-switch_enum!(Offscreen { All, End });
-switch_enum!(RenderKind { Metaballs, Points });
-switch_enum!(ShowMesh { Off, Shaded, Wire });
+use crate::kinds::switch_enum;
+pub use crate::kinds::*;
 
 /// The device, validation, seed and size: every command takes these.
 #[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
@@ -160,6 +85,13 @@ pub struct FluidArgs {
     /// SPH pressure solver (default: the scene's [fluid] solver, else wcsph)
     #[arg(long, value_enum)]
     pub solver: Option<Solver>,
+}
+
+impl FluidArgs {
+    /// `fluid` with `--fluid KEY=VALUE` and `--solver` applied.
+    pub fn apply(&self, fluid: &crate::sph::FluidParams) -> Result<crate::sph::FluidParams> {
+        fluid.with_overrides(&self.fluid, self.solver)
+    }
 }
 
 /// How `run` draws SPH particles.

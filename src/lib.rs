@@ -10,6 +10,7 @@ pub mod error;
 pub mod experiment;
 pub mod export;
 pub mod gpu;
+pub mod kinds;
 pub mod particles;
 pub mod primitives;
 pub mod progress;

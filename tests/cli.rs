@@ -508,7 +508,7 @@ fn fluid_overrides_from_the_command_line() {
 /// read back.
 #[test]
 fn every_scene_kind_and_list_mode_is_free_of_sync_hazards() {
-    use fluidform::sph::run::SphRunStats;
+    use fluidform::run::SphRunStats;
     let dir = tempfile::tempdir().unwrap();
     let small = ["--frames", "2", "--width", "96", "--height", "72"];
     let o = run_ok(

@@ -6,8 +6,8 @@ use fluidform::character::Mesh;
 use fluidform::config::{Adaptive, Neighbors, Skinning};
 use fluidform::control::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use fluidform::gpu::Labels;
+use fluidform::scene::schema::{Ball, Block, Domain, Scene};
 use fluidform::sph::hooks::SphHook;
-use fluidform::sph::scene::{Ball, Block, Domain, Scene};
 use fluidform::sph::{FluidParams, SphSolver};
 use glam::{Mat4, Vec3};
 

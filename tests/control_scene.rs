@@ -210,7 +210,7 @@ fn bad_timelines_fail_clearly() {
     for (i, (event, needle)) in cases.iter().enumerate() {
         let p = dir.path().join(format!("bad{i}.toml"));
         std::fs::write(&p, format!("{base}\n[[timeline]]\n{event}\n")).unwrap();
-        let e = fluidform::sph::Scene::load(p.to_str().unwrap())
+        let e = fluidform::scene::Scene::load(p.to_str().unwrap())
             .err()
             .unwrap_or_else(|| panic!("case {i} loaded"))
             .to_string();

@@ -303,13 +303,13 @@ fn uv_emitter_spreads_births_more_evenly_than_vertices() {
 #[test]
 fn dead_slots_change_nothing_for_the_live() {
     let ctx = common::ctx();
-    let scene = fluidform::sph::Scene::built_in("resting-block").unwrap();
+    let scene = fluidform::scene::Scene::built_in("resting-block").unwrap();
     let mut parts = scene.particles(3);
     for (i, a) in parts.attr.iter_mut().enumerate() {
         a[0] = i as f32; // an id, to match particles across runs
     }
     let n = parts.len();
-    let mut with_dead = fluidform::sph::scene::Particles {
+    let mut with_dead = fluidform::scene::schema::Particles {
         pos: parts.pos.clone(),
         vel: parts.vel.clone(),
         attr: parts.attr.clone(),
@@ -326,7 +326,7 @@ fn dead_slots_change_nothing_for_the_live() {
         (Neighbors::Hash, SortAlgo::Bitonic),
         (Neighbors::Morton, SortAlgo::OddEven),
     ] {
-        let run = |p: &fluidform::sph::scene::Particles| {
+        let run = |p: &fluidform::scene::schema::Particles| {
             let mut solver = SphSolver::new(&ctx, nb, Some(sort)).unwrap();
             let mut st = solver.state(&ctx, &scene, p).unwrap();
             ctx.one_shot(|cmd| {

@@ -3,7 +3,7 @@
 //! its first pose. Checked against the character's own numbers (inspect), on the CPU.
 use fluidform::character::inspect::thinnest;
 use fluidform::scene::fit::{fit, ACROSS, COARSEST, FINEST};
-use fluidform::sph::Scene;
+use fluidform::scene::Scene;
 
 fn scene(dir: &std::path::Path, body: &str) -> fluidform::Result<Scene> {
     let path = dir.join("scene.toml");

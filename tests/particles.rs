@@ -5,10 +5,10 @@ use common::{finish, fluidform, text};
 use fluidform::config::{Integrator, SortAlgo, SpriteMode};
 use fluidform::gpu::{Context, Labels};
 use fluidform::psys::cpu::{attractor_potential, closed_pos, partitions};
-use fluidform::psys::scenes::{base_system, emitter, ParticleScene};
 use fluidform::psys::spec::*;
 use fluidform::psys::{FrameInfo, ParticleSystem, Passes};
 use fluidform::render::Camera;
+use fluidform::scene::particles::{base_system, emitter, ParticleScene};
 use glam::Vec3;
 
 fn cam() -> Camera {
@@ -21,7 +21,7 @@ fn cam() -> Camera {
 }
 
 fn frame(cam: &Camera, k: u64, dt: f32) -> FrameInfo<'_> {
-    fluidform::psys::run::frame_info(cam, dt, k, 256, 256)
+    fluidform::psys::frame::frame_info(cam, dt, k, 256, 256)
 }
 
 /// A spec with colourful, distinct particles (their colour identifies them across systems
@@ -724,7 +724,7 @@ fn type_changes_conserve_the_budget() {
         ctx.one_shot(|cmd| {
             for k in chunk * 12..chunk * 12 + 12 {
                 let f = frame(&cam, k, dt);
-                fluidform::psys::run::record_simulation(
+                fluidform::psys::frame::record_simulation(
                     &ctx,
                     cmd,
                     &mut Labels,
@@ -941,7 +941,7 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     let cam = cam();
     let desc = CharacterDesc::new("builtin:walker");
     let ch = SceneCharacter::new(&ctx, &desc, Skinning::Lbs, ShowMesh::Shaded).unwrap();
-    let link = CharacterLink::new(&ctx, &ch).unwrap();
+    let link = CharacterLink::new(&ctx, &ch.ch).unwrap();
     let mats = ch.matrices(0.0);
     ctx.one_shot(|cmd| {
         ch.record(&ctx, cmd, &mut Labels, 0.0).unwrap();
@@ -1009,10 +1009,10 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
         ctx.one_shot(|cmd| {
             for k in frames {
                 let f = FrameInfo {
-                    character: Some(link.bufs(&ch)),
+                    character: Some(link.bufs(ch.surface())),
                     ..frame(&cam, k, dt)
                 };
-                fluidform::psys::run::record_simulation(
+                fluidform::psys::frame::record_simulation(
                     &ctx,
                     cmd,
                     &mut Labels,

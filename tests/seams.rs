@@ -4,8 +4,9 @@ mod common;
 use bytemuck::{Pod, Zeroable};
 use fluidform::gpu::{ComputeDesc, ComputePipeline, Labels};
 use fluidform::particles::{AttributeDecl, LiveArgsPass, LiveCount, ParticleStore};
+use fluidform::scene::Scene;
 use fluidform::sph::hooks::{ConstantForce, Hooks, SphHook};
-use fluidform::sph::{Scene, SphSolver};
+use fluidform::sph::SphSolver;
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]

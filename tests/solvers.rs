@@ -3,7 +3,7 @@
 mod common;
 use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
-use fluidform::sph::scene::{Block, Domain, Particles, Scene};
+use fluidform::scene::schema::{Block, Domain, Particles, Scene};
 use fluidform::sph::{cpu_pressure, FluidParams, SphSolver, SphState};
 
 const SOLVERS: [Solver; 3] = [Solver::Pcisph, Solver::Dfsph, Solver::Pbf];

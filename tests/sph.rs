@@ -2,9 +2,9 @@
 mod common;
 use fluidform::config::{Neighbors, SortAlgo};
 use fluidform::gpu::{Context, Labels};
+use fluidform::scene::schema::{Ball, Block, Domain, Particles, Scene};
 use fluidform::sph::cpu;
 use fluidform::sph::params::Collider;
-use fluidform::sph::scene::{Ball, Block, Domain, Particles, Scene};
 use fluidform::sph::{Eos, FluidParams, SphSolver};
 
 const STRATEGIES: [(Neighbors, SortAlgo); 4] = [
@@ -394,7 +394,7 @@ fn bad_scenes_are_clear_errors() {
     }
     let e = Scene::load("no/such/scene.toml").unwrap_err().to_string();
     assert!(e.contains("unknown scene"), "{e}");
-    for name in fluidform::sph::scene::BUILT_IN {
+    for name in fluidform::scene::builtin::BUILT_IN {
         let mut s = Scene::built_in(name).unwrap();
         s.validate().unwrap();
         // A liquid character's [pool] becomes a block when the scene is fitted.

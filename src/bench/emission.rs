@@ -8,9 +8,10 @@ use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
 use crate::scene::emission::EmissionDesc;
+use crate::scene::schema::Block;
 use crate::scene::targets::SceneTargets;
-use crate::sph::scene::Block;
-use crate::sph::{Scene, SphSolver};
+use crate::scene::Scene;
+use crate::sph::SphSolver;
 use serde_json::json;
 
 /// Figure 9's particle counts.
@@ -64,7 +65,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     for (strategy, sort) in strategies {
         for &n in &counts {
             let mut scene = scene(n);
-            scene.fluid = scene.fluid.with_overrides(&sw.fluid_args)?;
+            scene.fluid = sw.fluid_args.apply(&scene.fluid)?;
             let parts = scene.particles(sw.common.seed);
             let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
             let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);

@@ -5,11 +5,11 @@ use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{ColorTarget, Context, Guard};
-use crate::psys::run::{frame_info, record_simulation};
-use crate::psys::scenes::{base_system, emitter};
+use crate::psys::frame::{frame_info, record_simulation};
 use crate::psys::spec::{ColliderSpec, ParticleSpec, Shape, SystemSpec, Vary};
 use crate::psys::{ParticleSystem, Passes};
 use crate::render::Camera;
+use crate::scene::particles::{base_system, emitter};
 use serde_json::json;
 
 pub const COUNTS: &[u32] = &[64 << 10, 256 << 10, 1 << 20];

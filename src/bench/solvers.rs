@@ -9,11 +9,12 @@ use crate::config::Solver;
 use crate::error::{Error, Result};
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
 use crate::report::stat;
+use crate::scene::Scene;
 use crate::sph::errors::DensityErrorStats;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Eos, FluidParams};
 use crate::sph::run::Stepper;
-use crate::sph::{Scene, SphSolver, SphState};
+use crate::sph::{SphSolver, SphState};
 use ash::vk;
 
 pub const SOLVERS: [Solver; 4] = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
@@ -251,7 +252,7 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     // Frames of 20 ms (50 steps of WCSPH's 0.4 ms): the frame bounds a step, and the
     // incompressible solvers' CFL steps reach 8 ms.
     base.fluid.substeps = 50;
-    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args)?;
+    base.fluid = opts.switches.fluid_args.apply(&base.fluid)?;
     let (strategy, sort) = super::sph::strategies(
         opts,
         &[(

@@ -5,10 +5,11 @@ use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, FrameLoop, Guard};
 use crate::primitives::neighbors::default_sort;
+use crate::scene::Scene;
 use crate::sph::errors::DensityErrorStats;
 use crate::sph::params::FluidParams;
 use crate::sph::run::{check, physics_stats, PhysicsStats, Stepper};
-use crate::sph::{Scene, SphSolver};
+use crate::sph::SphSolver;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
@@ -27,7 +28,7 @@ pub fn strategies(
 /// One SPH step per frame on the dam break scaled to N particles.
 pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut base = Scene::built_in("dam-break").expect("built-in");
-    base.fluid = base.fluid.with_overrides(&opts.switches.fluid_args)?;
+    base.fluid = opts.switches.fluid_args.apply(&base.fluid)?;
     let mut rows = Vec::new();
     for (strategy, sort) in strategies(
         opts,
@@ -112,7 +113,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     // Frames of 20 ms: they bound a CFL step.
     scene.fluid.substeps = 50;
     scene.fluid = super::solvers::own(&scene.fluid, solver_kind);
-    scene.fluid = scene.fluid.with_overrides(&opts.switches.fluid_args)?;
+    scene.fluid = opts.switches.fluid_args.apply(&scene.fluid)?;
     if let Some(n) = opts.switches.common.particles {
         scene = scene.with_particles(n);
     }
@@ -160,7 +161,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let s = Checkpoint {
                 step: stepper.steps_taken,
                 time: stepper.sim_time,
-                physics: physics_stats(&d, &scene),
+                physics: physics_stats(&d, &scene.domain, scene.fluid.rest_density),
             };
             eprintln!(
                 "stability {}: {:.2} s, step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",

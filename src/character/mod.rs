@@ -16,8 +16,8 @@ pub use anim::Animator;
 pub use check::MeshCheck;
 pub use model::*;
 
-use crate::config::Skinning;
 use crate::error::{Error, Result};
+use crate::kinds::Skinning;
 use glam::{Mat4, Vec3};
 use std::path::Path;
 

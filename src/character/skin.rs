@@ -2,9 +2,9 @@
 //! matrices uploaded each frame. Sized buffers (`SkinnedMesh`) apart from the pipeline.
 use super::model::Mesh;
 use super::pose::GpuJoint;
-use crate::config::Skinning;
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::kinds::Skinning;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 

@@ -8,9 +8,9 @@ pub use super::settings::ControlSettings;
 use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
 use crate::sph::hooks::SphHook;
@@ -151,7 +151,7 @@ impl ControlForce {
         joints: usize,
         settings: ControlSettings,
         domain: ([f32; 3], [f32; 3]),
-        (rays, skinning): (Option<(f32, u32)>, crate::config::Skinning),
+        (rays, skinning): (Option<(f32, u32)>, crate::kinds::Skinning),
     ) -> Result<Self> {
         settings.validate()?;
         let m = match rays {

@@ -5,11 +5,10 @@ use super::binding;
 use super::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
 use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
-use crate::config::{
-    Adaptive, BoneWeights, ControlMotion, ControlPreset, Placement, Skinning, Switches,
-};
+use crate::config::Switches;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
+use crate::kinds::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Placement, Skinning};
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -207,17 +206,6 @@ impl Preset {
             },
         }
     }
-}
-
-/// A named control target beside the scene's `[character]` (TOML `[[targets]]`): a
-/// character or closed mesh, where it stands and how it plays, and its control settings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TargetDesc {
-    pub name: String,
-    pub character: crate::scene::character::CharacterDesc,
-    #[serde(default)]
-    pub control: ControlDesc,
 }
 
 /// Control particles of a placed character, driving the fluid as a hook lent to the steps.

@@ -7,9 +7,9 @@
 use super::emit::{EmitGpuParams, EmitInput, EmitPass, EmitSettings};
 use super::layout::UvLayout;
 use super::uv::UvSurface;
-use crate::config::EmitterKind;
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
+use crate::kinds::EmitterKind;
 use crate::particles::{AttrId, AttributeDecl};
 use crate::sph::hooks::SphHook;
 use crate::sph::params::SphGpuParams;

@@ -12,9 +12,9 @@ use super::counting::{CountingBuffers, CountingSort, GatherPass};
 use super::morton::MortonPass;
 use super::scan::{ScanPass, ScanVariant};
 use super::sort::{Network, NetworkSort};
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::kinds::{Neighbors, SortAlgo};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 

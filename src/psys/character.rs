@@ -2,9 +2,10 @@
 //! `character`, uploaded each frame) and its skinned triangles (the `mesh` emitter, picked
 //! by bind-pose area through a CDF, placed on the skinned triangle).
 use crate::character::capsules::{self, BoneCapsule};
+use crate::character::Character;
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, Guard};
-use crate::scene::character::SceneCharacter;
+use crate::render::mesh::MeshDraw;
 use ash::vk;
 use glam::Mat4;
 
@@ -33,14 +34,15 @@ pub struct CharacterLink {
 }
 
 impl CharacterLink {
-    pub fn new(ctx: &Context, ch: &SceneCharacter) -> Result<Self> {
-        let mut bones = capsules::of(&ch.ch);
+    /// For `ch` in its rest pose (capsules and the emitting triangles' areas).
+    pub fn new(ctx: &Context, ch: &Character) -> Result<Self> {
+        let mut bones = capsules::of(ch);
         if bones.len() > MAX_CAPSULES {
             // The largest ones collide; the rest are fingers and the like.
             bones.sort_by(|a, b| b.r.total_cmp(&a.r));
             bones.truncate(MAX_CAPSULES);
         }
-        let mesh = &ch.ch.mesh;
+        let mesh = &ch.mesh;
         let mut acc = 0.0f64;
         let mut cdf: Vec<f32> = mesh
             .indices
@@ -54,7 +56,7 @@ impl CharacterLink {
         if cdf.is_empty() || acc.is_nan() || acc <= 0.0 {
             return Err(Error::Param(format!(
                 "character {}: no triangle with an area to emit from",
-                ch.ch.source
+                ch.source
             )));
         }
         for c in &mut cdf {
@@ -93,8 +95,8 @@ impl CharacterLink {
         }
     }
 
-    pub fn bufs<'a>(&'a self, ch: &'a SceneCharacter) -> CharacterBufs<'a> {
-        let m = ch.surface();
+    /// The buffers of the character's skinned `surface`.
+    pub fn bufs<'a>(&'a self, m: MeshDraw<'a>) -> CharacterBufs<'a> {
         CharacterBufs {
             pos: m.pos,
             indices: m.indices,

@@ -4,13 +4,13 @@ use super::spec::{
     BoidsSpec, ColliderKind, EventKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES,
     MAX_KEYS,
 };
-use crate::config::Neighbors;
-use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::Result;
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
 };
+use crate::kinds::Neighbors;
+use crate::kinds::{Integrator, SortAlgo, SpriteMode};
 use crate::primitives::counting::CountingSort;
 use crate::primitives::neighbors::{GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanPass, ScanVariant};

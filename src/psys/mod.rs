@@ -5,9 +5,8 @@
 //! dispatch and draw; points, streaks and sprites sorted back to front.
 pub mod character;
 pub mod cpu;
+pub mod frame;
 pub mod gpu;
-pub mod run;
-pub mod scenes;
 pub mod spec;
 pub mod sprite;
 pub mod system;

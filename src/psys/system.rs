@@ -10,15 +10,18 @@ use super::gpu::{
 use super::spec::{EventKind, EventSpec};
 use super::spec::{Shape, SystemSpec};
 use super::sprite;
-use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
+use crate::kinds::{Integrator, SortAlgo, SpriteMode};
 use crate::primitives::counting::CountingBuffers;
 use crate::primitives::neighbors::NeighborBuffers;
 use crate::render::Camera;
 use ash::vk;
 use bytemuck::Zeroable;
 use rand::{Rng, SeedableRng};
+
+mod draw;
+use draw::DepthSort;
 
 /// Cells of the counting sort of sprite depths: log-scale depth buckets between the
 /// camera's near and far planes (relative depth resolution ln(far / near) / cells).
@@ -518,128 +521,6 @@ impl ParticleSystem {
             .dispatch_indirect(ctx, cmd, &bufs, &push, &parent.events, EVENTS_ARGS);
     }
 
-    /// Record the draw's vertex count from the list that is drawn (after spawns into it).
-    pub fn record_draw_count(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        passes: &Passes,
-        f: &FrameInfo,
-    ) {
-        let mut push = self.push(f, f.time, 0);
-        push.cur = 1 - self.drawn;
-        push.mode = 1;
-        passes
-            .args
-            .dispatch_groups(ctx, cmd, &self.bufs(passes, f), &push, 1);
-    }
-
-    /// Record the depth sort of what is drawn (nothing with --sort none). The step's
-    /// writes must be visible to compute.
-    pub fn record_sort(
-        &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        scopes: &mut dyn Scopes,
-        passes: &Passes,
-        f: &FrameInfo,
-    ) -> Result<()> {
-        if self.sort == SortAlgo::None {
-            return Ok(());
-        }
-        let t = f.time + f.dt as f64;
-        let mut push = self.push(f, t, 0);
-        // Keys read the list the step wrote: the shader reads alive[1 - cur].
-        push.cur = 1 - self.drawn;
-        push.mode = (self.sort == SortAlgo::Counting) as u32;
-        let bufs = self.bufs(passes, f);
-        let cap = self.capacity as u64;
-        scopes.begin(ctx, cmd, Passes::SORT);
-        if self.closed() {
-            let zero = StepPush { mode: 2, ..push };
-            passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-        }
-        passes.keys.dispatch(ctx, cmd, &bufs, &push, cap);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-        match (self.sort, &self.counting) {
-            (SortAlgo::Counting, Some(d)) => {
-                passes.counting.record(
-                    ctx,
-                    cmd,
-                    &passes.scan,
-                    &d.cells,
-                    &self.keys,
-                    &self.vals,
-                    &d.keys,
-                    &d.vals,
-                    cap,
-                )?;
-            }
-            (SortAlgo::OddEven, _) => {
-                passes
-                    .odd_even
-                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
-            }
-            (SortAlgo::Bitonic, _) => {
-                passes
-                    .bitonic
-                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
-            }
-            _ => unreachable!("counting buffers exist for the counting sort"),
-        }
-        scopes.end(ctx, cmd);
-        Ok(())
-    }
-
-    /// Record the draw (inside a rendering scope; the step's and sort's writes visible to
-    /// vertex shaders and indirect reads).
-    pub fn record_draw(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        passes: &Passes,
-        f: &FrameInfo,
-    ) {
-        let (r, u) = f.cam.axes();
-        let t = (f.time + f.dt as f64) as f32;
-        let (order, offset, identity) = match (self.sort, &self.counting) {
-            (SortAlgo::None, _) if self.closed() => (&self.alive, 0, 1),
-            (SortAlgo::None, _) => (&self.alive, self.drawn * self.capacity, 0),
-            (SortAlgo::Counting, Some(d)) => (&d.vals, 0, 0),
-            _ => (&self.vals, 0, 0),
-        };
-        let push = DrawPush {
-            view_proj: f.cam.view_proj().to_cols_array_2d(),
-            right: [r.x, r.y, r.z, self.spec.point_px],
-            up: [u.x, u.y, u.z, t],
-            screen: [
-                2.0 / f.width as f32,
-                2.0 / f.height as f32,
-                f.dt,
-                self.sprite_side as f32,
-            ],
-            offset,
-            identity,
-            pad: [0; 2],
-        };
-        let bufs = DrawBufs {
-            params: &self.params,
-            pos: &self.pos,
-            vel: &self.vel,
-            prev: &self.prev,
-            color: &self.color,
-            order,
-            sprite: &self.sprite,
-        };
-        passes.pipeline(self.mode).bind(ctx, cmd, &bufs, &push);
-        if identity == 1 {
-            ctx.draw(cmd, vertices(self.mode) * self.capacity, 1);
-        } else {
-            ctx.draw_indirect(cmd, &self.counters, Counters::DRAW_ARGS);
-        }
-    }
-
     /// Colours at birth (tests identify particles by them).
     pub fn color_buffer(&self) -> &Buffer {
         &self.color
@@ -664,21 +545,6 @@ impl ParticleSystem {
             dead: ctx.readback(&self.dead, 0, cap)?[..dead_n.min(cap)].to_vec(),
             counters,
         })
-    }
-
-    /// The sorted slots (NO_SLOT past the drawn ones) and their keys after `record_sort`.
-    pub fn read_sorted(&self, ctx: &Context) -> Result<(Vec<u32>, Vec<u32>)> {
-        let cap = self.capacity as usize;
-        match &self.counting {
-            Some(d) => Ok((
-                ctx.readback(&d.keys, 0, cap)?,
-                ctx.readback(&d.vals, 0, cap)?,
-            )),
-            None => Ok((
-                ctx.readback(&self.keys, 0, cap)?,
-                ctx.readback(&self.vals, 0, cap)?,
-            )),
-        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -708,35 +574,4 @@ impl ParticleSystem {
     }
 }
 
-/// The counting sort's cells and its sorted copies of the keys and values.
-struct DepthSort {
-    cells: CountingBuffers,
-    keys: Buffer,
-    vals: Buffer,
-}
-
-impl DepthSort {
-    fn new(ctx: &Context, passes: &Passes, name: &str, cap: u64) -> Result<Self> {
-        let cells = Guard::new(
-            ctx,
-            CountingBuffers::new(ctx, &passes.scan, cap, DEPTH_CELLS)?,
-        );
-        let buf = |what: &str| {
-            ctx.storage_buffer(&format!("{name} sorted {what}"), cap * 4)
-                .map(|b| Guard::new(ctx, b))
-        };
-        let (keys, vals) = (buf("keys")?, buf("values")?);
-        Ok(Self {
-            cells: cells.take(),
-            keys: keys.take(),
-            vals: vals.take(),
-        })
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        self.cells.destroy(ctx);
-        ctx.destroy_buffer(&mut self.keys);
-        ctx.destroy_buffer(&mut self.vals);
-    }
-}
-crate::impl_destroy!(ParticleSystem, DepthSort);
+crate::impl_destroy!(ParticleSystem);

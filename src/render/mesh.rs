@@ -1,10 +1,10 @@
 //! A skinned character's mesh drawn shaded or as a wireframe (`--show-mesh`), from the
 //! skinning pass's positions and normals, depth-tested in the frame's colour target.
 use super::Camera;
-use crate::config::ShowMesh;
 use crate::error::{Error, Result};
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::{Buffer, Context, GraphicsDesc, GraphicsPipeline};
+use crate::kinds::ShowMesh;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 

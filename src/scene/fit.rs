@@ -4,7 +4,7 @@
 use super::character::placed_matrices;
 use crate::character::inspect::thinnest;
 use crate::error::{Error, Result};
-use crate::sph::scene::{white, Block, Scene};
+use crate::scene::schema::{white, Block, Scene};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 

@@ -1,6 +1,12 @@
-//! Scene parts beside the SPH scenes: the `orbits` test scene and characters.
+//! Scenes: the schema and its built-ins, and the parts a scene plays beside the fluid
+//! (characters, control targets, emission, the `orbits` test scene).
+pub mod builtin;
 pub mod character;
 pub mod emission;
 pub mod fit;
 pub mod orbits;
+pub mod particles;
+pub mod schema;
 pub mod targets;
+
+pub use schema::Scene;

@@ -5,7 +5,7 @@
 //! the collision response out (no wall in reach). Starts from a state with no warm-start
 //! stiffness (a scene's first step).
 use super::params::{Eos, FluidParams, Kernels};
-use crate::config::Solver;
+use crate::kinds::Solver;
 
 type V3 = [f64; 3];
 fn sub(a: V3, b: V3) -> V3 {

@@ -1,5 +1,6 @@
 //! Weakly compressible SPH after Müller et al. 2003 and Kelager 2006, on the GPU, with
 //! switchable neighbour search, boundaries and colliders, and an f64 CPU reference.
+pub mod collider;
 pub mod cpu;
 pub mod cpu_pressure;
 pub mod dfsph;
@@ -11,10 +12,10 @@ pub mod pbf;
 pub mod pcisph;
 pub mod pressure;
 pub mod run;
-pub mod scene;
+pub mod setup;
 pub mod solver;
 pub mod spacing;
 
 pub use params::{Collider, Eos, FluidParams};
-pub use scene::Scene;
+pub use setup::{Particles, SphSetup};
 pub use solver::{SphSolver, SphState};

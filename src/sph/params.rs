@@ -1,7 +1,10 @@
 //! Fluid parameters (Kelager 2006's water by default) and their GPU mirror.
 use crate::error::{Error, Result};
+use crate::kinds::Solver;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
+
+pub use super::collider::{Collider, GpuCollider, MAX_COLLIDERS};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -60,7 +63,7 @@ pub struct FluidParams {
     /// Tangential velocity lost at a wall, 0..1
     pub friction: f32,
     /// The pressure solver (`--solver`).
-    pub solver: crate::config::Solver,
+    pub solver: crate::kinds::Solver,
     /// With `cfl`: the largest step, s (default: `dt`). The frame time stays dt * substeps.
     pub dt_max: Option<f32>,
     /// pcisph, dfsph, pbf: iterate until the mean density error (rho / rho_0 - 1 where
@@ -113,7 +116,7 @@ impl Default for FluidParams {
             gravity: [0.0, -9.82, 0.0],
             restitution: 0.0,
             friction: 0.0,
-            solver: crate::config::Solver::Wcsph,
+            solver: crate::kinds::Solver::Wcsph,
             dt_max: None,
             density_error: 0.001,
             divergence_error: 0.001,
@@ -263,17 +266,17 @@ impl FluidParams {
     /// (least, most) iterations of the solver's pressure solve: pbf's fixed count, if set.
     pub fn iterations(&self) -> (u32, u32) {
         match (self.solver, self.pbf_iterations) {
-            (crate::config::Solver::Pbf, k) if k > 0 => (k, k),
+            (crate::kinds::Solver::Pbf, k) if k > 0 => (k, k),
             _ => (self.min_iterations, self.max_iterations),
         }
     }
 
     /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
     /// a scene file's [fluid] table: unknown keys and invalid values are errors.
-    /// The parameters with `--fluid KEY=VALUE` overrides and `--solver` applied.
-    pub fn with_overrides(&self, args: &crate::config::FluidArgs) -> Result<Self> {
-        let mut out = self.with_values(&args.fluid)?;
-        if let Some(s) = args.solver {
+    /// The parameters with `KEY=VALUE` `overrides` (`--fluid`) and `solver` applied.
+    pub fn with_overrides(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
+        let mut out = self.with_values(overrides)?;
+        if let Some(s) = solver {
             out.solver = s;
             out.validate()?;
         }
@@ -311,7 +314,7 @@ impl FluidParams {
     /// The neighbour list length the solver uses: dfsph's `neighbor_list`, else 0.
     pub fn list_len(&self) -> u32 {
         match self.solver {
-            crate::config::Solver::Dfsph => self.neighbor_list,
+            crate::kinds::Solver::Dfsph => self.neighbor_list,
             _ => 0,
         }
     }
@@ -332,7 +335,7 @@ impl FluidParams {
     /// Speed of sound used by the CFL limit: the equation of state's for wcsph; the
     /// incompressible solvers have none (their CFL limit is the largest speed alone).
     pub fn sound(&self) -> f32 {
-        if self.solver != crate::config::Solver::Wcsph {
+        if self.solver != crate::kinds::Solver::Wcsph {
             return 0.0;
         }
         match self.eos {
@@ -398,7 +401,7 @@ impl SphGpuParams {
     pub fn new(f: &FluidParams, lo: [f32; 3], hi: [f32; 3], dt: f32, colliders: u32) -> Self {
         let h = f.h;
         let k = Kernels::new(h as f64);
-        let incompressible = f.solver != crate::config::Solver::Wcsph;
+        let incompressible = f.solver != crate::kinds::Solver::Wcsph;
         let (min_iter, max_iter) = f.iterations();
         let dq = (f.scorr_dq * h) as f64;
         let w_dq = k.poly6 * (h as f64 * h as f64 - dq * dq).powi(3);
@@ -416,7 +419,7 @@ impl SphGpuParams {
             } else {
                 f.eos_constant()
             },
-            viscosity: if f.solver == crate::config::Solver::Pbf {
+            viscosity: if f.solver == crate::kinds::Solver::Pbf {
                 0.0
             } else {
                 f.viscosity
@@ -498,158 +501,6 @@ impl Kernels {
             poly6_grad: -945.0 / (32.0 * PI * h.powi(9)),
             spiky_grad: -45.0 / (PI * h.powi(6)),
             visc_lap: 45.0 / (PI * h.powi(6)),
-        }
-    }
-}
-
-/// Mirror of `Collider` in glsl/sph/common.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuCollider {
-    pub a: [f32; 4],
-    pub b: [f32; 4],
-    pub vel: [f32; 4],
-}
-const _: () = assert!(std::mem::size_of::<GpuCollider>() == 48);
-
-/// Static or moving colliders; the fluid stays outside spheres and capsules and on the
-/// positive side of planes. Moving colliders carry their velocity for the response.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum Collider {
-    Plane {
-        normal: [f32; 3],
-        offset: f32,
-        #[serde(default)]
-        velocity: [f32; 3],
-    },
-    Sphere {
-        center: [f32; 3],
-        radius: f32,
-        #[serde(default)]
-        velocity: [f32; 3],
-    },
-    Capsule {
-        a: [f32; 3],
-        b: [f32; 3],
-        radius: f32,
-        #[serde(default)]
-        velocity: [f32; 3],
-    },
-}
-
-/// Most colliders a scene may have.
-pub const MAX_COLLIDERS: usize = 64;
-
-impl Collider {
-    pub fn to_gpu(&self) -> Result<GpuCollider> {
-        let v = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
-        Ok(match self {
-            Collider::Plane {
-                normal,
-                offset,
-                velocity,
-            } => {
-                let n = glam::Vec3::from(*normal);
-                if n.length().is_nan() || n.length() <= 1e-6 {
-                    return Err(Error::Param(
-                        "plane collider: normal must be non-zero".into(),
-                    ));
-                }
-                let n = n.normalize();
-                GpuCollider {
-                    a: [n.x, n.y, n.z, *offset],
-                    b: [0.0, 0.0, 0.0, 0.0],
-                    vel: v(velocity),
-                }
-            }
-            Collider::Sphere {
-                center,
-                radius,
-                velocity,
-            } => {
-                if radius.is_nan() || *radius <= 0.0 {
-                    return Err(Error::Param(
-                        "sphere collider: radius must be positive".into(),
-                    ));
-                }
-                GpuCollider {
-                    a: [center[0], center[1], center[2], *radius],
-                    b: [0.0, 0.0, 0.0, 1.0],
-                    vel: v(velocity),
-                }
-            }
-            Collider::Capsule {
-                a,
-                b,
-                radius,
-                velocity,
-            } => {
-                if radius.is_nan() || *radius <= 0.0 {
-                    return Err(Error::Param(
-                        "capsule collider: radius must be positive".into(),
-                    ));
-                }
-                GpuCollider {
-                    a: [a[0], a[1], a[2], *radius],
-                    b: [b[0], b[1], b[2], 2.0],
-                    vel: v(velocity),
-                }
-            }
-        })
-    }
-
-    pub fn scaled(&self, s: f32) -> Self {
-        let m = |v: &[f32; 3]| [v[0] * s, v[1] * s, v[2] * s];
-        match self {
-            Collider::Plane {
-                normal,
-                offset,
-                velocity,
-            } => Collider::Plane {
-                normal: *normal,
-                offset: offset * s,
-                velocity: *velocity,
-            },
-            Collider::Sphere {
-                center,
-                radius,
-                velocity,
-            } => Collider::Sphere {
-                center: m(center),
-                radius: radius * s,
-                velocity: *velocity,
-            },
-            Collider::Capsule {
-                a,
-                b,
-                radius,
-                velocity,
-            } => Collider::Capsule {
-                a: m(a),
-                b: m(b),
-                radius: radius * s,
-                velocity: *velocity,
-            },
-        }
-    }
-
-    /// Signed distance to the collider surface (negative inside the solid).
-    pub fn distance(&self, p: [f32; 3]) -> f32 {
-        let p = glam::Vec3::from(p);
-        match self {
-            Collider::Plane { normal, offset, .. } => {
-                glam::Vec3::from(*normal).normalize().dot(p) - offset
-            }
-            Collider::Sphere { center, radius, .. } => {
-                (p - glam::Vec3::from(*center)).length() - radius
-            }
-            Collider::Capsule { a, b, radius, .. } => {
-                let (a, b) = (glam::Vec3::from(*a), glam::Vec3::from(*b));
-                let ab = b - a;
-                let t = ((p - a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
-                (p - (a + t * ab)).length() - radius
-            }
         }
     }
 }

@@ -5,9 +5,9 @@
 //! once the solve has converged, zeroes the group count of the indirect dispatches that
 //! remain: no read-back per iteration, and skipped iterations cost an empty dispatch.
 use super::solver::{SphState, LOCAL_SIZE};
-use crate::config::Solver;
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::kinds::Solver;
 use crate::primitives::neighbors::NeighborPush;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};

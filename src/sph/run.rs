@@ -2,7 +2,7 @@
 //! frame's largest speed), the state's health every frame, and end-of-run statistics.
 use super::errors::{DensityErrorStats, StepError, StepErrors};
 use super::health::Health;
-use super::scene::Scene;
+use super::setup::Domain;
 use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, Profiler};
@@ -199,32 +199,11 @@ pub struct PhysicsStats {
     pub max_speed: f64,
 }
 
-/// `stats` of an SPH run.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct SphRunStats {
-    #[serde(flatten)]
-    pub physics: PhysicsStats,
-    pub steps: u64,
-    pub simulated_seconds: f64,
-    pub render: crate::viewer::RenderSummary,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub character: Option<crate::scene::character::CharacterStats>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub control: Option<crate::scene::targets::ControlSummary>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<crate::scene::emission::EmissionStats>,
-    /// The density error of every step (per step in steps.csv).
-    #[serde(default)]
-    pub density_error: super::errors::DensityErrorStats,
-    /// The scene's particle systems, if any.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub particle_systems: Vec<crate::psys::run::SystemStats>,
-}
-
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.
-pub fn physics_stats(d: &StateDump, scene: &Scene) -> PhysicsStats {
+/// `rest_density`: the fluid's (densities are reported over it too).
+pub fn physics_stats(d: &StateDump, domain: &Domain, rest_density: f32) -> PhysicsStats {
     let n = d.pos.len();
-    let (lo, hi) = (scene.domain.min, scene.domain.max);
+    let (lo, hi) = (domain.min, domain.max);
     let nan = d
         .pos
         .iter()
@@ -249,7 +228,7 @@ pub fn physics_stats(d: &StateDump, scene: &Scene) -> PhysicsStats {
                 a.max(b)
             }
         });
-    let rho0 = scene.fluid.rest_density as f64;
+    let rho0 = rest_density as f64;
     PhysicsStats {
         particles: n,
         nan,

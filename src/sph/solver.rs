@@ -6,10 +6,10 @@
 use super::hooks::{Hooks, SphHook};
 use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
 use super::pressure::{PressureBuffers, PressurePasses};
-use super::scene::{Particles, Scene};
-use crate::config::{Neighbors, Solver, SortAlgo};
+use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::kinds::{Neighbors, Solver, SortAlgo};
 use crate::particles::{AttrId, AttributeDecl, ParticleStore};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
@@ -285,13 +285,15 @@ impl SphSolver {
         Ok(())
     }
 
-    /// Buffers for the scene's particles, uploaded.
-    pub fn state(
+    /// Buffers for `particles` in the fluid `setup` (a scene gives one), uploaded; the
+    /// passes of its solver built.
+    pub fn state<'a>(
         &mut self,
         ctx: &Context,
-        scene: &Scene,
+        setup: impl Into<SphSetup<'a>>,
         particles: &Particles,
     ) -> Result<SphState> {
+        let scene: SphSetup = setup.into();
         scene.validate()?;
         let n = particles.len();
         if n == 0 {
@@ -303,7 +305,7 @@ impl SphSolver {
         if n as u64 > MAX_PARTICLES {
             return Err(Error::Param(format!("{n} particles: at most 2^26")));
         }
-        let f = &scene.fluid;
+        let f = scene.fluid;
         let grid = GridSpec::covering(scene.domain.min, scene.domain.max, f.h)?;
         let colliders: Vec<GpuCollider> = scene
             .colliders

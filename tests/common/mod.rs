@@ -75,7 +75,7 @@ pub fn random_particles(
     side: f32,
     speed: f32,
     seed: u64,
-) -> fluidform::sph::scene::Particles {
+) -> fluidform::scene::schema::Particles {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
     let mut pos: Vec<[f32; 4]> = Vec::new();
@@ -103,7 +103,7 @@ pub fn random_particles(
             ]
         })
         .collect();
-    fluidform::sph::scene::Particles {
+    fluidform::scene::schema::Particles {
         pos,
         vel,
         attr: vec![[1.0, 1.0, 1.0, 0.0]; n],

@@ -3,9 +3,9 @@
 //! sizes rebuilds buffers only.
 use super::settings::{MetaballSettings, RenderParams};
 use super::stats::GpuStats;
-use crate::config::ListKind;
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, Guard, MemoryLocation};
+use crate::kinds::ListKind;
 use crate::primitives::bounds::BoundsBuffers;
 use crate::primitives::scan::{ScanPass, ScanScratch};
 use ash::vk;

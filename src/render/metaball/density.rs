@@ -1,7 +1,7 @@
 //! Finite-support metaball density functions D(r), r <= R (0 beyond), normalised to
 //! D(0) = 1, with their radial derivative for analytic normals. The surface is where the
 //! sum over metaballs equals the threshold T.
-use crate::config::DensityFn;
+use crate::kinds::DensityFn;
 
 /// Blinn's Gaussian b exp(-a r^2) truncated at R, shifted and rescaled so that it reaches
 /// 0 continuously at R (a = BLINN_A / R^2).

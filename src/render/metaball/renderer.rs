@@ -6,13 +6,13 @@
 use super::buffers::MetaballBuffers;
 use super::settings::{MetaballSettings, RenderParams};
 use super::stats::{FrameStats, GpuStats};
-use crate::config::ListKind;
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::{
     sync, Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
     Labels, Scopes,
 };
+use crate::kinds::ListKind;
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::render::Camera;

@@ -1,7 +1,8 @@
 //! Renderer settings from the command line (or a bench configuration), with the thesis's
 //! defaults, and their GPU mirror.
-use crate::config::{DensityFn, ListKind, Material, Switches};
+use crate::config::Switches;
 use crate::error::{Error, Result};
+use crate::kinds::{DensityFn, ListKind, Material};
 use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;
@@ -102,11 +103,11 @@ impl MetaballSettings {
             offscreen_end: sw
                 .metaball
                 .offscreen
-                .map(|o| o == crate::config::Offscreen::End)
+                .map(|o| o == crate::kinds::Offscreen::End)
                 .unwrap_or(false),
             // Sorting pays where rays read the lists many times: inside glass and tinted.
             sorted: match sw.metaball.list_sort {
-                Some(o) => o == crate::config::OnOff::On,
+                Some(o) => o == crate::kinds::OnOff::On,
                 None => matches!(
                     sw.metaball.material,
                     Some(Material::Glass) | Some(Material::Tinted)

@@ -1,16 +1,18 @@
 //! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
-use super::character::{CharacterBufs, CharacterLink};
-use super::gpu::Passes;
-use super::scenes::ParticleScene;
-use super::spec::SystemSpec;
-use super::system::{FrameInfo, ParticleSystem};
-use crate::config::{Group, Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
-use crate::error::{Error, Result};
+use crate::config::Group;
+use crate::error::Result;
 use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
+use crate::kinds::{Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
+use crate::psys::character::{CharacterBufs, CharacterLink};
+use crate::psys::frame::{frame_info, record_simulation};
+use crate::psys::gpu::Passes;
+use crate::psys::spec::SystemSpec;
+use crate::psys::system::{FrameInfo, ParticleSystem};
 use crate::render::mesh::MeshView;
 use crate::render::Camera;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
 use crate::scene::character::SceneCharacter;
+use crate::scene::particles::ParticleScene;
 use crate::session::{camera_with_switches, open, play, SLOTS};
 use crate::viewer::Picture;
 use ash::vk;
@@ -194,100 +196,6 @@ impl crate::viewer::Overlay for SystemsFrame<'_> {
     }
 }
 
-/// Frame `frame` of a scene stepping `dt` per frame, drawn `width` x `height` by `cam`.
-pub fn frame_info(cam: &Camera, dt: f32, frame: u64, width: u32, height: u32) -> FrameInfo<'_> {
-    FrameInfo {
-        cam,
-        time: frame as f64 * dt as f64,
-        dt,
-        frame,
-        width,
-        height,
-        character: None,
-    }
-}
-
-/// Record the systems' steps, then their depth sorts; their writes made visible to the
-/// draws (vertex shaders and indirect arguments). `run` and `bench particles` share it.
-pub fn record_simulation(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    prof: &mut dyn Scopes,
-    passes: &Passes,
-    systems: &mut [ParticleSystem],
-    f: &FrameInfo,
-) -> Result<()> {
-    for s in systems.iter_mut() {
-        s.record_step(ctx, cmd, prof, passes, f);
-    }
-    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-    record_events(ctx, cmd, prof, passes, systems, f)?;
-    for s in systems.iter_mut() {
-        s.record_sort(ctx, cmd, prof, passes, f)?;
-    }
-    ctx.barrier(
-        cmd,
-        sync::COMPUTE_WRITE,
-        sync::GRAPHICS_READ | sync::INDIRECT_READ,
-    );
-    Ok(())
-}
-
-/// Record the children of every event the steps recorded: each parent's spawn dispatch,
-/// then the children born into their systems' drawn lists, then those draws' counts.
-fn record_events(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    prof: &mut dyn Scopes,
-    passes: &Passes,
-    systems: &[ParticleSystem],
-    f: &FrameInfo,
-) -> Result<()> {
-    let mut links = Vec::new();
-    for (i, s) in systems.iter().enumerate() {
-        for e in &s.spec.event {
-            let j = systems
-                .iter()
-                .position(|t| t.spec.name == e.spawn)
-                .ok_or_else(|| {
-                    Error::Param(format!(
-                        "system '{}' spawns '{}', which is not among the scene's systems",
-                        s.spec.name, e.spawn
-                    ))
-                })?;
-            links.push((i, j, e));
-        }
-    }
-    if links.is_empty() {
-        return Ok(());
-    }
-    prof.begin(ctx, cmd, Passes::EVENTS);
-    for (i, s) in systems.iter().enumerate() {
-        if links.iter().any(|l| l.0 == i) {
-            s.record_event_args(ctx, cmd, passes, f);
-        }
-    }
-    ctx.barrier(
-        cmd,
-        sync::COMPUTE_WRITE,
-        sync::COMPUTE_READ | sync::INDIRECT_READ,
-    );
-    for &(i, j, e) in &links {
-        systems[j].record_spawn(ctx, cmd, passes, f, &systems[i], e);
-        // Spawns into one system pop its dead stack and append to its list in turn.
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-    }
-    let mut targets: Vec<usize> = links.iter().map(|l| l.1).collect();
-    targets.sort_unstable();
-    targets.dedup();
-    for j in targets {
-        systems[j].record_draw_count(ctx, cmd, passes, f);
-    }
-    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
-    prof.end(ctx, cmd);
-    Ok(())
-}
-
 /// The scene character: skinned each frame, its capsules posed for the colliders, its
 /// mesh drawn (unless --show-mesh off) before the particles, so they are depth-tested
 /// against it.
@@ -331,7 +239,7 @@ impl FrameWork for ParticleWork<'_> {
             body.link.record(ctx, cmd, &body.ch.matrices(t));
             ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
         }
-        let bufs = self.body.as_ref().map(|b| b.link.bufs(&b.ch));
+        let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
         prof.begin(ctx, cmd, Passes::DRAW);
         let b = self.background;
@@ -396,7 +304,7 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
             let show = sw.character.show_mesh.unwrap_or(ShowMesh::Shaded);
             let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
             let ch = Guard::new(&ctx, SceneCharacter::new(&ctx, desc, method, show)?);
-            let link = Guard::new(&ctx, CharacterLink::new(&ctx, &ch)?);
+            let link = Guard::new(&ctx, CharacterLink::new(&ctx, &ch.ch)?);
             let view = match show {
                 ShowMesh::Off => None,
                 s => Some(MeshView::new(&ctx, &cam, s)?),

@@ -1,10 +1,10 @@
 //! Particle-system scenes: built-ins (`fountain`, `smoke`, `flock`, `rain`) and TOML files holding
 //! `[[system]]` tables (see tests/scenes/). Built-ins use no asset files.
-use super::spec::*;
-use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
+use crate::kinds::{Integrator, SortAlgo, SpriteMode};
+use crate::psys::spec::*;
 use crate::scene::character::CharacterDesc;
-use crate::sph::scene::CameraDesc;
+use crate::scene::schema::CameraDesc;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -292,7 +292,7 @@ impl ParticleScene {
             return Ok(None);
         }
         let mut s: Self = toml::from_str(&text)
-            .map_err(|e| crate::sph::scene::toml_error(name_or_path, &text, &e))?;
+            .map_err(|e| crate::scene::schema::toml_error(name_or_path, &text, &e))?;
         if s.name.is_empty() {
             s.name = path
                 .file_stem()

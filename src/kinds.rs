@@ -1,0 +1,83 @@
+//! The closed sets of algorithm and look choices (sorts, neighbour searches, solvers,
+//! list modes, materials, ...): plain values every layer may name, below the command line
+//! (`config`), which offers them as switches. Each parses and prints as its switch spells it.
+macro_rules! switch_enum {
+    ($(#[$m:meta])* $name:ident { $($v:ident),+ $(,)? }) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+        #[serde(rename_all = "kebab-case")]
+        pub enum $name { $($v),+ }
+        impl $name {
+            /// The switch value as written on the command line.
+            pub fn as_str(self) -> String {
+                <Self as clap::ValueEnum>::to_possible_value(&self)
+                    .map(|v| v.get_name().to_string())
+                    .unwrap_or_default()
+            }
+        }
+    };
+}
+
+switch_enum!(SortAlgo {
+    OddEven,
+    Bitonic,
+    Counting,
+    None
+});
+switch_enum!(Integrator {
+    Euler,
+    Verlet,
+    Closed
+});
+switch_enum!(SpriteMode {
+    Points,
+    Streaks,
+    Sprites
+});
+switch_enum!(Neighbors { Morton, Grid, Hash });
+switch_enum!(
+    /// SPH pressure solver: weakly compressible (the papers'), or the incompressible
+    /// predictive-corrective, divergence-free and position-based ones.
+    Solver {
+        Wcsph,
+        Pcisph,
+        Dfsph,
+        Pbf
+    }
+);
+
+switch_enum!(ListKind {
+    None,
+    Abuffer,
+    Sbuffer
+});
+switch_enum!(DensityFn {
+    Blinn,
+    Wyvill,
+    Nishimura,
+    Murakami
+});
+switch_enum!(Material {
+    Phong,
+    Glass,
+    Tinted,
+    Gold,
+    Copper,
+    Aluminium
+});
+switch_enum!(EmitterKind { Uv, Vertices });
+switch_enum!(Placement {
+    Vertices,
+    Random,
+    Rays
+});
+switch_enum!(Skinning { Lbs, Dqs });
+switch_enum!(OnOff { On, Off });
+switch_enum!(Adaptive { Off, On, Smooth });
+switch_enum!(ControlPreset { Thesis, Fidelity });
+switch_enum!(ControlMotion { Frames, Skin });
+switch_enum!(BoneWeights { Eq8, Eq9, Skin });
+switch_enum!(Offscreen { All, End });
+switch_enum!(RenderKind { Metaballs, Points });
+switch_enum!(ShowMesh { Off, Shaded, Wire });
+pub(crate) use switch_enum;

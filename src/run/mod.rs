@@ -1,0 +1,241 @@
+//! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
+//! Every scene kind is a `FrameWork` played by `session::play`.
+use crate::animation::Animation;
+use crate::config::Switches;
+use crate::config::{Neighbors, RenderKind, ShowMesh, Skinning, SortAlgo};
+use crate::error::{Error, Result};
+use crate::gpu::target::save_rgba;
+use crate::gpu::{sync, Context, FrameWork, Guard, Profiler};
+use crate::render::Camera;
+use crate::report::{Report, Summary};
+use crate::scene::character::{CharacterStats, SceneCharacter};
+pub use crate::session::{camera_with_switches, check_validation, SLOTS};
+use crate::session::{open, play};
+use crate::sph::FluidParams;
+use crate::viewer::{Picture, PointsViewer, View};
+use ash::vk;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+mod character;
+mod orbits;
+pub mod particles;
+mod sph;
+use character::run_character;
+use orbits::run_orbits;
+use sph::run_sph;
+
+pub struct RunOptions {
+    pub scene: String,
+    /// Frames to play; None: the scene's own count (orbits: 120).
+    pub frames: Option<u64>,
+    pub out: PathBuf,
+    /// Save every k-th frame as PNG; 0 saves none.
+    pub save_every: u64,
+    pub switches: Switches,
+}
+
+pub const DEFAULT_SCENE: &str = "character";
+
+/// `config` of a run's summary.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunConfig {
+    pub command: String,
+    pub scene: String,
+    pub frames: u64,
+    pub save_every: u64,
+    pub particles: u64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub neighbors: Option<Neighbors>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sort: Option<SortAlgo>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub render: Option<RenderKind>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fluid: Option<FluidParams>,
+    pub switches: Switches,
+}
+
+/// `stats` of the orbits scene (strict, so an SPH block never reads back as this).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitsStats {
+    pub particles: u32,
+}
+
+/// `stats` of a scene with a character and no fluid.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterRunStats {
+    pub character: CharacterStats,
+    pub render: crate::viewer::RenderSummary,
+}
+
+/// `stats` of a run, by scene kind.
+/// `stats` of an SPH run.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SphRunStats {
+    #[serde(flatten)]
+    pub physics: crate::sph::run::PhysicsStats,
+    pub steps: u64,
+    pub simulated_seconds: f64,
+    pub render: crate::viewer::RenderSummary,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub character: Option<crate::scene::character::CharacterStats>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<crate::scene::targets::ControlSummary>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<crate::scene::emission::EmissionStats>,
+    /// The density error of every step (per step in steps.csv).
+    #[serde(default)]
+    pub density_error: crate::sph::errors::DensityErrorStats,
+    /// The scene's particle systems, if any.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub particle_systems: Vec<crate::run::particles::SystemStats>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum RunStats {
+    Sph(Box<SphRunStats>),
+    Character(Box<CharacterRunStats>),
+    Orbits(OrbitsStats),
+    Particles(Box<crate::run::particles::ParticleRunStats>),
+}
+
+pub type RunSummary = Summary<RunConfig, RunStats>;
+
+/// The run's outcome: the summary written and the frames saved.
+pub struct RunResult {
+    pub summary: RunSummary,
+    pub pngs: Vec<PathBuf>,
+    /// animation.png (APNG) of the saved frames, when any were saved.
+    pub animation: Option<PathBuf>,
+    /// Particle files written by --export.
+    pub exports: Vec<PathBuf>,
+}
+
+/// Frames per second the animation plays at.
+pub const ANIMATION_FPS: u16 = 30;
+
+/// Where saved frames go: frame_NNNN.png each, and animation.png (APNG) of them all.
+pub(crate) struct Frames<'a> {
+    out: &'a Path,
+    every: u64,
+    /// Frames the run plays.
+    total: u64,
+    pngs: Vec<PathBuf>,
+    animation: Option<Animation>,
+}
+
+impl<'a> Frames<'a> {
+    pub(crate) fn new(out: &'a Path, every: u64, total: u64) -> Self {
+        Self {
+            out,
+            every,
+            total,
+            pngs: Vec::new(),
+            animation: None,
+        }
+    }
+
+    pub(crate) fn save(&self, f: u64) -> bool {
+        self.every > 0 && f.is_multiple_of(self.every)
+    }
+
+    /// Write frame `f`'s picture as a PNG and as the animation's next frame.
+    pub(crate) fn store(&mut self, f: u64, pic: Option<Picture>) -> Result<()> {
+        let Some(pic) = pic else { return Ok(()) };
+        let path = self.out.join(format!("frame_{f:04}.png"));
+        save_rgba(&path, pic.width, pic.height, pic.rgba)?;
+        self.pngs.push(path);
+        if self.animation.is_none() {
+            let saved = (self.total - 1) / self.every + 1;
+            self.animation = Some(Animation::create(
+                &self.out.join("animation.png"),
+                pic.width,
+                pic.height,
+                saved as u32,
+                ANIMATION_FPS,
+            )?);
+        }
+        if let Some(a) = &mut self.animation {
+            a.add(pic.rgba, pic.width, pic.height)?;
+        }
+        Ok(())
+    }
+
+    /// Close the animation; its path, when frames were saved.
+    fn finish(&mut self) -> Result<Option<PathBuf>> {
+        self.animation.take().map(Animation::finish).transpose()
+    }
+}
+
+/// The metaball radius at the default particle spacing (MetaballSettings' default).
+const DEFAULT_RADIUS: f32 = 0.04;
+
+pub fn run(opts: &RunOptions) -> Result<RunResult> {
+    if opts.frames == Some(0) {
+        return Err(Error::Param("--frames must be at least 1".into()));
+    }
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
+        path: opts.out.display().to_string(),
+        source: e,
+    })?;
+    if opts.scene == "orbits" {
+        return run_orbits(opts);
+    }
+    if let Some(scene) = crate::scene::particles::ParticleScene::find(&opts.scene)? {
+        return crate::run::particles::run(opts, scene);
+    }
+    let scene = crate::scene::Scene::load(&opts.scene)?;
+    match scene.has_fluid() {
+        true => run_sph(opts, scene),
+        false => run_character(opts, scene),
+    }
+}
+
+/// The end of a run without fluid (orbits, a character alone): the animation closed,
+/// summary.json written, validation checked.
+pub(crate) fn finish_fluidless(
+    ctx: &Context,
+    opts: &RunOptions,
+    sw: &Switches,
+    (scene, frames, particles): (&str, u64, u64),
+    (timings, memory): (
+        &[crate::gpu::FrameTiming],
+        std::collections::BTreeMap<String, u64>,
+    ),
+    stats: RunStats,
+    mut saved: Frames,
+) -> Result<RunResult> {
+    let animation = saved.finish()?;
+    let config = RunConfig {
+        command: "run".into(),
+        scene: scene.to_string(),
+        frames,
+        save_every: opts.save_every,
+        particles,
+        neighbors: None,
+        sort: None,
+        render: None,
+        fluid: None,
+        switches: sw.clone(),
+    };
+    let report = Report {
+        device: &ctx.info,
+        config,
+        timings,
+        memory,
+        stats,
+        validation: sw.common.validation.then(|| ctx.validation_counts()),
+    };
+    let summary = report.write(&opts.out)?;
+    check_validation(ctx)?;
+    Ok(RunResult {
+        summary,
+        pngs: saved.pngs,
+        animation,
+        exports: Vec::new(),
+    })
+}

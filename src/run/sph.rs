@@ -1,0 +1,332 @@
+//! `run` of an SPH scene: the fluid stepped per frame with the scene's characters,
+//! control targets, emission and particle systems, and the view.
+use super::*;
+
+/// An SPH scene: steps per frame and the view.
+struct SphWork<'a> {
+    solver: crate::sph::SphSolver,
+    st: crate::sph::SphState,
+    stepper: crate::sph::run::Stepper,
+    view: Box<dyn crate::viewer::View>,
+    frames: Frames<'a>,
+    export: Option<crate::export::ParticleExport>,
+    targets: crate::scene::targets::SceneTargets,
+    /// The scene's particle systems, stepped once per frame after the fluid.
+    systems: Option<crate::run::particles::SceneSystems>,
+}
+
+impl FrameWork for SphWork<'_> {
+    fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        let frame_dt = self.stepper.frame_time as f32;
+        self.targets
+            .record_poses(frame, self.stepper.sim_time, frame_dt, slot)?;
+        let (steps, _) = self.stepper.plan(&self.st);
+        let t0 = self.stepper.sim_time;
+        self.targets
+            .record_before(ctx, cmd, prof, &mut self.st, t0, frame_dt, steps)?;
+        let hooks = &mut self.targets.hooks();
+        self.stepper
+            .record_frame(ctx, cmd, prof, &self.solver, &mut self.st, (slot, hooks))?;
+        let t = self.stepper.sim_time;
+        self.targets
+            .record_after(ctx, cmd, prof, &self.st, t, (frame, slot))?;
+        // The step's positions -> the view's copies and shaders.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::TRANSFER_READ | sync::GRAPHICS_READ,
+        );
+        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+            e.record(ctx, cmd, &self.st, slot, self.stepper.sim_time);
+        }
+        if let Some(s) = &mut self.systems {
+            s.record_simulation(ctx, cmd, prof, frame, None)?;
+        }
+        let save = self.frames.save(frame);
+        let st = &self.st;
+        let mesh = self.targets.draw();
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let layers = crate::viewer::Layers {
+            mesh: mesh.as_ref(),
+            overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
+        };
+        self.view.record(
+            ctx,
+            cmd,
+            prof,
+            st.pos(),
+            st.attr(),
+            st.n,
+            layers,
+            slot,
+            save,
+        )
+    }
+
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        self.stepper.retire_slot(slot, frame)?;
+        self.targets.retire(slot, frame, &self.st.fluid)?;
+        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+            e.retire(frame, slot)?;
+        }
+        let save = self.frames.save(frame);
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
+        let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
+        self.frames.store(frame, pic)
+    }
+}
+
+impl SphWork<'_> {
+    fn destroy(&mut self, ctx: &Context) {
+        self.stepper.destroy(ctx);
+        if let Some(e) = &mut self.export {
+            e.destroy(ctx);
+        }
+        self.view.destroy(ctx);
+        if let Some(s) = &mut self.systems {
+            s.destroy(ctx);
+        }
+        self.targets.destroy(ctx);
+        self.st.destroy(ctx);
+        self.solver.destroy(ctx);
+    }
+}
+
+pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<RunResult> {
+    use crate::sph::run::{check, physics_stats, Stepper};
+    use crate::sph::SphSolver;
+    use crate::viewer::{MetaballViewer, PointsViewer, View};
+    let sw = &opts.switches;
+    let render = sw
+        .view
+        .render
+        .or(scene.look.render)
+        .unwrap_or(RenderKind::Metaballs);
+    use crate::config::Group;
+    let mut uses = vec![
+        Group::Sort,
+        Group::Neighbors,
+        Group::Fluid,
+        Group::View,
+        Group::Export,
+        Group::Camera,
+    ];
+    if render == RenderKind::Metaballs {
+        uses.push(Group::Metaball);
+    }
+    if scene.character.is_some() || !scene.targets.is_empty() {
+        uses.push(Group::Character);
+    }
+    if !scene.control_targets().is_empty() {
+        uses.push(Group::Control);
+    }
+    if scene.emission.is_some() {
+        uses.push(Group::Emission);
+    }
+    if !scene.system.is_empty() {
+        uses.push(Group::Particles);
+    }
+    sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
+    use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
+    let mut scene = scene;
+    // The scene's look where the switches leave it open; summary.json records the result.
+    let mut sw = scene.look.apply(sw);
+    scene.fluid = sw.fluid_args.apply(&scene.fluid)?;
+    // A liquid character's spacing and pool from its character (scene::fit).
+    for line in crate::scene::fit::fit(&mut scene)?.describe() {
+        if !sw.common.quiet {
+            eprintln!("{}: {line}", scene.name);
+        }
+    }
+    // The metaballs' radius follows the particle spacing (0.04 m at the default spacing).
+    if sw.metaball.radius.is_none() && scene.fluid.spacing.is_some() {
+        let s0 = crate::sph::FluidParams::default().spacing();
+        sw.metaball.radius = Some(DEFAULT_RADIUS * scene.fluid.spacing() / s0);
+    }
+    let sw = &sw;
+    crate::scene::particles::set_integrator_draw(
+        &mut scene.system,
+        sw.particle.integrator,
+        sw.particle.draw,
+    );
+    // Refused before any particle or buffer is made (the count is estimated, not built).
+    scene.validate()?;
+    let per_particle = bytes_per_particle(&scene.fluid);
+    scene.check_size(MAX_PARTICLES, per_particle, 0)?;
+    let scene = match sw.common.particles {
+        Some(n) => scene.with_particles(n),
+        None => scene,
+    };
+    let frame_count = opts.frames.unwrap_or(scene.frames);
+    let ctx = open(sw)?;
+    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
+    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+    let mut solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
+    let parts = scene.particles(sw.common.seed);
+    let mut st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
+    let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
+    let cam = match &scene.camera {
+        Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
+        None => {
+            let (lo, hi) = (
+                glam::Vec3::from(scene.domain.min),
+                glam::Vec3::from(scene.domain.max),
+            );
+            let c = 0.5 * (lo + hi);
+            Camera::look_at(
+                c + glam::Vec3::new(0.0, 0.4, 1.6) * (hi - lo).length(),
+                c,
+                45.0,
+                aspect,
+            )
+        }
+    };
+    let cam = camera_with_switches(cam, sw);
+    let targets = crate::scene::targets::SceneTargets::new(
+        &ctx, &scene, sw, &solver, &mut st, &parts.pos, SLOTS,
+    )?;
+    let targets = Guard::new(&ctx, targets);
+    let show = targets.show();
+    let view: Box<dyn View> = match render {
+        RenderKind::Metaballs => {
+            let tank = scene
+                .look
+                .tank
+                .unwrap_or(true)
+                .then_some([scene.domain.min, scene.domain.max]);
+            let overlay = !scene.system.is_empty();
+            Box::new(MetaballViewer::new(
+                &ctx, sw, cam, st.n, SLOTS, tank, show, overlay,
+            )?)
+        }
+        // Spheres of half the rest spacing.
+        RenderKind::Points => Box::new(PointsViewer::new(
+            &ctx,
+            sw,
+            &cam,
+            0.5 * scene.fluid.spacing(),
+            SLOTS,
+            show,
+        )?),
+    };
+    let view = Guard::new(&ctx, view);
+    let stepper = Guard::new(&ctx, Stepper::new(&ctx, &st, SLOTS)?);
+    let systems = match scene.system.is_empty() {
+        true => None,
+        false => Some(crate::run::particles::SceneSystems::new(
+            &ctx,
+            &scene.system,
+            stepper.frame_time as f32,
+            cam,
+            sw.frame.width(),
+            sw.frame.height(),
+            sw.common.seed,
+        )?),
+    };
+    let systems = Guard::new(&ctx, systems);
+    let every = sw.export.export_every.unwrap_or(1);
+    let export = sw
+        .export
+        .export
+        .map(|f| crate::export::ParticleExport::new(&ctx, f, every, &opts.out, &st, SLOTS))
+        .transpose()?;
+    let mut work = SphWork {
+        solver: solver.take(),
+        st: st.take(),
+        stepper: stepper.take(),
+        view: view.take(),
+        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+        export,
+        targets: targets.take(),
+        systems: systems.take(),
+    };
+    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
+    let memory = ctx.memory_bytes();
+    let dump = match &timings {
+        Ok(_) => Some(work.st.read(&ctx)),
+        Err(_) => None,
+    };
+    let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
+    let density_error = work.stepper.error_stats(&work.st);
+    let steps_csv = work.stepper.write_csv(&opts.out.join("steps.csv"));
+    let render_stats = work.view.stats();
+    let character_stats = work.targets.character_stats();
+    let control_stats = work.targets.control_summary(&opts.out);
+    let emission_stats = match &timings {
+        Ok(_) => work
+            .targets
+            .emission_summary(&ctx, simulated_seconds, &opts.out),
+        Err(_) => Ok(None),
+    };
+    let particle_systems = match (&timings, &work.systems) {
+        (Ok(_), Some(s)) => s
+            .systems
+            .iter()
+            .map(|s| crate::run::particles::SystemStats::of(&ctx, s))
+            .collect::<Result<Vec<_>>>(),
+        _ => Ok(Vec::new()),
+    };
+    let sort = work.solver.search.sort;
+    let exports = work
+        .export
+        .as_ref()
+        .map(|e| e.files.clone())
+        .unwrap_or_default();
+    work.destroy(&ctx);
+    let timings = timings?;
+    let animation = work.frames.finish()?;
+    let stats = SphRunStats {
+        physics: physics_stats(
+            &dump.expect("state read")?,
+            &scene.domain,
+            scene.fluid.rest_density,
+        ),
+        steps,
+        simulated_seconds,
+        render: render_stats,
+        character: character_stats?,
+        control: control_stats?,
+        emission: emission_stats?,
+        particle_systems: particle_systems?,
+        density_error,
+    };
+    steps_csv?;
+    let config = RunConfig {
+        command: "run".into(),
+        scene: scene.name.clone(),
+        frames: frame_count,
+        save_every: opts.save_every,
+        particles: stats.physics.particles as u64,
+        neighbors: Some(neighbors),
+        sort: Some(sort),
+        render: Some(render),
+        fluid: Some(scene.fluid.clone()),
+        switches: sw.clone(),
+    };
+    let physics = stats.physics.clone();
+    let report = Report {
+        device: &ctx.info,
+        config,
+        timings: &timings,
+        memory,
+        stats: RunStats::Sph(Box::new(stats)),
+        validation: sw.common.validation.then(|| ctx.validation_counts()),
+    };
+    let summary = report.write(&opts.out)?;
+    check_validation(&ctx)?;
+    check(&physics)?;
+    Ok(RunResult {
+        summary,
+        pngs: work.frames.pngs,
+        animation,
+        exports,
+    })
+}
