@@ -3,69 +3,153 @@
 //! the next step's start), then the non-pressure forces, then the constant-density solve on
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
 //! Euler (glsl/sph/dfsph.comp, euler.comp).
-use super::pressure::PressurePasses;
-use super::solver::SphState;
+use super::pressure::{PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY, LOOP_DIVERGENCE};
+use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{Context, Scopes};
+use crate::kinds::Solver;
 use ash::vk;
 
-/// After the arrange, in place of the density and forces passes: densities, factors and
-/// the step's neighbour lists, the divergence-free solve, the non-pressure forces (from the
-/// lists).
-pub fn record_divergence(
-    p: &PressurePasses,
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    scopes: &mut dyn Scopes,
-    st: &SphState,
-) -> Result<()> {
-    p.scoped(ctx, cmd, scopes, st, "factor")?;
-    solve(p, ctx, cmd, scopes, st, "divergence")?;
-    p.scoped(ctx, cmd, scopes, st, "forces")
+/// The passes, in [`PASSES`] order.
+#[derive(Clone, Copy)]
+enum Pass {
+    Factor,
+    Forces,
+    Predict,
+    WarmDensity,
+    SourceDensity,
+    VelocityDensity,
+    WarmDivergence,
+    SourceDivergence,
+    VelocityDivergence,
+    LoopDivergence,
+    LoopDensity,
+    Euler,
 }
 
-/// Warm start, sources, iterations of one solve (`mode`: divergence or density).
-fn solve(
-    p: &PressurePasses,
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    scopes: &mut dyn Scopes,
-    st: &SphState,
-    mode: &str,
-) -> Result<()> {
-    let scope = if mode == "density" { "pressure" } else { mode };
-    let (velocity, source) = (format!("velocity/{mode}"), format!("source/{mode}"));
-    scopes.begin(ctx, cmd, scope);
-    let r = p
-        .run(ctx, cmd, st, &format!("warm/{mode}"))
-        .and_then(|_| p.run(ctx, cmd, st, &source))
-        .and_then(|_| {
-            p.solve(
-                ctx,
-                cmd,
-                scopes,
-                st,
-                (
+pub const PASSES: [PassDecl; 12] = [
+    ("factor", "sph/dfsph.comp", "PASS_FACTOR", false),
+    ("forces", "sph/forces.comp", "PASS_FORCES", false),
+    ("predict", "sph/dfsph.comp", "PASS_PREDICT", false),
+    ("warm/density", "sph/dfsph.comp", "PASS_WARM", false),
+    ("source/density", "sph/dfsph.comp", "PASS_SOURCE", false),
+    ("velocity/density", "sph/dfsph.comp", "PASS_VELOCITY", false),
+    ("warm/divergence", "sph/dfsph.comp", "PASS_WARM", true),
+    ("source/divergence", "sph/dfsph.comp", "PASS_SOURCE", true),
+    (
+        "velocity/divergence",
+        "sph/dfsph.comp",
+        "PASS_VELOCITY",
+        true,
+    ),
+    LOOP_DIVERGENCE,
+    LOOP_DENSITY,
+    EULER,
+];
+
+/// One of the two solves: its scope, passes and loop pass.
+struct Solve {
+    scope: &'static str,
+    warm: Pass,
+    source: Pass,
+    velocity: Pass,
+    check: Pass,
+    divergence: bool,
+}
+
+const DIVERGENCE: Solve = Solve {
+    scope: "divergence",
+    warm: Pass::WarmDivergence,
+    source: Pass::SourceDivergence,
+    velocity: Pass::VelocityDivergence,
+    check: Pass::LoopDivergence,
+    divergence: true,
+};
+
+const DENSITY: Solve = Solve {
+    scope: "pressure",
+    warm: Pass::WarmDensity,
+    source: Pass::SourceDensity,
+    velocity: Pass::VelocityDensity,
+    check: Pass::LoopDensity,
+    divergence: false,
+};
+
+pub struct Dfsph(Pipelines);
+
+impl Dfsph {
+    pub fn new(ctx: &Context, base: &[(&str, String)]) -> Result<Self> {
+        Pipelines::new(ctx, Solver::Dfsph, &PASSES, base).map(Self)
+    }
+
+    /// Warm start, sources, iterations of one solve.
+    fn solve(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+        s: &Solve,
+    ) -> Result<()> {
+        let p = &self.0;
+        scopes.begin(ctx, cmd, s.scope);
+        let body = [s.velocity as usize, s.source as usize];
+        let r = p
+            .run(ctx, cmd, st, s.warm as usize)
+            .and_then(|_| p.run(ctx, cmd, st, s.source as usize))
+            .and_then(|_| {
+                let check = s.check as usize;
+                p.solve(
+                    ctx,
+                    cmd,
+                    scopes,
+                    st,
                     "iterations",
-                    &[velocity.as_str(), source.as_str()],
-                    mode == "divergence",
-                ),
-            )
-        });
-    scopes.end(ctx, cmd);
-    r
+                    (&body, check),
+                    s.divergence,
+                )
+            });
+        scopes.end(ctx, cmd);
+        r
+    }
 }
 
-/// After the forces and the force hooks: predicted velocities, the constant-density solve,
-/// the positions.
-pub fn record_density(
-    p: &PressurePasses,
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    scopes: &mut dyn Scopes,
-    st: &SphState,
-) -> Result<()> {
-    p.scoped(ctx, cmd, scopes, st, "predict")?;
-    solve(p, ctx, cmd, scopes, st, "density")?;
-    p.scoped(ctx, cmd, scopes, st, "euler")
+impl PressureSolver for Dfsph {
+    fn kind(&self) -> Solver {
+        Solver::Dfsph
+    }
+
+    /// In place of the density and forces passes: densities, factors and the step's
+    /// neighbour lists, the divergence-free solve, the non-pressure forces (from the lists).
+    fn record_forces(
+        &self,
+        _: &SphSolver,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()> {
+        self.0.scoped(ctx, cmd, scopes, st, Pass::Factor as usize)?;
+        self.solve(ctx, cmd, scopes, st, &DIVERGENCE)?;
+        self.0.scoped(ctx, cmd, scopes, st, Pass::Forces as usize)
+    }
+
+    /// Predicted velocities, the constant-density solve, the positions.
+    fn record_solve(
+        &self,
+        _: &SphSolver,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()> {
+        self.0
+            .scoped(ctx, cmd, scopes, st, Pass::Predict as usize)?;
+        self.solve(ctx, cmd, scopes, st, &DENSITY)?;
+        self.0.scoped(ctx, cmd, scopes, st, Pass::Euler as usize)
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.0.destroy(ctx);
+    }
 }

@@ -15,6 +15,7 @@ pub mod run;
 pub mod setup;
 pub mod solver;
 pub mod spacing;
+pub mod wcsph;
 
 pub use params::{Collider, Eos, FluidParams};
 pub use setup::{Particles, SphSetup};

@@ -4,7 +4,7 @@
 //! a one-workgroup pass (solve_loop.comp) that reduces the iteration's error on the GPU and,
 //! once the solve has converged, zeroes the group count of the indirect dispatches that
 //! remain: no read-back per iteration, and skipped iterations cost an empty dispatch.
-use super::solver::{SphState, LOCAL_SIZE};
+use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::Solver;
@@ -59,56 +59,80 @@ pub fn list_bytes(len: u32) -> u64 {
 }
 
 /// A pass: (name, shader, PASS, DIVERGENCE).
-type PassDecl = (&'static str, &'static str, &'static str, bool);
+pub type PassDecl = (&'static str, &'static str, &'static str, bool);
 
-const LOOP_DENSITY: PassDecl = ("loop/density", "sph/solve_loop.comp", "PASS_LOOP", false);
-const LOOP_DIVERGENCE: PassDecl = ("loop/divergence", "sph/solve_loop.comp", "PASS_LOOP", true);
-const EULER: PassDecl = ("euler", "sph/euler.comp", "PASS_EULER", false);
+pub const LOOP_DENSITY: PassDecl = ("loop/density", "sph/solve_loop.comp", "PASS_LOOP", false);
+pub const LOOP_DIVERGENCE: PassDecl = ("loop/divergence", "sph/solve_loop.comp", "PASS_LOOP", true);
+pub const EULER: PassDecl = ("euler", "sph/euler.comp", "PASS_EULER", false);
 
-/// The passes of each incompressible solver.
-pub fn passes(solver: Solver) -> Vec<PassDecl> {
-    let mut v: Vec<PassDecl> = match solver {
-        Solver::Wcsph => return Vec::new(),
-        Solver::Pcisph => ["factor", "predict", "pressure", "accel"]
-            .iter()
-            .zip(["PASS_FACTOR", "PASS_PREDICT", "PASS_PRESSURE", "PASS_ACCEL"])
-            .map(|(n, p)| (*n, "sph/pcisph.comp", p, false))
-            .collect(),
-        Solver::Dfsph => vec![
-            ("factor", "sph/dfsph.comp", "PASS_FACTOR", false),
-            ("forces", "sph/forces.comp", "PASS_FORCES", false),
-            ("predict", "sph/dfsph.comp", "PASS_PREDICT", false),
-            ("warm/density", "sph/dfsph.comp", "PASS_WARM", false),
-            ("source/density", "sph/dfsph.comp", "PASS_SOURCE", false),
-            ("velocity/density", "sph/dfsph.comp", "PASS_VELOCITY", false),
-            ("warm/divergence", "sph/dfsph.comp", "PASS_WARM", true),
-            ("source/divergence", "sph/dfsph.comp", "PASS_SOURCE", true),
-            (
-                "velocity/divergence",
-                "sph/dfsph.comp",
-                "PASS_VELOCITY",
-                true,
-            ),
-            LOOP_DIVERGENCE,
-        ],
-        Solver::Pbf => [
-            ("predict", "PASS_PREDICT"),
-            ("lambda", "PASS_LAMBDA"),
-            ("delta", "PASS_DELTA"),
-            ("apply", "PASS_APPLY"),
-            ("velocity", "PASS_VELOCITY"),
-            ("vorticity", "PASS_VORTICITY"),
-            ("confine", "PASS_CONFINE"),
-        ]
-        .iter()
-        .map(|(n, p)| (*n, "sph/pbf.comp", *p, false))
-        .collect(),
-    };
-    v.push(LOOP_DENSITY);
-    if solver != Solver::Pbf {
-        v.push(EULER);
+/// A solver's constructor (`base`: the neighbour search's and the EOS's defines).
+type Make = fn(&Context, &[(&str, String)]) -> Result<Box<dyn PressureSolver>>;
+
+/// Each solver's pass table and constructor: its one registration line.
+fn registered(kind: Solver) -> (&'static [PassDecl], Make) {
+    use super::{dfsph::Dfsph, pbf::Pbf, pcisph::Pcisph, wcsph::Wcsph};
+    match kind {
+        Solver::Wcsph => (&[], |_, _| Ok(Box::new(Wcsph))),
+        Solver::Pcisph => (&super::pcisph::PASSES, |c, b| {
+            Ok(Box::new(Pcisph::new(c, b)?))
+        }),
+        Solver::Dfsph => (&super::dfsph::PASSES, |c, b| {
+            Ok(Box::new(Dfsph::new(c, b)?))
+        }),
+        Solver::Pbf => (&super::pbf::PASSES, |c, b| Ok(Box::new(Pbf::new(c, b)?))),
     }
-    v
+}
+
+/// The passes of each solver (the every-shader-compiles registry reads them too).
+pub fn passes(solver: Solver) -> Vec<PassDecl> {
+    registered(solver).0.to_vec()
+}
+
+/// Build `kind`'s passes (`base`: the neighbour search's and the EOS's defines).
+pub fn build(
+    ctx: &Context,
+    kind: Solver,
+    base: &[(&str, String)],
+) -> Result<Box<dyn PressureSolver>> {
+    (registered(kind).1)(ctx, base)
+}
+
+/// A pressure solver: what a step records after the arrange. The base passes (density,
+/// forces, integrate) are `SphSolver`'s; a solver adds its own around them.
+pub trait PressureSolver {
+    fn kind(&self) -> Solver;
+
+    /// Whether its states need [`PressureBuffers`].
+    fn buffers(&self) -> bool {
+        true
+    }
+
+    /// After the arrange, before the force hooks: densities, and the non-pressure forces
+    /// into `acc`.
+    fn record_forces(
+        &self,
+        base: &SphSolver,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()> {
+        base.record_density(ctx, cmd, scopes, st);
+        base.record_forces(ctx, cmd, scopes, st);
+        Ok(())
+    }
+
+    /// After the force hooks: the pressure solve, new velocities and positions.
+    fn record_solve(
+        &self,
+        base: &SphSolver,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        st: &SphState,
+    ) -> Result<()>;
+
+    fn destroy(&mut self, ctx: &Context);
 }
 
 const PASS_NAMES: [&str; 15] = [
@@ -146,37 +170,41 @@ pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
     v
 }
 
-/// `SOLVER_WCSPH`, ... for glsl/sph/common.glsl.
+/// `SOLVER_WCSPH`, ... for glsl/sph/common.glsl, one per `kinds::Solver` value.
 pub fn solver_defines() -> Vec<(String, String)> {
-    crate::gpu::interface::enum_defines(
-        "SOLVER",
-        &[
-            ("wcsph", Solver::Wcsph as u32),
-            ("pcisph", Solver::Pcisph as u32),
-            ("dfsph", Solver::Dfsph as u32),
-            ("pbf", Solver::Pbf as u32),
-        ],
-    )
+    use clap::ValueEnum;
+    let names: Vec<(String, u32)> = Solver::value_variants()
+        .iter()
+        .map(|s| (s.as_str(), *s as u32))
+        .collect();
+    let refs: Vec<(&str, u32)> = names.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    crate::gpu::interface::enum_defines("SOLVER", &refs)
 }
 
-/// One solver's pipelines, by pass name.
-pub struct PressurePasses {
-    pub solver: Solver,
-    pipelines: Vec<(&'static str, ComputePipeline<PressureIo>)>,
+/// A solver's pipelines, built in the order of its pass table; the solver's pass enum
+/// (declared with the table, in its order) indexes them: typed handles, no name lookup.
+pub struct Pipelines {
+    table: &'static [PassDecl],
+    list: Vec<ComputePipeline<PressureIo>>,
 }
 
-impl PressurePasses {
+impl Pipelines {
     /// `base`: the neighbour search's and the EOS's defines.
-    pub fn new(ctx: &Context, solver: Solver, base: &[(&str, String)]) -> Result<Self> {
+    pub fn new(
+        ctx: &Context,
+        solver: Solver,
+        table: &'static [PassDecl],
+        base: &[(&str, String)],
+    ) -> Result<Self> {
         let mut out = Guard::new(
             ctx,
             Self {
-                solver,
-                pipelines: Vec::new(),
+                table,
+                list: Vec::new(),
             },
         );
-        for d in passes(solver) {
-            let own = pass_defines(&d);
+        for d in table {
+            let own = pass_defines(d);
             let mut defines: Vec<(&str, String)> = base.to_vec();
             defines.extend(crate::gpu::pipeline::as_refs(&own));
             let local = if d.2 == "PASS_LOOP" {
@@ -186,59 +214,60 @@ impl PressurePasses {
             };
             let label = format!("{}/{}", solver.as_str(), d.0);
             let p = ComputePipeline::new(ctx, &ComputeDesc::plain(&label, d.1, &defines, local))?;
-            out.pipelines.push((d.0, p));
+            out.list.push(p);
         }
         Ok(out.take())
     }
 
-    fn get(&self, name: &str) -> &ComputePipeline<PressureIo> {
-        &self
-            .pipelines
-            .iter()
-            .find(|(n, _)| *n == name)
-            .expect("every pass of passes() is built")
-            .1
+    /// Pass `k` of the table: its name (the timestamp scope) and pipeline.
+    fn pass(&self, k: usize) -> (&'static str, &ComputePipeline<PressureIo>) {
+        (self.table[k].0, &self.list[k])
     }
 
-    /// One pass over every particle, then its writes -> the next pass.
+    /// Pass `k` over every particle, then its writes -> the next pass.
     pub fn run(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         st: &SphState,
-        name: &str,
+        k: usize,
     ) -> Result<()> {
         let b = st.pressure_bufs()?;
-        self.get(name)
+        self.pass(k)
+            .1
             .dispatch(ctx, cmd, &b, &st.neighbor_push(), st.n as u64);
         ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
         Ok(())
     }
 
-    /// [`run`](Self::run) inside its own timestamp scope.
+    /// [`run`](Self::run) inside a timestamp scope named after the pass.
     pub fn scoped(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
-        name: &str,
+        k: usize,
     ) -> Result<()> {
-        scopes.begin(ctx, cmd, name);
-        let r = self.run(ctx, cmd, st, name);
+        scopes.begin(ctx, cmd, self.pass(k).0);
+        let r = self.run(ctx, cmd, st, k);
         scopes.end(ctx, cmd);
         r
     }
 
-    /// An iterative solve: `body` passes per iteration (the one that reduces the error
-    /// among them), then the loop pass, `max_iter` times, in the scope `scope`.
+    /// An iterative solve in the scope `scope`: the `body` passes per iteration (the one
+    /// that reduces the error among them), then the loop pass `check`, `max_iter` times;
+    /// `divergence`: the divergence solve (its own iteration bound).
+    #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
-        (scope, body, divergence): (&str, &[&str], bool),
+        scope: &str,
+        (body, check): (&[usize], usize),
+        divergence: bool,
     ) -> Result<()> {
         let b = st.pressure_bufs()?;
         let solve = st.pressure()?.solve();
@@ -266,12 +295,8 @@ impl PressurePasses {
             sync::TRANSFER_WRITE,
             sync::COMPUTE_READ | sync::INDIRECT_READ,
         );
-        let check = self.get(if divergence {
-            LOOP_DIVERGENCE.0
-        } else {
-            LOOP_DENSITY.0
-        });
-        let body: Vec<_> = body.iter().map(|name| self.get(name)).collect();
+        let check = self.pass(check).1;
+        let body: Vec<_> = body.iter().map(|k| self.pass(*k).1).collect();
         for _ in 0..recorded {
             for p in &body {
                 p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
@@ -290,7 +315,7 @@ impl PressurePasses {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for (_, p) in &mut self.pipelines {
+        for p in &mut self.list {
             p.destroy(ctx);
         }
     }
@@ -426,4 +451,4 @@ impl SphState {
     }
 }
 
-crate::impl_destroy!(PressurePasses, PressureBuffers);
+crate::impl_destroy!(Pipelines, PressureBuffers);

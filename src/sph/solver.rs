@@ -1,11 +1,11 @@
 //! The GPU SPH step: pre-arrange hooks, arrange (neighbour keys, sort, cell ranges, every
 //! reordered attribute into sorted order), density, forces, extra force terms, integrate.
 //! Every pass a compute shader. Particle state is a registry (particles.rs): a hook adds
-//! its own attribute with one `register` call and its pass with `add_force` or
-//! `add_pre_arrange` (hooks.rs).
+//! its own attribute with one `register` call; its pass is an `SphHook` lent to each step
+//! (hooks.rs).
 use super::hooks::{Hooks, SphHook};
 use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
-use super::pressure::{PressureBuffers, PressurePasses};
+use super::pressure::{PressureBuffers, PressureSolver};
 use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
 use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
@@ -88,8 +88,8 @@ pub struct SphSolver {
     density: ComputePipeline<SphIo>,
     forces: ComputePipeline<SphIo>,
     integrate: ComputePipeline<SphIo>,
-    /// The incompressible solvers' passes, built by `state` for the scene's solver.
-    pressure: Vec<PressurePasses>,
+    /// The pressure solvers built so far (`state` builds its fluid's).
+    pressure: Vec<Box<dyn PressureSolver>>,
     /// The neighbour search's and the EOS's defines (for those passes).
     defines: Vec<(String, String)>,
 }
@@ -276,13 +276,17 @@ impl SphSolver {
     }
 
     /// Build the passes of `solver` (once).
-    pub fn prepare(&mut self, ctx: &Context, solver: Solver) -> Result<()> {
-        if solver == Solver::Wcsph || self.pressure.iter().any(|p| p.solver == solver) {
-            return Ok(());
-        }
-        let p = PressurePasses::new(ctx, solver, &crate::gpu::pipeline::as_refs(&self.defines))?;
-        self.pressure.push(p);
-        Ok(())
+    pub fn prepare(&mut self, ctx: &Context, solver: Solver) -> Result<&dyn PressureSolver> {
+        let k = match self.pressure.iter().position(|p| p.kind() == solver) {
+            Some(k) => k,
+            None => {
+                let refs = crate::gpu::pipeline::as_refs(&self.defines);
+                self.pressure
+                    .push(super::pressure::build(ctx, solver, &refs)?);
+                self.pressure.len() - 1
+            }
+        };
+        Ok(self.pressure[k].as_ref())
     }
 
     /// Buffers for `particles` in the fluid `setup` (a scene gives one), uploaded; the
@@ -335,10 +339,9 @@ impl SphSolver {
                 (MAX_COLLIDERS * std::mem::size_of::<GpuCollider>()) as u64,
             )?,
         );
-        self.prepare(ctx, f.solver)?;
-        let pressure = match f.solver {
-            Solver::Wcsph => None,
-            _ => Some(PressureBuffers::new(ctx, n as u64, f.list_len())?),
+        let pressure = match self.prepare(ctx, f.solver)?.buffers() {
+            false => None,
+            true => Some(PressureBuffers::new(ctx, n as u64, f.list_len())?),
         };
         let pressure = Guard::new(ctx, pressure);
         let nb = self.search.buffers(ctx, n as u64, &grid, 0)?;
@@ -477,33 +480,22 @@ impl SphSolver {
         hooks: &mut Hooks,
     ) -> Result<()> {
         let solver = st.fluid.solver;
-        if solver != Solver::Wcsph {
+        let p = self.pressure.iter().find(|p| p.kind() == solver).ok_or_else(|| {
+            Error::Param(format!(
+                "the {} passes were not built: make the state with SphSolver::state, or call prepare",
+                solver.as_str()
+            ))
+        })?;
+        if p.buffers() {
             st.pressure()?; // a state made for another solver: a clear error, nothing recorded
-        }
-        let p = self.pressure.iter().find(|p| p.solver == solver);
-        if solver != Solver::Wcsph && p.is_none() {
-            return Err(Error::Param(format!(
-                "the {solver:?} passes were not built: make the state with SphSolver::state, or call prepare"
-            )));
         }
         scopes.begin(ctx, cmd, "sph");
         self.record_params(ctx, cmd, st);
         Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
-        match (p, solver) {
-            (Some(p), Solver::Dfsph) => super::dfsph::record_divergence(p, ctx, cmd, scopes, st)?,
-            _ => {
-                self.record_density(ctx, cmd, scopes, st);
-                self.record_forces(ctx, cmd, scopes, st);
-            }
-        }
+        p.record_forces(self, ctx, cmd, scopes, st)?;
         Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
-        match (p, solver) {
-            (Some(p), Solver::Pcisph) => super::pcisph::record(p, ctx, cmd, scopes, st)?,
-            (Some(p), Solver::Dfsph) => super::dfsph::record_density(p, ctx, cmd, scopes, st)?,
-            (Some(p), Solver::Pbf) => super::pbf::record(p, ctx, cmd, scopes, st)?,
-            _ => self.record_integrate(ctx, cmd, scopes, st),
-        }
+        p.record_solve(self, ctx, cmd, scopes, st)?;
         // The step's state -> the next step or its readers.
         ctx.compute_barrier(cmd);
         scopes.end(ctx, cmd);
