@@ -90,7 +90,10 @@ pub fn variants() -> Vec<Variant> {
                 .into_iter()
                 .map(|(k, v)| (k.to_string(), v))
                 .collect();
-            v.push(with::<neighbors::NbKeysIo>("primitives/nb_keys.comp", &d));
+            // The Morton search makes its keys in its own pass.
+            if nb != Neighbors::Morton {
+                v.push(with::<neighbors::NbKeysIo>("primitives/nb_keys.comp", &d));
+            }
             v.push(with::<neighbors::NbRangesIo>(
                 "primitives/nb_ranges.comp",
                 &d,

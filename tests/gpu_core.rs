@@ -391,3 +391,44 @@ fn every_glsl_file_compiles_with_every_define_set_the_code_uses() {
     }
     assert!(count >= 100, "only {count} shader variants compiled");
 }
+
+#[test]
+fn a_variant_switch_with_an_unknown_value_fails_to_compile() {
+    // Every multi-valued GLSL switch ends in #error: an unlisted value must not compile
+    // into a default variant.
+    let c = shader::ShaderCompiler::new().unwrap();
+    let variants = fluidform::shaders::variants();
+    let cases = [
+        ("render/metaball/march.comp", "DENSITY"),
+        ("render/metaball/march.comp", "LIST"),
+        ("render/metaball/march.comp", "MATERIAL"),
+        ("render/metaball/billboard.frag", "PASS"),
+        ("primitives/nb_query.comp", "NB_STRATEGY"),
+        ("primitives/nb_keys.comp", "NB_STRATEGY"),
+        ("control/rays.frag", "PASS"),
+        ("psys/draw.vert", "MODE"),
+        ("psys/draw.frag", "MODE"),
+        ("character/skin.comp", "SKIN_METHOD"),
+        ("control/force.comp", "ADAPTIVE"),
+        ("sph/dfsph.comp", "PASS"),
+        ("sph/pcisph.comp", "PASS"),
+        ("sph/pbf.comp", "PASS"),
+    ];
+    for (file, switch) in cases {
+        let (_, defines) = variants
+            .iter()
+            .find(|(f, d)| *f == file && d.iter().any(|(k, _)| k == switch))
+            .unwrap_or_else(|| panic!("no registered variant of {file} sets {switch}"));
+        let d: Vec<(&str, String)> = defines
+            .iter()
+            .map(|(k, v)| match k == switch {
+                true => (k.as_str(), "99".to_string()),
+                false => (k.as_str(), v.clone()),
+            })
+            .collect();
+        let e = c
+            .compile(file, &d)
+            .expect_err(&format!("{file} compiled with {switch}=99"));
+        assert!(e.to_string().contains("#error"), "{file} {switch}: {e}");
+    }
+}

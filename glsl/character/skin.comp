@@ -44,7 +44,7 @@ void main() {
     }
     out_pos[v] = vec4(a * p + t, 1.0);
     vec3 nn = cofactor(a) * n;
-#else
+#elif SKIN_METHOD == 1
     vec4 q0 = joints[joint_of(joint_ids[v * SKIN_SETS], 0u)].real;
     vec4 r = vec4(0.0), d = vec4(0.0);
     mat3 st = mat3(0.0);
@@ -65,6 +65,8 @@ void main() {
     vec3 t = 2.0 * (r.w * d.xyz - d.w * r.xyz + cross(r.xyz, d.xyz));
     out_pos[v] = vec4(rotate(r, st * p) + t, 1.0);
     vec3 nn = rotate(r, cofactor(st) * n);
+#else
+#error "SKIN_METHOD is 0 (linear blend) or 1 (dual quaternion)"
 #endif
     float l = length(nn);
     out_nrm[v] = vec4(l > 0.0 ? nn / l : vec3(0.0), 0.0);

@@ -64,8 +64,10 @@ float adaptive_factor(float rho) {
     // Ours: the pull fades continuously as the particle fills: up below low, none above
     // high, linear between (1 at the midpoint when up = 2).
     return C.up * clamp((C.high - f) / (C.high - C.low), 0.0, 1.0);
-#else
+#elif ADAPTIVE == ADAPTIVE_OFF
     return 1.0;
+#else
+#error "ADAPTIVE names no adaptive mode"
 #endif
 }
 #endif

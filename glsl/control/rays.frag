@@ -13,8 +13,10 @@ void main() {
     uint p = q.y * pc.dims.x + q.x;
 #if PASS == 0
     atomicAdd(offsets[p], 1u);
-#else
+#elif PASS == 1
     uint slot = atomicAdd(offsets[p], 1u);
     if (slot < pc.dims.w) frags[slot] = vec2(v_z, v_sign);
+#else
+#error "PASS is 0 (count) or 1 (fill)"
 #endif
 }

@@ -15,8 +15,10 @@ void main() {
     vec4 p = pos[i];
 #if NB_STRATEGY == NB_GRID
     keys[i] = p.w < 0.0 ? NB_DIMS.x * NB_DIMS.y * NB_DIMS.z : nb_grid_id(nb_grid_cell(p.xyz));
-#else
+#elif NB_STRATEGY == NB_HASH
     keys[i] = p.w < 0.0 ? NB_TABLE : nb_hash(nb_cell_of(p.xyz));
+#else
+#error "nb_keys.comp serves the grid and hash searches only"
 #endif
     vals[i] = i;
 }

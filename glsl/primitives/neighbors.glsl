@@ -64,7 +64,7 @@ uint nb_lower_bound(uint key) {  // first sorted slot with nb_keys[slot] >= key
         uint nb_s = nb_start[nb_h]; uint nb_e = NB_CELL_END(nb_h, nb_s); \
         for (uint J = nb_s; J < nb_e; ++J) {
 #define NB_END }}}
-#else
+#elif NB_STRATEGY == NB_MORTON
 // Seed 000: the query box's corner codes bound a contiguous range of the sorted array.
 // NB_UNROLL candidates per iteration of the outer loop, the inner loop unrolled away:
 // llvmpipe stops an invocation's loops after about 65535 iterations in total, and a range
@@ -82,6 +82,8 @@ uint nb_lower_bound(uint key) {  // first sorted slot with nb_keys[slot] >= key
         uint J = nb_b + nb_u; \
         if (!nb_more || J >= NB_N || nb_keys[J] > nb_hi) { nb_more = false; continue; }
 #define NB_END }}}
+#else
+#error "NB_STRATEGY names no neighbour search"
 #endif
 #endif // NB_CELL_ONLY
 #endif

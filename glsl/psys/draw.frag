@@ -19,7 +19,7 @@ void main() {
     out_color = vec4(col.rgb, 1.0);
 #elif MODE == 1
     out_color = vec4(col.rgb, col.a * mix(0.15, 1.0, uv.x));  // the tail fades
-#else
+#elif MODE == 2
     float n = pc.screen.w;
     vec2 f = (uv * 0.5 + 0.5) * n - 0.5;
     ivec2 i = ivec2(floor(f));
@@ -28,5 +28,7 @@ void main() {
                   mix(texel(i + ivec2(0, 1)), texel(i + ivec2(1, 1)), w.x), w.y);
     out_color = vec4(col.rgb, col.a * a);
     if (out_color.a < 1.0 / 255.0) discard;
+#else
+#error "MODE is 0 (points), 1 (streaks) or 2 (sprites)"
 #endif
 }

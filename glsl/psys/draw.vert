@@ -22,8 +22,10 @@ void main() {
     const uint VERTS = 1u;
 #elif MODE == 1
     const uint VERTS = 2u;
-#else
+#elif MODE == 2
     const uint VERTS = 6u;
+#else
+#error "MODE is 0 (points), 1 (streaks) or 2 (sprites)"
 #endif
     uint inst = uint(gl_VertexIndex) / VERTS, corner = uint(gl_VertexIndex) % VERTS;
     uint slot = pc.identity == 1u ? inst : order[pc.offset + inst];
@@ -59,10 +61,12 @@ void main() {
 #elif MODE == 1
     gl_Position = pc.view_proj * vec4(corner == 0u ? before : p, 1.0);
     uv = vec2(corner == 0u ? 0.0 : 1.0, 0.0);  // 0 at the tail
-#else
+#elif MODE == 2
     vec2 k = corners[corner];
     vec3 world = p + (k.x * pc.right.xyz + k.y * pc.up.xyz) * 0.5 * size;
     gl_Position = pc.view_proj * vec4(world, 1.0);
     uv = k;
+#else
+#error "MODE is 0 (points), 1 (streaks) or 2 (sprites)"
 #endif
 }

@@ -152,5 +152,7 @@ void main() {
     wall_response(pos[i].xyz, dt, v);
     vel[i].xyz = v;
     vhalf[i].w = aux2[i].y;
+#else
+#error "PASS names no DFSPH pass"
 #endif
 }

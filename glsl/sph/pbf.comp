@@ -108,5 +108,7 @@ void main() {
     float el = length(eta);
     vec3 f = el > 1e-6 / P.h ? P.vorticity * cross(eta / el, wi) : vec3(0.0);
     vel[i].xyz += dt * f + aux2[i].xyz;
+#else
+#error "PASS names no PBF pass"
 #endif
 }

@@ -72,5 +72,7 @@ void main() {
     NB_END
     // p is in units of rho0 (see delta): a = -V sum (p_i + p_j) grad W.
     aux2[i] = vec4(vol0() * a, 0.0);
+#else
+#error "PASS names no PCISPH pass"
 #endif
 }

@@ -15,9 +15,11 @@ void main() {
 #elif PASS == 1
     uint slot = atomicAdd(offsets[p], 1u);
     if (slot < P.list_capacity) list[slot] = v_id; else atomicAdd(stats.overflow, 1u);
-#else
+#elif PASS == 2
     uint node = atomicAdd(stats.abuffer_nodes, 1u);
     if (node < P.list_capacity) nodes[node] = uvec2(v_id, atomicExchange(heads[p], node));
     else atomicAdd(stats.overflow, 1u);
+#else
+#error "PASS is 0 (count), 1 (fill) or 2 (A-buffer)"
 #endif
 }

@@ -86,8 +86,10 @@ float density2(float r2) {
 #elif DENSITY == DENSITY_NISHIMURA
     float q = sqrt(q2);
     return q <= 1.0 / 3.0 ? 1.0 - 3.0 * q2 : 1.5 * (1.0 - q) * (1.0 - q);
-#else
+#elif DENSITY == DENSITY_MURAKAMI
     return (1.0 - q2) * (1.0 - q2);
+#else
+#error "DENSITY names no density function"
 #endif
 }
 
@@ -106,8 +108,10 @@ float density_grad_over_r(float r2) {
     float q = sqrt(q2);
     if (q <= 1.0 / 3.0) return -6.0 * inv;
     return q > 1e-12 ? -3.0 * (1.0 - q) / q * inv : 0.0;
-#else
+#elif DENSITY == DENSITY_MURAKAMI
     return -4.0 * (1.0 - q2) * inv;
+#else
+#error "DENSITY names no density function"
 #endif
 }
 

@@ -73,8 +73,10 @@ bool cut = false;
             uint s_ = b_ + u_; \
             if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } \
     CUT_UNLESS(!(b_ < e_)) }
-#else
+#elif LIST == LIST_NONE
 #define SUM_LIST(x, p, ACC, TERM)
+#else
+#error "LIST names no list mode"
 #endif
 
 float field(vec3 x, uint p) {
@@ -126,9 +128,11 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
     for (; s < e; ++s) {
         vec3 oc = o - centers[list[s]].xyz;
         len++;
-#else
+#elif LIST == LIST_NONE
     for (uint j = 0u; j < 0u; ++j) {
         vec3 oc = o;
+#else
+#error "LIST names no list mode"
 #endif
         float b = dot(oc, d);
         float disc = b * b - (dot(oc, oc) - R2);
@@ -138,6 +142,8 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
     CUT_UNLESS(node == NIL)
 #elif LIST == LIST_SBUFFER
     CUT_UNLESS(!(s < e))
+#elif LIST != LIST_NONE
+#error "LIST names no list mode"
 #endif
     longest = max(longest, len);
     return vec2(max(iv.x, 0.0), iv.y);
@@ -312,7 +318,7 @@ void main() {
         if (primary) dbg = vec4(t, n);
 #if MATERIAL == MATERIAL_PHONG
         color += r.w * phong(n, -r.d);
-#else
+#elif MATERIAL == MATERIAL_GLASS || MATERIAL == MATERIAL_TINTED || MATERIAL == MATERIAL_METAL
         vec3 w = r.w;
 #if MATERIAL == MATERIAL_TINTED
         if (r.inside) w *= exp(-P.absorb.rgb * t);  // Beer-Lambert along the inside path
@@ -340,6 +346,8 @@ void main() {
             if (deep || sp >= STACK) color += refr.w * sky_color(refr.d); else stack[sp++] = refr;
         }
 #endif
+#else
+#error "MATERIAL names no material"
 #endif
     }
     CUT_UNLESS(!(sp > 0))
