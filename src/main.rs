@@ -36,9 +36,7 @@ enum Command {
     },
     /// Play a scene and write frames, timings.csv and summary.json
     Run {
-        /// Built-in scene (character, demo, dam-break, drop, resting-block, walker, giraffe,
-        /// union, morph, two-groups, orbits; particle systems: fountain, smoke) or a TOML
-        /// scene file
+        /// A built-in scene (`fluidform scene list`) or a TOML scene file
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: String,
         /// Frames to play (default: the scene's own count)
@@ -88,6 +86,11 @@ enum Command {
         #[arg(long)]
         date: String,
     },
+    /// The built-in scenes: list them, or print one's TOML to copy and edit
+    Scene {
+        #[command(subcommand)]
+        what: SceneWhat,
+    },
     /// What a character or mesh file (.glb, .gltf, .obj, builtin:walker, builtin:giraffe)
     /// holds: triangles, vertices, joints, animations, bounds, closedness, volume, warnings
     Inspect {
@@ -109,6 +112,15 @@ enum Command {
         #[command(flatten)]
         common: fluidform::config::CommonArgs,
     },
+}
+
+#[derive(Subcommand)]
+enum SceneWhat {
+    /// Every built-in scene: name, kind and what it shows
+    List,
+    /// Print a built-in scene's TOML (`fluidform scene show demo > my.toml`, edit, then
+    /// `fluidform run --scene my.toml`)
+    Show { name: String },
 }
 
 /// The benchmarks, each with only the switches it uses.
@@ -485,6 +497,35 @@ fn real_main() -> Result<()> {
             let rows = fluidform::bench::plot::read_sweep(&csv)?;
             fluidform::bench::plot::sweep_dated(&out, &title, &scope, &device, &date, &rows)?;
             println!("wrote {}", out.display());
+            Ok(())
+        }
+        Command::Scene { what } => {
+            use fluidform::scene::builtin;
+            match what {
+                SceneWhat::List => {
+                    for b in builtin::BUILT_IN {
+                        let kind = match fluidform::scene::load::kind_of(b.text) {
+                            fluidform::scene::load::SceneKind::Fluid => "fluid",
+                            fluidform::scene::load::SceneKind::Particles => "particles",
+                        };
+                        println!("{:<14} {kind:<10} {}", b.name, b.summary());
+                    }
+                    println!(
+                        "{:<14} {:<10} particles orbiting an attractor, made in code (no file)",
+                        "orbits", "test"
+                    );
+                }
+                SceneWhat::Show { name } => match builtin::find(&name) {
+                    Some(b) => print!("{}", b.text),
+                    None if name == "orbits" => anyhow::bail!(
+                        "orbits makes its particles in code: it has no scene file"
+                    ),
+                    None => anyhow::bail!(
+                        "no built-in scene '{name}' (fluidform scene list: {})",
+                        builtin::names().join(", ")
+                    ),
+                },
+            }
             Ok(())
         }
         Command::Inspect { file, json } => {

@@ -42,14 +42,16 @@ fn random_particles(f: &FluidParams, n: usize, c: f32, speed: f32, seed: u64) ->
 }
 
 fn fixed_iterations(solver: Solver, k: u32) -> FluidParams {
-    FluidParams {
+    let mut f = FluidParams {
         solver,
-        min_iterations: k,
-        max_iterations: k,
-        pbf_iterations: if solver == Solver::Pbf { k } else { 0 },
         dt: 2e-3,
         ..Default::default()
-    }
+    };
+    (f.pcisph.min_iterations, f.pcisph.max_iterations) = (k, k);
+    (f.dfsph.min_iterations, f.dfsph.max_iterations) = (k, k);
+    (f.pbf.min_iterations, f.pbf.max_iterations) = (k, k);
+    f.pbf.iterations = if solver == Solver::Pbf { k } else { 0 };
+    f
 }
 
 /// Arrange, read, step, read. The counting sort's order inside a cell is arbitrary, so the
@@ -168,10 +170,8 @@ fn dfsph_neighbor_lists_match_the_grid_search() {
     let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     let mut runs = Vec::new();
     for list in [0u32, 4, 96] {
-        let f = FluidParams {
-            neighbor_list: list,
-            ..fixed_iterations(Solver::Dfsph, 3)
-        };
+        let mut f = fixed_iterations(Solver::Dfsph, 3);
+        f.dfsph.neighbor_list = list;
         let sc = scene(f.clone(), [0.4; 3], vec![]);
         let parts = tagged(random_particles(&f, 400, 0.2, 0.5, 7));
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
@@ -219,15 +219,15 @@ fn momentum_is_conserved_without_walls() {
     for s in SOLVERS {
         // Pair-symmetric terms only: no gravity, viscosity (its m / rho_j weights), surface
         // tension or vorticity confinement (an external force by design).
-        let f = FluidParams {
+        let mut f = FluidParams {
             solver: s,
             gravity: [0.0; 3],
             viscosity: 0.0,
             surface_tension: 0.0,
-            vorticity: 0.0,
             dt: 2e-3,
             ..Default::default()
         };
+        f.pbf.vorticity = 0.0;
         let sc = scene(f.clone(), [1.0; 3], vec![]);
         let parts = random_particles(&f, 500, 0.5, 0.5, 11);
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
@@ -281,15 +281,17 @@ fn a_resting_pool_stays_at_rest_under_the_target() {
     let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     let mut bad = Vec::new();
     for s in SOLVERS {
-        let f = FluidParams {
+        let mut f = FluidParams {
             solver: s,
-            density_error: 0.005,
-            divergence_error: 0.005,
-            // Recorded per solve and step: a bound that keeps the command buffer small.
-            max_iterations: 30,
             dt: 2e-3,
             ..Default::default()
-        };
+        }
+        .with_density_error(0.005);
+        f.dfsph.divergence_error = 0.005;
+        // Recorded per solve and step: a bound that keeps the command buffer small.
+        f.pcisph.max_iterations = 30;
+        f.dfsph.max_iterations = 30;
+        f.pbf.max_iterations = 30;
         let sc = scene(
             f.clone(),
             [0.24, 0.3, 0.24],
@@ -341,7 +343,7 @@ fn a_resting_pool_stays_at_rest_under_the_target() {
                 d.pos.len()
             );
             let fall = (2.0f32 * 9.81 * 0.12).sqrt();
-            if vmax >= 0.1 * fall || vmean >= 0.02 * fall || err > f.density_error as f64 {
+            if vmax >= 0.1 * fall || vmean >= 0.02 * fall || err > f.convergence().density_error as f64 {
                 bad.push(format!(
                     "{s:?} at {when}: max speed {vmax} m/s, mean {vmean} m/s, density error {err:.3e}"
                 ));

@@ -71,12 +71,14 @@ pub fn ladder(base: &FluidParams, solver: Solver, target: f64) -> Vec<FluidParam
             .collect(),
         _ => [1.0, 0.5, 0.25]
             .into_iter()
-            .map(|k| FluidParams {
-                solver,
-                cfl: Some(0.4),
-                dt_max: Some(own_dt_max(solver) * k),
-                density_error: target as f32,
-                ..base.clone()
+            .map(|k| {
+                FluidParams {
+                    solver,
+                    cfl: Some(0.4),
+                    dt_max: Some(own_dt_max(solver) * k),
+                    ..base.clone()
+                }
+                .with_density_error(target as f32)
             })
             .collect(),
     }
@@ -90,7 +92,7 @@ pub fn setting(f: &FluidParams) -> String {
     };
     match f.solver {
         Solver::Wcsph => format!("c {} m/s, {step}", f.sound()),
-        _ => format!("target {}%, {step}", f.density_error * 100.0),
+        _ => format!("target {}%, {step}", f.convergence().density_error * 100.0),
     }
 }
 

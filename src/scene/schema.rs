@@ -1,11 +1,11 @@
 //! The scene schema: a domain box, fluid parameters, fluid blocks and balls, colliders,
 //! a camera, and the features that drive the fluid (characters, control targets, a
-//! timeline, emission, particle systems). Built in (`builtin.rs`) or read from TOML.
+//! timeline, emission, particle systems). Read from TOML (`load.rs`): a user's file or a
+//! built-in's (`builtin.rs`).
 use crate::error::{Error, Result};
 use crate::sph::params::{Collider, FluidParams};
 pub use crate::sph::setup::{fill, white, Ball, Block, Domain, Particles, SphSetup};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -112,60 +112,7 @@ impl Look {
     }
 }
 
-/// A scene file's parse error as one line: where, then what (the parser's own text draws
-/// the line).
-pub fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> Error {
-    let at = e.span().map(|r| {
-        let before = &text[..r.start.min(text.len())];
-        let line = before.matches('\n').count() + 1;
-        let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-        format!(" line {line} column {col}:")
-    });
-    Error::Param(format!(
-        "scene file {file}:{} {}",
-        at.unwrap_or_default(),
-        e.message().trim().replace('\n', " ")
-    ))
-}
-
 impl Scene {
-    pub fn load(name_or_path: &str) -> Result<Self> {
-        if let Some(s) = Self::built_in(name_or_path) {
-            return Ok(s);
-        }
-        let path = Path::new(name_or_path);
-        if !path.exists() {
-            return Err(Error::Param(format!(
-                "unknown scene '{name_or_path}': not a built-in ({}, orbits, {}) nor an existing file",
-                super::builtin::BUILT_IN.join(", "),
-                crate::scene::particles::BUILT_IN.join(", ")
-            )));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: name_or_path.into(),
-            source: e,
-        })?;
-        let mut s: Scene =
-            toml::from_str(&text).map_err(|e| toml_error(name_or_path, &text, &e))?;
-        // A liquid character's file that leaves [fluid] out gets the built-in liquid
-        // characters' water (Kelager's defaults take 10 ms ideal-gas steps).
-        let has_fluid = toml::from_str::<toml::Table>(&text).is_ok_and(|t| t.contains_key("fluid"));
-        if !has_fluid && (s.control.is_some() || !s.targets.is_empty()) {
-            s.fluid = super::builtin::released_water();
-        }
-        // A character file is named relative to the scene file.
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let chars = s.character.iter_mut();
-        for c in chars.chain(s.targets.iter_mut().map(|t| &mut t.character)) {
-            let f = Path::new(&c.file);
-            if !c.file.starts_with("builtin:") && f.is_relative() {
-                c.file = dir.join(f).display().to_string();
-            }
-        }
-        s.validate()?;
-        Ok(s)
-    }
-
     pub fn validate(&self) -> Result<()> {
         SphSetup::from(self).validate()?;
         for b in &self.blocks {

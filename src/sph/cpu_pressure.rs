@@ -300,13 +300,13 @@ pub fn step(
             let mut xs: Vec<V3> = (0..n)
                 .map(|i| axpy(dt, axpy(dt, a[i], v[i]), x[i]))
                 .collect();
-            let dq = f.scorr_dq as f64 * kk.h;
+            let dq = f.pbf.scorr_dq as f64 * kk.h;
             let wdq = kk.w(dq * dq);
             for _ in 0..iterations {
                 let lambda: Vec<f64> = (0..n)
                     .map(|i| {
                         let c = (kk.density(&xs, i) / kk.rho0 - 1.0).max(0.0);
-                        -c / (kk.grad2(&xs, i) + f.pbf_relaxation as f64 * proto)
+                        -c / (kk.grad2(&xs, i) + f.pbf.relaxation as f64 * proto)
                     })
                     .collect();
                 let dx: Vec<V3> = (0..n)
@@ -315,8 +315,8 @@ pub fn step(
                         for j in 0..n {
                             let d = sub(xs[i], xs[j]);
                             if j != i && dot(d, d) < kk.h * kk.h {
-                                let sc = -f.scorr_k as f64
-                                    * (kk.w(dot(d, d)) / wdq).powf(f.scorr_n as f64)
+                                let sc = -f.pbf.scorr_k as f64
+                                    * (kk.w(dot(d, d)) / wdq).powf(f.pbf.scorr_n as f64)
                                     / proto;
                                 s = axpy(lambda[i] + lambda[j] + sc, kk.vg(d), s);
                             }
@@ -340,7 +340,7 @@ pub fn step(
                     if j != i && dot(d, d) < kk.h * kk.h {
                         let vji = sub(v[j], v[i]);
                         w[i] = axpy(1.0, cross(kk.vg(d), vji), w[i]);
-                        dv[i] = axpy(kk.v * kk.w(dot(d, d)) * f.xsph as f64, vji, dv[i]);
+                        dv[i] = axpy(kk.v * kk.w(dot(d, d)) * f.pbf.xsph as f64, vji, dv[i]);
                     }
                 }
             }
@@ -355,7 +355,7 @@ pub fn step(
                 }
                 let el = dot(eta, eta).sqrt();
                 let fv = if el > 1e-6 / kk.h {
-                    cross(eta.map(|c| c / el), w[i]).map(|c| c * f.vorticity as f64)
+                    cross(eta.map(|c| c / el), w[i]).map(|c| c * f.pbf.vorticity as f64)
                 } else {
                     [0.0; 3]
                 };

@@ -3,12 +3,72 @@
 //! the next step's start), then the non-pressure forces, then the constant-density solve on
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
 //! Euler (glsl/sph/dfsph.comp, euler.comp).
-use super::pressure::{PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY, LOOP_DIVERGENCE};
+use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY, LOOP_DIVERGENCE};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{Context, Scopes};
 use crate::kinds::Solver;
 use ash::vk;
+
+/// DFSPH's neighbour list length: a particle has about 20 neighbours at rest (h = 1.68
+/// spacings), 30 compressed by half.
+pub const DEFAULT_NEIGHBOR_LIST: u32 = 48;
+/// Longest neighbour list.
+pub const MAX_NEIGHBOR_LIST: u32 = 256;
+
+/// `[fluid.dfsph]`: when the two solves stop, and the neighbour list.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DfsphParams {
+    /// Iterate the density solve until the mean density error is at most this.
+    pub density_error: f32,
+    /// Iterate the divergence solve until the mean compression rate times dt is at most this.
+    pub divergence_error: f32,
+    /// Iterations each solve takes at least and at most.
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+    /// Neighbours kept per particle and step (0: none). The solves' iterations then read a
+    /// list instead of searching 27 grid cells; a particle with more neighbours is searched
+    /// as before (exact; counted in `stats.density_error.list_overflows`).
+    pub neighbor_list: u32,
+}
+
+impl Default for DfsphParams {
+    fn default() -> Self {
+        Self {
+            density_error: 0.001,
+            divergence_error: 0.001,
+            min_iterations: 2,
+            max_iterations: 100,
+            neighbor_list: DEFAULT_NEIGHBOR_LIST,
+        }
+    }
+}
+
+impl DfsphParams {
+    pub fn validate(&self) -> Result<()> {
+        check_range("dfsph", "density_error", self.density_error, (1e-6, 0.5))?;
+        let d = self.divergence_error;
+        check_range("dfsph", "divergence_error", d, (1e-6, 0.5))?;
+        check_iterations("dfsph", self.min_iterations, self.max_iterations)?;
+        if self.neighbor_list > MAX_NEIGHBOR_LIST {
+            return Err(crate::error::Error::Param(format!(
+                "fluid.dfsph.neighbor_list must be at most {MAX_NEIGHBOR_LIST} (0: off), got {}",
+                self.neighbor_list
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn convergence(&self) -> Convergence {
+        Convergence {
+            density_error: self.density_error,
+            divergence_error: self.divergence_error,
+            min_iterations: self.min_iterations,
+            max_iterations: self.max_iterations,
+        }
+    }
+}
 
 /// The passes, in [`PASSES`] order.
 #[derive(Clone, Copy)]

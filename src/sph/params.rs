@@ -5,6 +5,10 @@ use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
 pub use super::collider::{Collider, GpuCollider, MAX_COLLIDERS};
+pub use super::dfsph::{DfsphParams, DEFAULT_NEIGHBOR_LIST, MAX_NEIGHBOR_LIST};
+pub use super::pbf::PbfParams;
+pub use super::pcisph::PcisphParams;
+pub use super::pressure::Convergence;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -66,30 +70,10 @@ pub struct FluidParams {
     pub solver: crate::kinds::Solver,
     /// With `cfl`: the largest step, s (default: `dt`). The frame time stays dt * substeps.
     pub dt_max: Option<f32>,
-    /// pcisph, dfsph, pbf: iterate until the mean density error (rho / rho_0 - 1 where
-    /// compressed) the solver predicts is at most this (0.001: 0.1%).
-    pub density_error: f32,
-    /// dfsph: iterate until the mean compression rate times dt is at most this.
-    pub divergence_error: f32,
-    /// Iterations each pressure solve takes at least and at most.
-    pub min_iterations: u32,
-    pub max_iterations: u32,
-    /// pbf: a fixed iteration count (0: iterate to `density_error`).
-    pub pbf_iterations: u32,
-    /// pbf: constraint relaxation epsilon, relative to a full neighbourhood's gradient sum.
-    pub pbf_relaxation: f32,
-    /// pbf: tensile-instability correction s_corr = -k (W(r) / W(dq h))^n.
-    pub scorr_k: f32,
-    pub scorr_n: f32,
-    pub scorr_dq: f32,
-    /// pbf: XSPH viscosity c.
-    pub xsph: f32,
-    /// pbf: vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
-    pub vorticity: f32,
-    /// dfsph: neighbours kept per particle and step (0: none). The solves' iterations then
-    /// read a list instead of searching 27 grid cells; a particle with more neighbours is
-    /// searched as before (exact; counted in `stats.density_error.list_overflows`).
-    pub neighbor_list: u32,
+    /// `[fluid.pcisph]`, `[fluid.dfsph]`, `[fluid.pbf]`: each solver's own settings.
+    pub pcisph: PcisphParams,
+    pub dfsph: DfsphParams,
+    pub pbf: PbfParams,
     /// Particle spacing at rest, m (`--fluid spacing=S`): when set, the mass becomes
     /// rho_0 S^3 and h, dt and the steps per frame scale with S from the values given, so
     /// the frame time, h in spacings and the CFL number stay as they were.
@@ -118,28 +102,13 @@ impl Default for FluidParams {
             friction: 0.0,
             solver: crate::kinds::Solver::Wcsph,
             dt_max: None,
-            density_error: 0.001,
-            divergence_error: 0.001,
-            min_iterations: 2,
-            max_iterations: 100,
-            pbf_iterations: 0,
-            pbf_relaxation: 0.01,
-            scorr_k: 0.1,
-            scorr_n: 4.0,
-            scorr_dq: 0.2,
-            xsph: 0.01,
-            vorticity: 0.01,
-            neighbor_list: DEFAULT_NEIGHBOR_LIST,
+            pcisph: PcisphParams::default(),
+            dfsph: DfsphParams::default(),
+            pbf: PbfParams::default(),
             spacing: None,
         }
     }
 }
-
-/// DFSPH's neighbour list length: a particle has about 20 neighbours at rest (h = 1.68
-/// spacings), 30 compressed by half.
-pub const DEFAULT_NEIGHBOR_LIST: u32 = 48;
-/// Longest neighbour list.
-pub const MAX_NEIGHBOR_LIST: u32 = 256;
 
 /// Most steps one frame may be split into.
 pub const MAX_SUBSTEPS: u32 = 1000;
@@ -210,44 +179,9 @@ impl FluidParams {
     }
 
     fn validate_solver(&self) -> Result<()> {
-        for (name, v, lo, hi) in [
-            ("density_error", self.density_error, 1e-6, 0.5),
-            ("divergence_error", self.divergence_error, 1e-6, 0.5),
-            ("pbf_relaxation", self.pbf_relaxation, 1e-6, 10.0),
-            ("scorr_k", self.scorr_k, 0.0, 1.0),
-            ("scorr_n", self.scorr_n, 1.0, 8.0),
-            ("scorr_dq", self.scorr_dq, 0.01, 0.99),
-            ("xsph", self.xsph, 0.0, 1.0),
-            ("vorticity", self.vorticity, 0.0, 10.0),
-        ] {
-            if !(v >= lo && v <= hi) {
-                return Err(Error::Param(format!(
-                    "fluid.{name} must be in {lo}..={hi}, got {v}"
-                )));
-            }
-        }
-        if self.min_iterations == 0
-            || self.min_iterations > self.max_iterations
-            || self.max_iterations > MAX_ITERATIONS
-        {
-            return Err(Error::Param(format!(
-                "fluid iterations: need 1 <= min_iterations ({}) <= max_iterations ({}) <= \
-                 {MAX_ITERATIONS}",
-                self.min_iterations, self.max_iterations
-            )));
-        }
-        if self.neighbor_list > MAX_NEIGHBOR_LIST {
-            return Err(Error::Param(format!(
-                "fluid.neighbor_list must be at most {MAX_NEIGHBOR_LIST} (0: off), got {}",
-                self.neighbor_list
-            )));
-        }
-        if self.pbf_iterations > MAX_ITERATIONS {
-            return Err(Error::Param(format!(
-                "fluid.pbf_iterations must be at most {MAX_ITERATIONS}, got {}",
-                self.pbf_iterations
-            )));
-        }
+        self.pcisph.validate()?;
+        self.dfsph.validate()?;
+        self.pbf.validate()?;
         if let Some(d) = self.dt_max {
             if !(d > 0.0 && d.is_finite()) {
                 return Err(Error::Param(format!(
@@ -263,11 +197,14 @@ impl FluidParams {
         Ok(())
     }
 
-    /// (least, most) iterations of the solver's pressure solve: pbf's fixed count, if set.
-    pub fn iterations(&self) -> (u32, u32) {
-        match (self.solver, self.pbf_iterations) {
-            (crate::kinds::Solver::Pbf, k) if k > 0 => (k, k),
-            _ => (self.min_iterations, self.max_iterations),
+    /// When the chosen solver's pressure solve stops (wcsph solves none: pcisph's defaults
+    /// fill the GPU's fields).
+    pub fn convergence(&self) -> Convergence {
+        match self.solver {
+            Solver::Wcsph => PcisphParams::default().convergence(),
+            Solver::Pcisph => self.pcisph.convergence(),
+            Solver::Dfsph => self.dfsph.convergence(),
+            Solver::Pbf => self.pbf.convergence(),
         }
     }
 
@@ -302,7 +239,9 @@ impl FluidParams {
                 .ok()
                 .and_then(|mut t| t.remove("x"))
                 .unwrap_or_else(|| toml::Value::String(v.to_string()));
-            table.insert(k.to_string(), parsed);
+            for path in override_paths(k) {
+                set_path(table, &path, parsed.clone())?;
+            }
         }
         let out: FluidParams = value
             .try_into()
@@ -311,11 +250,19 @@ impl FluidParams {
         Ok(out)
     }
 
+    /// Every iterative solver's density error target set to `e`.
+    pub fn with_density_error(mut self, e: f32) -> Self {
+        self.pcisph.density_error = e;
+        self.dfsph.density_error = e;
+        self.pbf.density_error = e;
+        self
+    }
+
     /// The neighbour list length the solver uses: dfsph's `neighbor_list`, else 0.
     pub fn list_len(&self) -> u32 {
         match self.solver {
-            crate::kinds::Solver::Dfsph => self.neighbor_list,
-            _ => 0,
+            Solver::Dfsph => self.dfsph.neighbor_list,
+            Solver::Wcsph | Solver::Pcisph | Solver::Pbf => 0,
         }
     }
 
@@ -343,6 +290,44 @@ impl FluidParams {
             Eos::Tait => self.sound_speed,
         }
     }
+}
+
+/// The table paths a `--fluid KEY` sets: `a.b` as written; the solver settings by their
+/// earlier flat names (`density_error` and the iteration bounds: every iterative solver's;
+/// `neighbor_list`, `divergence_error`: dfsph's; `pbf_iterations`, `xsph`, ...: pbf's).
+fn override_paths(key: &str) -> Vec<Vec<String>> {
+    let one = |t: &str, k: &str| vec![vec![t.to_string(), k.to_string()]];
+    match key {
+        "density_error" | "min_iterations" | "max_iterations" => ["pcisph", "dfsph", "pbf"]
+            .iter()
+            .map(|t| vec![t.to_string(), key.to_string()])
+            .collect(),
+        "divergence_error" | "neighbor_list" => one("dfsph", key),
+        "pbf_iterations" => one("pbf", "iterations"),
+        "pbf_relaxation" => one("pbf", "relaxation"),
+        "scorr_k" | "scorr_n" | "scorr_dq" | "xsph" | "vorticity" => one("pbf", key),
+        _ => vec![key.split('.').map(str::to_string).collect()],
+    }
+}
+
+/// Sets `value` at `path` under `table`, refusing a path through a value that is not a table.
+fn set_path(table: &mut toml::Table, path: &[String], value: toml::Value) -> Result<()> {
+    let (last, tables) = path.split_last().expect("a key has one part at least");
+    let mut t = table;
+    for (i, k) in tables.iter().enumerate() {
+        t = match t.get_mut(k).and_then(toml::Value::as_table_mut) {
+            Some(sub) => sub,
+            None => {
+                return Err(Error::Param(format!(
+                    "--fluid {}: fluid.{} is not a table",
+                    path.join("."),
+                    tables[..=i].join(".")
+                )))
+            }
+        };
+    }
+    t.insert(last.clone(), value);
+    Ok(())
 }
 
 /// Mirror of `SphParams` in glsl/sph/common.glsl (std430).
@@ -402,8 +387,8 @@ impl SphGpuParams {
         let h = f.h;
         let k = Kernels::new(h as f64);
         let incompressible = f.solver != crate::kinds::Solver::Wcsph;
-        let (min_iter, max_iter) = f.iterations();
-        let dq = (f.scorr_dq * h) as f64;
+        let c = f.convergence();
+        let dq = (f.pbf.scorr_dq * h) as f64;
         let w_dq = k.poly6 * (h as f64 * h as f64 - dq * dq).powi(3);
         Self {
             gravity: [f.gravity[0], f.gravity[1], f.gravity[2], dt],
@@ -440,17 +425,17 @@ impl SphGpuParams {
             spiky_grad: k.spiky_grad as f32,
             visc_lap: k.visc_lap as f32,
             solver: f.solver as u32,
-            min_iter,
-            max_iter,
-            density_target: f.density_error,
-            divergence_target: f.divergence_error,
+            min_iter: c.min_iterations,
+            max_iter: c.max_iterations,
+            density_target: c.density_error,
+            divergence_target: c.divergence_error,
             proto_grad2: proto_grad2(f) as f32,
-            pbf_relaxation: f.pbf_relaxation,
-            scorr_k: f.scorr_k,
-            scorr_n: f.scorr_n,
+            pbf_relaxation: f.pbf.relaxation,
+            scorr_k: f.pbf.scorr_k,
+            scorr_n: f.pbf.scorr_n,
             scorr_inv_w: (1.0 / w_dq) as f32,
-            xsph: f.xsph,
-            vorticity: f.vorticity,
+            xsph: f.pbf.xsph,
+            vorticity: f.pbf.vorticity,
             list_max: f.list_len(),
             pad0: 0,
             pad1: 0,

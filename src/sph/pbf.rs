@@ -2,12 +2,92 @@
 //! non-pressure forces, density-constraint iterations (lambda, correction with s_corr,
 //! apply) to the density error target or a fixed count, velocities from the positions,
 //! then vorticity confinement and XSPH viscosity (glsl/sph/pbf.comp).
-use super::pressure::{PassDecl, Pipelines, PressureSolver, LOOP_DENSITY};
+use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, LOOP_DENSITY};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{Context, Scopes};
 use crate::kinds::Solver;
 use ash::vk;
+
+/// `[fluid.pbf]`: the constraint iterations, relaxation, tensile correction, XSPH and
+/// vorticity confinement.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PbfParams {
+    /// Iterate until the mean density error is at most this (unless `iterations` is set).
+    pub density_error: f32,
+    /// Iterations each solve takes at least and at most.
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+    /// A fixed iteration count (0: iterate to `density_error`).
+    pub iterations: u32,
+    /// Constraint relaxation epsilon, relative to a full neighbourhood's gradient sum.
+    pub relaxation: f32,
+    /// Tensile-instability correction s_corr = -k (W(r) / W(dq h))^n.
+    pub scorr_k: f32,
+    pub scorr_n: f32,
+    pub scorr_dq: f32,
+    /// XSPH viscosity c.
+    pub xsph: f32,
+    /// Vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
+    pub vorticity: f32,
+}
+
+impl Default for PbfParams {
+    fn default() -> Self {
+        Self {
+            density_error: 0.001,
+            min_iterations: 2,
+            max_iterations: 100,
+            iterations: 0,
+            relaxation: 0.01,
+            scorr_k: 0.1,
+            scorr_n: 4.0,
+            scorr_dq: 0.2,
+            xsph: 0.01,
+            vorticity: 0.01,
+        }
+    }
+}
+
+impl PbfParams {
+    pub fn validate(&self) -> Result<()> {
+        for (name, v, range) in [
+            ("density_error", self.density_error, (1e-6, 0.5)),
+            ("relaxation", self.relaxation, (1e-6, 10.0)),
+            ("scorr_k", self.scorr_k, (0.0, 1.0)),
+            ("scorr_n", self.scorr_n, (1.0, 8.0)),
+            ("scorr_dq", self.scorr_dq, (0.01, 0.99)),
+            ("xsph", self.xsph, (0.0, 1.0)),
+            ("vorticity", self.vorticity, (0.0, 10.0)),
+        ] {
+            check_range("pbf", name, v, range)?;
+        }
+        check_iterations("pbf", self.min_iterations, self.max_iterations)?;
+        if self.iterations > super::params::MAX_ITERATIONS {
+            return Err(crate::error::Error::Param(format!(
+                "fluid.pbf.iterations must be at most {}, got {}",
+                super::params::MAX_ITERATIONS,
+                self.iterations
+            )));
+        }
+        Ok(())
+    }
+
+    /// A fixed `iterations` count is both bounds.
+    pub fn convergence(&self) -> Convergence {
+        let (min, max) = match self.iterations {
+            0 => (self.min_iterations, self.max_iterations),
+            k => (k, k),
+        };
+        Convergence {
+            density_error: self.density_error,
+            divergence_error: 0.001,
+            min_iterations: min,
+            max_iterations: max,
+        }
+    }
+}
 
 /// The passes, in [`PASSES`] order.
 #[derive(Clone, Copy)]
@@ -68,7 +148,7 @@ impl PressureSolver for Pbf {
             false,
         )?;
         p.scoped(ctx, cmd, scopes, st, Pass::Velocity as usize)?;
-        if st.fluid.xsph > 0.0 || st.fluid.vorticity > 0.0 {
+        if st.fluid.pbf.xsph > 0.0 || st.fluid.pbf.vorticity > 0.0 {
             scopes.begin(ctx, cmd, "vorticity");
             p.run(ctx, cmd, st, Pass::Vorticity as usize)?;
             p.run(ctx, cmd, st, Pass::Confine as usize)?;

@@ -1,12 +1,50 @@
 //! PCISPH (Solenthaler & Pajarola 2009): after the non-pressure forces, predict-correct
 //! pressure iterations to the density error target, then symplectic Euler
 //! (glsl/sph/pcisph.comp, euler.comp).
-use super::pressure::{PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY};
+use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{sync, Context, Scopes};
 use crate::kinds::Solver;
 use ash::vk;
+
+/// `[fluid.pcisph]`: when the predict-correct loop stops.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PcisphParams {
+    /// Iterate until the predicted mean density error is at most this (0.001: 0.1%).
+    pub density_error: f32,
+    /// Iterations each solve takes at least and at most.
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+}
+
+impl Default for PcisphParams {
+    fn default() -> Self {
+        Self {
+            density_error: 0.001,
+            min_iterations: 2,
+            max_iterations: 100,
+        }
+    }
+}
+
+impl PcisphParams {
+    pub fn validate(&self) -> Result<()> {
+        check_range("pcisph", "density_error", self.density_error, (1e-6, 0.5))?;
+        check_iterations("pcisph", self.min_iterations, self.max_iterations)
+    }
+
+    pub fn convergence(&self) -> Convergence {
+        Convergence {
+            density_error: self.density_error,
+            // No divergence solve: the GPU field keeps the default target.
+            divergence_error: 0.001,
+            min_iterations: self.min_iterations,
+            max_iterations: self.max_iterations,
+        }
+    }
+}
 
 /// The passes, in [`PASSES`] order.
 #[derive(Clone, Copy)]

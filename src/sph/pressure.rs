@@ -275,7 +275,8 @@ impl Pipelines {
         let groups = (st.n as u64).div_ceil(LOCAL_SIZE as u64).max(1);
         let gx = groups.min(crate::gpu::pipeline::MAX_GROUPS_X as u64) as u32;
         let gy = groups.div_ceil(gx as u64) as u32;
-        let (min_iter, max_iter) = st.fluid.iterations();
+        let c = st.fluid.convergence();
+        let (min_iter, max_iter) = (c.min_iterations, c.max_iterations);
         // The iterations recorded: the state's bound (set from earlier steps' counts by
         // the Stepper), else max_iter.
         let recorded = match st.iteration_bound[divergence as usize] {
@@ -452,3 +453,36 @@ impl SphState {
 }
 
 crate::impl_destroy!(Pipelines, PressureBuffers);
+
+/// When a pressure solve stops: the chosen solver's targets and iteration bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Convergence {
+    /// Mean density error (rho / rho_0 - 1 where compressed) the solve iterates down to.
+    pub density_error: f32,
+    /// dfsph: mean compression rate times dt the divergence solve iterates down to.
+    pub divergence_error: f32,
+    pub min_iterations: u32,
+    pub max_iterations: u32,
+}
+
+/// `fluid.TABLE.NAME` must lie in lo..=hi.
+pub(crate) fn check_range(table: &str, name: &str, v: f32, (lo, hi): (f32, f32)) -> Result<()> {
+    match v >= lo && v <= hi {
+        true => Ok(()),
+        false => Err(Error::Param(format!(
+            "fluid.{table}.{name} must be in {lo}..={hi}, got {v}"
+        ))),
+    }
+}
+
+/// 1 <= min <= max <= MAX_ITERATIONS for `fluid.TABLE`.
+pub(crate) fn check_iterations(table: &str, min: u32, max: u32) -> Result<()> {
+    use super::params::MAX_ITERATIONS;
+    match min >= 1 && min <= max && max <= MAX_ITERATIONS {
+        true => Ok(()),
+        false => Err(Error::Param(format!(
+            "fluid.{table}: need 1 <= min_iterations ({min}) <= max_iterations ({max}) <= \
+             {MAX_ITERATIONS}"
+        ))),
+    }
+}

@@ -53,7 +53,10 @@ impl Stepper {
             sim_time: 0.0,
             v_max: 0.0,
             rest_density: st.fluid.rest_density,
-            iterations: st.fluid.iterations(),
+            iterations: {
+                let c = st.fluid.convergence();
+                (c.min_iterations, c.max_iterations)
+            },
         })
     }
 
