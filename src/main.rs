@@ -517,9 +517,9 @@ fn real_main() -> Result<()> {
                 }
                 SceneWhat::Show { name } => match builtin::find(&name) {
                     Some(b) => print!("{}", b.text),
-                    None if name == "orbits" => anyhow::bail!(
-                        "orbits makes its particles in code: it has no scene file"
-                    ),
+                    None if name == "orbits" => {
+                        anyhow::bail!("orbits makes its particles in code: it has no scene file")
+                    }
                     None => anyhow::bail!(
                         "no built-in scene '{name}' (fluidform scene list: {})",
                         builtin::names().join(", ")

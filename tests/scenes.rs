@@ -42,7 +42,9 @@ fn scene_list_names_every_built_in_and_show_refuses_unknown_names() {
     assert!(o.status.success(), "{}", common::text(&o));
     let out = String::from_utf8_lossy(&o.stdout).to_string();
     for b in BUILT_IN {
-        let line = out.lines().find(|l| l.split_whitespace().next() == Some(b.name));
+        let line = out
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(b.name));
         let line = line.unwrap_or_else(|| panic!("{} not listed:\n{out}", b.name));
         assert!(line.contains(&b.summary()), "{line}");
     }
@@ -62,7 +64,11 @@ fn unknown_keys_are_refused_with_their_path_and_line() {
     let head = "name = \"t\"\n[domain]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n";
     let cases = [
         ("[fluid.dfsph]\nnope = 1\n", "fluid.dfsph.nope", "line 6"),
-        ("[fluid]\nneighbor_list = 4\n", "fluid.neighbor_list", "line 6"),
+        (
+            "[fluid]\nneighbor_list = 4\n",
+            "fluid.neighbor_list",
+            "line 6",
+        ),
         ("[look]\ncolour = \"red\"\n", "look.colour", "line 6"),
         (
             "[[blocks]]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nvelocty = [0, 0, 0]\n",
@@ -99,11 +105,17 @@ fn fluid_overrides_reach_each_solvers_table() {
         assert_eq!((e, max), (0.002, 7));
     }
     let g = o(&["pbf_iterations=4", "neighbor_list=0", "vorticity=0"]).unwrap();
-    assert_eq!((g.pbf.iterations, g.dfsph.neighbor_list, g.pbf.vorticity), (4, 0, 0.0));
+    assert_eq!(
+        (g.pbf.iterations, g.dfsph.neighbor_list, g.pbf.vorticity),
+        (4, 0, 0.0)
+    );
     // Out of range, unknown, or through a value that is not a table: one-line errors
     // naming the key.
     for (args, needle) in [
-        (&["dfsph.neighbor_list=1000"][..], "fluid.dfsph.neighbor_list"),
+        (
+            &["dfsph.neighbor_list=1000"][..],
+            "fluid.dfsph.neighbor_list",
+        ),
         (&["pcisph.min_iterations=0"][..], "fluid.pcisph"),
         (&["dfsph.nope=1"][..], "nope"),
         (&["h.x=1"][..], "fluid.h is not a table"),

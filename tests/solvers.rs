@@ -343,7 +343,10 @@ fn a_resting_pool_stays_at_rest_under_the_target() {
                 d.pos.len()
             );
             let fall = (2.0f32 * 9.81 * 0.12).sqrt();
-            if vmax >= 0.1 * fall || vmean >= 0.02 * fall || err > f.convergence().density_error as f64 {
+            if vmax >= 0.1 * fall
+                || vmean >= 0.02 * fall
+                || err > f.convergence().density_error as f64
+            {
                 bad.push(format!(
                     "{s:?} at {when}: max speed {vmax} m/s, mean {vmean} m/s, density error {err:.3e}"
                 ));

@@ -1,10 +1,10 @@
 //! Scenes: the schema and its built-ins, and the parts a scene plays beside the fluid
 //! (characters, control targets, emission, the `orbits` test scene).
 pub mod builtin;
-pub mod load;
 pub mod character;
 pub mod emission;
 pub mod fit;
+pub mod load;
 pub mod orbits;
 pub mod particles;
 pub mod schema;

@@ -3,7 +3,10 @@
 //! the next step's start), then the non-pressure forces, then the constant-density solve on
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
 //! Euler (glsl/sph/dfsph.comp, euler.comp).
-use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY, LOOP_DIVERGENCE};
+use super::pressure::{
+    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER,
+    LOOP_DENSITY, LOOP_DIVERGENCE,
+};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{Context, Scopes};

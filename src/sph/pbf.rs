@@ -2,7 +2,9 @@
 //! non-pressure forces, density-constraint iterations (lambda, correction with s_corr,
 //! apply) to the density error target or a fixed count, velocities from the positions,
 //! then vorticity confinement and XSPH viscosity (glsl/sph/pbf.comp).
-use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, LOOP_DENSITY};
+use super::pressure::{
+    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, LOOP_DENSITY,
+};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{Context, Scopes};

@@ -1,7 +1,10 @@
 //! PCISPH (Solenthaler & Pajarola 2009): after the non-pressure forces, predict-correct
 //! pressure iterations to the density error target, then symplectic Euler
 //! (glsl/sph/pcisph.comp, euler.comp).
-use super::pressure::{check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER, LOOP_DENSITY};
+use super::pressure::{
+    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER,
+    LOOP_DENSITY,
+};
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::{sync, Context, Scopes};
