@@ -225,6 +225,12 @@ pub struct ControlArgs {
     /// frame ahead)
     #[arg(long, value_enum)]
     pub control_motion: Option<ControlMotion>,
+    /// Steps between refreshes of the control's sums (control densities, the deficit
+    /// field, eq. 7's walk); the steps between apply each particle's stored eq. 7 sum with
+    /// their own density and velocity, and a frame's first step always refreshes (1: every
+    /// step, the thesis; default: the preset's)
+    #[arg(long, value_name = "K")]
+    pub control_every: Option<u32>,
     /// Scene time in seconds from which the fidelity metrics are summarised in
     /// summary.json (default: the second half of the run)
     #[arg(long, value_name = "T")]

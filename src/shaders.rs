@@ -126,9 +126,13 @@ pub fn variants() -> Vec<Variant> {
                     "control/density.comp",
                     "control/aggregate.comp",
                     "control/field.comp",
-                    "control/force.comp",
                 ] {
                     v.push(with::<ControlIo>(f, &c));
+                }
+                for refresh in ["0", "1"] {
+                    let mut d = c.clone();
+                    d.push(kv("CONTROL_REFRESH", refresh));
+                    v.push(with::<ControlIo>("control/force.comp", &d));
                 }
             }
         }

@@ -296,6 +296,7 @@ fn settings(adaptive: Adaptive, group: u32) -> ControlSettings {
         damping: 0.0,
         motion: fluidform::config::ControlMotion::Frames,
         group,
+        every: 1,
     }
 }
 
@@ -338,4 +339,100 @@ fn driving_force_matches_the_f64_reference() {
             "{a:?} group {g}: acceleration error {err} of the largest"
         );
     }
+}
+
+/// `--control-every 2`: the step after a refresh gathers each particle's stored eq. 7 sum
+/// and mean control velocity through the step's permutation and applies them with its own
+/// density and velocity. Here the second step sees the first step's particles in a random
+/// order (its permutation says so) with the same positions, densities and velocities, so
+/// each particle must get exactly the acceleration the refresh gave it.
+#[test]
+fn stored_control_sums_follow_the_particles_through_the_sort() {
+    use fluidform::sph::solver::{ACC, ATTR, POS, RHO_P, VEL};
+    use rand::seq::SliceRandom;
+    use rand::SeedableRng;
+    let ctx = common::ctx();
+    let sc = scene();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+    let parts = sc.particles(1);
+    let s = ControlSettings {
+        velocity: 5.0,
+        attraction: 20.0,
+        reach: 0.1,
+        damping: 3.0,
+        every: 2,
+        ..settings(Adaptive::Smooth, ALL_GROUPS)
+    };
+    let mesh = control_mesh(0.03);
+    let domain = (sc.domain.min, sc.domain.max);
+    let mut control =
+        ControlForce::new(&ctx, &solver, &mesh, 1, s, domain, (None, Skinning::Lbs)).unwrap();
+    let mut st = solver.state(&ctx, &sc, &parts).unwrap();
+    let joints =
+        fluidform::character::pose::gpu_joints(&[Mat4::IDENTITY], Skinning::Lbs, &|_| "j".into())
+            .unwrap();
+    control.set_pose(Pose {
+        joints,
+        frame_dt: 1.0 / 30.0,
+        next: None,
+    });
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    let n = st.n as usize;
+    // Fluid velocities for the velocity term and the damping to act on.
+    let vel: Vec<[f32; 4]> = (0..n)
+        .map(|i| [(i % 7) as f32 * 0.1 - 0.3, 0.2, (i % 5) as f32 * -0.05, 0.0])
+        .collect();
+    st.particles.upload(&ctx, VEL, &vel).unwrap();
+    let zero = vec![[0f32; 4]; n];
+    // Step 1: a refresh (the pose's first step), onto zero accelerations.
+    ctx.one_shot(|cmd| {
+        solver.record_params(&ctx, cmd, &st);
+        solver.record_arrange(&ctx, cmd, &mut Labels, &mut st)?;
+        solver.record_density(&ctx, cmd, &mut Labels, &st);
+        Ok::<_, fluidform::Error>(())
+    })
+    .unwrap()
+    .unwrap();
+    st.particles.upload(&ctx, ACC, &zero).unwrap();
+    ctx.one_shot(|cmd| control.record(&ctx, cmd, &mut Labels, &st))
+        .unwrap()
+        .unwrap();
+    let a = st.read(&ctx).unwrap();
+    let moved = a
+        .acc
+        .iter()
+        .filter(|v| v[0].abs() + v[1].abs() + v[2].abs() > 1e-3);
+    assert!(moved.count() > n / 4, "the control barely acts");
+    // The same particles in a random order, and that order as the step's permutation.
+    let mut perm: Vec<u32> = (0..n as u32).collect();
+    perm.shuffle(&mut rng);
+    let by = |v: &[[f32; 4]]| perm.iter().map(|&p| v[p as usize]).collect::<Vec<_>>();
+    st.particles.upload(&ctx, POS, &by(&a.pos)).unwrap();
+    st.particles.upload(&ctx, VEL, &by(&a.vel)).unwrap();
+    st.particles.upload(&ctx, ATTR, &by(&a.attr)).unwrap();
+    let rho: Vec<[f32; 2]> = perm.iter().map(|&p| a.rho_p[p as usize]).collect();
+    st.particles.upload(&ctx, RHO_P, &rho).unwrap();
+    st.particles.upload(&ctx, ACC, &zero).unwrap();
+    ctx.upload(&mut st.nb.perm, 0, &perm).unwrap();
+    // Step 2: no new pose, one step after the refresh: the stored sums.
+    ctx.one_shot(|cmd| control.record(&ctx, cmd, &mut Labels, &st))
+        .unwrap()
+        .unwrap();
+    let b = st.read(&ctx).unwrap();
+    let largest = a.acc.iter().fold(0f32, |m, v| {
+        m.max(v[0].abs().max(v[1].abs()).max(v[2].abs()))
+    });
+    for (i, &p) in perm.iter().enumerate() {
+        let (want, got) = (a.acc[p as usize], b.acc[i]);
+        for k in 0..3 {
+            assert!(
+                (want[k] - got[k]).abs() <= 1e-5 * largest,
+                "particle {i} (was {p}): {got:?} against the refresh's {want:?}"
+            );
+        }
+    }
+    control.destroy(&ctx);
+    st.destroy(&ctx);
+    solver.destroy(&ctx);
+    common::finish(&ctx);
 }

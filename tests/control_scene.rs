@@ -505,7 +505,7 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     let s = summary(&big);
     let h = s["stats"]["character"]["height"].as_f64().unwrap();
     assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
-    let fails: [(&[&str], &str); 6] = [
+    let fails: [(&[&str], &str); 7] = [
         (
             &["--scene", "character", "--adaptive-thresholds", "1.3,1.2"],
             "0 < low < high",
@@ -528,6 +528,10 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
         (
             &["--scene", "character", "--control-pressure=-1"],
             "--control-pressure must be at least 0",
+        ),
+        (
+            &["--scene", "character", "--control-every", "0"],
+            "--control-every must be in 1..=1000",
         ),
         (
             &["--scene", "drop", "--adaptive", "on"],

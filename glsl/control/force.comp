@@ -10,25 +10,33 @@
 // far one a little), and a damping of the velocity relative to the character's there
 // (the mean control velocity, weighted alike). Both are a field on the control grid
 // (aggregate.comp sums each cell, field.comp evaluates at cell centres) read trilinearly.
+// --control-every K: CONTROL_REFRESH 1 walks and stores eq. 7's sum and the velocity
+// term's mean (cforce, cvmean); CONTROL_REFRESH 0 reads them back (gathered into this
+// step's order by the control hook) and applies them with this step's density and velocity.
 #include "common.glsl"
 void main() {
     uint i = global_id();
     if (i >= sph_live() || !controlled(i)) return;
     vec3 xi = pos[i].xyz;
+#if CONTROL_REFRESH == 1
     float hc = C.radius, hc2 = hc * hc;
-    ivec3 c0 = clamp(ivec3(floor((xi - C.grid.xyz) / C.grid.w)), ivec3(0), ivec3(C.dims.xyz) - 1);
+    ivec3 fd = ivec3(C.fine_dims.xyz);
+    ivec3 c0 = clamp(ivec3(floor((xi - C.fine.xyz) / C.fine.w)), ivec3(0), fd - 1);
     vec3 f = vec3(0.0);
     vec3 vsum = vec3(0.0);
     float wsum = 0.0;
-    // Eq. 7 and the velocity term walk the control particles within h_c; with both off
-    // (c_cp = K = 0) the walk is skipped.
-    int n = (C.pressure != 0.0 || C.velocity > 0.0) ? 1 : -2;
+    // Eq. 7 and the velocity term walk the control particles within h_c: the fine cells
+    // (h_c / 2) whose box comes within h_c of xi; with both off (c_cp = K = 0) the walk is
+    // skipped.
+    int n = (C.pressure != 0.0 || C.velocity > 0.0) ? 2 : -3;
     for (int dz = -n; dz <= n; ++dz) for (int dy = -n; dy <= n; ++dy) for (int dx = -n; dx <= n; ++dx) {
         ivec3 c = c0 + ivec3(dx, dy, dz);
-        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
-        uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
-        uint s = cstart[id], e = s + ccount[id];
-        for (uint j = s; j < e; ++j) {
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, fd))) continue;
+        vec3 lo = C.fine.xyz + vec3(c) * C.fine.w;
+        vec3 out_by = max(max(lo - xi, xi - (lo + C.fine.w)), 0.0);
+        if (dot(out_by, out_by) >= hc2) continue;
+        uvec2 range = fine_range(c);
+        for (uint j = range.x; j < range.y; ++j) {
             vec3 d = xi - cpos[j].xyz;
             float r2 = dot(d, d);
             if (r2 >= hc2 || r2 == 0.0) continue;
@@ -44,9 +52,18 @@ void main() {
             }
         }
     }
+    vec4 vmean = wsum > 0.0 ? vec4(vsum / wsum, 1.0) : vec4(0.0);
+    cforce[i] = vec4(f, 0.0);
+    cvmean[i] = vmean;
+#elif CONTROL_REFRESH == 0
+    vec3 f = cforce[i].xyz;
+    vec4 vmean = cvmean[i];
+#else
+#error "CONTROL_REFRESH is neither 0 nor 1"
+#endif
     float rho = max(rho_p[i].x, 1e-6);
     vec3 a = f / rho;
-    if (wsum > 0.0) a += C.velocity * (vsum / wsum - vel[i].xyz);
+    if (vmean.w > 0.0) a += C.velocity * (vmean.xyz - vel[i].xyz);
     if (C.attraction > 0.0 || C.damping > 0.0) {
         // The field of field.comp at xi, trilinear between cell centres (clamped at the
         // grid's faces); the damping fades with the interpolated mask.

@@ -4,6 +4,7 @@
 //! (`control-density`, over the fluid grid) and the force on each fluid particle
 //! (`control-force`, over the control grid), with adaptive control pressure and an
 //! optional velocity term.
+use super::cache::ForceCache;
 pub use super::settings::ControlSettings;
 use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
@@ -24,7 +25,7 @@ crate::gpu_interface! {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
         control = 11, cpos = 12, cprev = 13, crho = 14, cstart = 15, ccount = 16, attr = 17,
-        cagg = 18, cfield = 19,
+        cagg = 18, cfield = 19, cforce = 20, cvmean = 21,
     }
 }
 
@@ -52,8 +53,12 @@ pub struct ControlGpuParams {
     pub reach: f32,
     pub reach_cells: u32,
     pub damping: f32,
+    /// The grid the control set is sorted on (eq. 7's walk): the control grid's origin,
+    /// cell h_c / 2, and its dims.
+    pub fine: [f32; 4],
+    pub fine_dims: [u32; 4],
 }
-const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 96);
+const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 128);
 /// Byte offset of `live` (the rays placement copies its count there).
 pub const LIVE_OFFSET: u64 = std::mem::offset_of!(ControlGpuParams, live) as u64;
 
@@ -76,11 +81,18 @@ struct ControlGpu {
     aggregate: ComputePipeline<ControlIo>,
     field: ComputePipeline<ControlIo>,
     force: ComputePipeline<ControlIo>,
+    /// The force pass between refreshes (`--control-every`): stored sums applied.
+    apply: ComputePipeline<ControlIo>,
+    /// Made at the first step, for the fluid's capacity.
+    cache: Option<ForceCache>,
     skin: SkinPass,
     mesh: SkinnedMesh,
     search: NeighborSearch,
     nb: NeighborBuffers,
+    /// Cells of h_c (the attraction's sums and field) ...
     grid: GridSpec,
+    /// ... each split in 2 x 2 x 2 cells that the control set is sorted on.
+    fine: GridSpec,
     gather: GatherPass,
     prev: Buffer,
     sorted_pos: Buffer,
@@ -102,6 +114,10 @@ impl ControlGpu {
         self.aggregate.destroy(ctx);
         self.field.destroy(ctx);
         self.force.destroy(ctx);
+        self.apply.destroy(ctx);
+        if let Some(c) = &mut self.cache {
+            c.destroy(ctx);
+        }
         self.skin.destroy(ctx);
         self.mesh.destroy(ctx);
         self.search.destroy(ctx);
@@ -178,24 +194,28 @@ impl ControlForce {
         let mut defines = solver.search.defines();
         defines.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
         defines.extend(ControlSettings::defines(settings.adaptive));
-        let pipeline = |name, shader| {
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, 64))
+        let pipeline = |name, shader, refresh: Option<&str>| {
+            let mut d = defines.clone();
+            d.extend(refresh.map(|r| ("CONTROL_REFRESH", r.to_string())));
+            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &d, 64))
                 .map(|p| Guard::new(ctx, p))
         };
-        let density = pipeline("control-density", "control/density.comp")?;
-        let aggregate = pipeline("control-aggregate", "control/aggregate.comp")?;
-        let field = pipeline("control-field", "control/field.comp")?;
-        let force = pipeline("control-force", "control/force.comp")?;
+        let density = pipeline("control-density", "control/density.comp", None)?;
+        let aggregate = pipeline("control-aggregate", "control/aggregate.comp", None)?;
+        let field = pipeline("control-field", "control/field.comp", None)?;
+        let force = pipeline("control-force", "control/force.comp", Some("1"))?;
+        let apply = pipeline("control-force-stored", "control/force.comp", Some("0"))?;
         // Rays: three more layers above the domain in z, the last one parking the unused
         // slots two cells away from any fluid particle's.
         let r = settings.radius;
         let spacing = rays.map_or(0.0, |(s, _)| s);
         // (Lattice steps reach half a spacing past the domain's top.)
         let top = [domain.1[0], domain.1[1], domain.1[2] + spacing + 3.0 * r];
-        let grid = match rays {
-            Some(_) => GridSpec::covering(domain.0, top, r)?,
-            None => GridSpec::covering(domain.0, domain.1, r)?,
-        };
+        let hi = if rays.is_some() { top } else { domain.1 };
+        let grid = GridSpec::covering(domain.0, hi, r)?;
+        // Eq. 7's walk over cells of h_c / 2 near its sphere visits about 300 candidate
+        // control particles instead of the 27 cells of h_c's 1000.
+        let fine = GridSpec::covering(domain.0, hi, r / 2.0)?;
         let rays = match rays {
             Some((spacing, capacity)) => {
                 let g = super::rays::RaysGrid::new(domain.0, domain.1, spacing)?;
@@ -213,7 +233,7 @@ impl ControlForce {
             None => None,
         };
         let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
-        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
+        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &fine, 0)?);
         let skin = SkinPass::new(ctx, skinning, mesh.influence_sets)?;
         let skin = Guard::new(ctx, skin);
         let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
@@ -238,11 +258,14 @@ impl ControlForce {
                 aggregate: aggregate.take(),
                 field: field.take(),
                 force: force.take(),
+                apply: apply.take(),
+                cache: None,
                 skin: skin.take(),
                 mesh: cmesh.take(),
                 search: search.take(),
                 nb: nb.take(),
                 grid,
+                fine,
                 gather: gather.take(),
                 prev: prev.take(),
                 sorted_pos: sorted_pos.take(),
@@ -317,6 +340,13 @@ impl ControlForce {
             reach: s.reach,
             reach_cells: (s.reach / g.grid.cell).ceil() as u32,
             damping: s.damping,
+            fine: [
+                g.fine.origin[0],
+                g.fine.origin[1],
+                g.fine.origin[2],
+                g.fine.cell,
+            ],
+            fine_dims: [g.fine.dims[0], g.fine.dims[1], g.fine.dims[2], 0],
         }
     }
 
@@ -408,7 +438,7 @@ impl ControlForce {
         };
         scopes.begin(ctx, cmd, "control-grid");
         g.search
-            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
+            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.fine)?;
         ctx.compute_barrier(cmd); // permutation -> gathers
         g.gather
             .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
@@ -419,7 +449,12 @@ impl ControlForce {
         Ok(())
     }
 
-    fn bufs<'a>(&self, g: &'a ControlGpu, st: &'a SphState) -> ControlBufs<'a> {
+    fn bufs<'a>(
+        &self,
+        g: &'a ControlGpu,
+        st: &'a SphState,
+        (cforce, cvmean): (&'a Buffer, &'a Buffer),
+    ) -> ControlBufs<'a> {
         let s = st.bufs();
         let (cstart, ccount) = g.nb.cell_buffers();
         ControlBufs {
@@ -443,6 +478,8 @@ impl ControlForce {
             attr: st.attr(),
             cagg: &g.cagg,
             cfield: &g.cfield,
+            cforce,
+            cvmean,
         }
     }
 
@@ -507,17 +544,42 @@ impl SphHook for ControlForce {
         if !self.attached {
             return Ok(());
         }
-        if let Some(pose) = self.pending.take() {
-            let first = std::mem::replace(&mut self.first, false);
-            self.record_pose(ctx, cmd, scopes, &pose, first)?;
-        } else if self.first {
-            return Err(Error::Param(
-                "control particles stepped before their first pose".into(),
-            ));
-        }
-        let (c, g) = (&*self, &self.gpu);
+        let posed = match self.pending.take() {
+            Some(pose) => {
+                let first = std::mem::replace(&mut self.first, false);
+                self.record_pose(ctx, cmd, scopes, &pose, first)?;
+                true
+            }
+            None if self.first => {
+                return Err(Error::Param(
+                    "control particles stepped before their first pose".into(),
+                ))
+            }
+            None => false,
+        };
+        let cache = match &mut self.gpu.cache {
+            Some(c) => c,
+            none => none.insert(ForceCache::new(ctx, st.particles.capacity)?),
+        };
+        let refresh = cache.step(st, self.settings.every, posed)?;
         let push = st.neighbor_push();
-        let bufs = c.bufs(g, st);
+        let (c, g) = (&*self, &self.gpu);
+        let Some(cache) = g.cache.as_ref() else {
+            return Err(Error::Bug("control force cache missing".into()));
+        };
+        let bufs = c.bufs(g, st, cache.current());
+        if !refresh {
+            // The last step's stored sums, gathered into this step's particle order.
+            scopes.begin(ctx, cmd, "control-force-stored");
+            ctx.compute_barrier(cmd); // last step's sums and this step's permutation -> gather
+            for (src, dst) in cache.gathers() {
+                g.gather.record(ctx, cmd, &st.nb.perm, src, dst, st.n);
+            }
+            ctx.compute_barrier(cmd); // gathered sums -> force
+            g.apply.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
+            scopes.end(ctx, cmd);
+            return Ok(());
+        }
         scopes.begin(ctx, cmd, "control-density");
         g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
         scopes.end(ctx, cmd);

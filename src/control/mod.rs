@@ -1,6 +1,7 @@
 //! Control particles (seed 000, section 3): placement inside a character's mesh, binding to
 //! its skeleton, and the inside tests they need.
 pub mod binding;
+pub mod cache;
 pub mod fidelity;
 pub mod force;
 pub mod inside;

@@ -27,6 +27,9 @@ pub struct ControlSettings {
     pub motion: ControlMotion,
     /// The controlled group, or ALL_GROUPS.
     pub group: u32,
+    /// Steps between refreshes of the control's sums (1: every step, the thesis; see
+    /// `control::cache`).
+    pub every: u32,
 }
 
 impl ControlSettings {
@@ -54,6 +57,13 @@ impl ControlSettings {
                 "--control-reach must be positive and at most 16 control radii ({} m), got {}",
                 16.0 * self.radius,
                 self.reach
+            )));
+        }
+        if !(1..=super::cache::MAX_EVERY).contains(&self.every) {
+            return Err(Error::Param(format!(
+                "--control-every must be in 1..={}, got {}",
+                super::cache::MAX_EVERY,
+                self.every
             )));
         }
         if !(0.0 < self.low && self.low < self.high && self.up > 0.0 && self.down > 0.0) {

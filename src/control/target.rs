@@ -36,6 +36,8 @@ fn default_pressure() -> f32 {
 pub const FIDELITY_VELOCITY: f32 = 10.0;
 pub const FIDELITY_ATTRACTION: f32 = 120.0;
 pub const FIDELITY_DAMPING: f32 = 1.0;
+/// The fidelity preset's steps between refreshes of the control's sums (`--control-every`).
+pub const FIDELITY_EVERY: u32 = 1;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
 /// built-in walker fills from a pool in about two seconds).
@@ -82,6 +84,9 @@ pub struct ControlDesc {
     /// The controlled group (default: all).
     #[serde(default)]
     pub group: Option<u32>,
+    /// Steps between refreshes of the control's sums (default: the preset's).
+    #[serde(default)]
+    pub every: Option<u32>,
 }
 
 impl Default for ControlDesc {
@@ -102,6 +107,7 @@ impl Default for ControlDesc {
             damping: None,
             motion: None,
             group: None,
+            every: None,
         }
     }
 }
@@ -140,6 +146,7 @@ impl ControlDesc {
             damping: c.control_damping.or(self.damping),
             motion: c.control_motion.or(self.motion),
             group: self.group,
+            every: c.control_every.or(self.every),
         })
     }
 
@@ -173,6 +180,7 @@ impl ControlDesc {
             damping: self.damping.unwrap_or(d.damping),
             motion: self.motion.unwrap_or(d.motion),
             group: self.group.unwrap_or(ALL_GROUPS),
+            every: self.every.unwrap_or(d.every),
         }
     }
 }
@@ -185,6 +193,8 @@ struct Preset {
     reach: f32,
     damping: f32,
     motion: ControlMotion,
+    /// Steps between refreshes of the control's sums.
+    every: u32,
 }
 
 impl Preset {
@@ -196,6 +206,7 @@ impl Preset {
                 reach: 3.0,
                 damping: 0.0,
                 motion: ControlMotion::Frames,
+                every: 1,
             },
             ControlPreset::Fidelity => Self {
                 velocity: FIDELITY_VELOCITY,
@@ -203,6 +214,7 @@ impl Preset {
                 reach: 3.0,
                 damping: FIDELITY_DAMPING,
                 motion: ControlMotion::Skin,
+                every: FIDELITY_EVERY,
             },
         }
     }
