@@ -245,7 +245,10 @@ impl FluidParams {
         }
         let out: FluidParams = value
             .try_into()
-            .map_err(|e| Error::Param(format!("--fluid: {e}")))?;
+            .map_err(|e| {
+                let e = e.to_string().replace('\n', " ");
+                Error::Param(format!("--fluid: {}", e.trim()))
+            })?;
         out.validate()?;
         Ok(out)
     }
