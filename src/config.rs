@@ -228,7 +228,7 @@ pub struct ControlArgs {
     /// Steps between refreshes of the control's sums (control densities, the deficit
     /// field, eq. 7's walk); the steps between apply each particle's stored eq. 7 sum with
     /// their own density and velocity, and a frame's first step always refreshes (1: every
-    /// step, the thesis; default: the preset's)
+    /// step, the thesis's preset; fidelity: 1.5 ms over the step, rounded)
     #[arg(long, value_name = "K")]
     pub control_every: Option<u32>,
     /// Scene time in seconds from which the fidelity metrics are summarised in

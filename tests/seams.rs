@@ -363,7 +363,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "ControlParams",
             fields!(fluidform::control::force::ControlGpuParams;
             grid, dims, pressure, radius, spiky_grad, velocity, adaptive, low, high, up, down,
-            inv_frame, group, live, attraction, reach, reach_cells, damping, fine, fine_dims),
+            inv_frame, group, live, attraction, reach, reach_cells, damping),
         ),
         (
             "emission/emit.comp",

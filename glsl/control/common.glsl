@@ -1,6 +1,5 @@
 // Control particles (seed 000, 3.1): the SPH bindings (as CTL_B_* numbers) and the control
-// set, sorted on a grid of cells h_c / 2 (cstart, ccount); the control grid (cell = control
-// radius h_c) holds the attraction's per-cell sums and field. Bindings: ControlIo in
+// set, sorted by its own grid (cell = control radius h_c). Bindings: ControlIo in
 // src/control/force.rs; ControlParams mirrors ControlGpuParams there (offsets tested).
 #ifndef CONTROL_COMMON_GLSL
 #define CONTROL_COMMON_GLSL
@@ -36,8 +35,6 @@ struct ControlParams {
     float reach;      // its reach and the damping's (metres) ...
     uint reach_cells; // ... in control-grid cells
     float damping;    // damping relative to the character's velocity (1/s, 0: off)
-    vec4 fine;        // the grid the control set is sorted on: xyz origin, w = h_c / 2
-    uvec4 fine_dims;  // its cells (each cell of the control grid is 2 x 2 x 2 of them)
 };
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
 layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
@@ -56,12 +53,6 @@ layout(std430, binding = CTL_B_CFORCE) buffer Cforce { vec4 cforce[]; };
 layout(std430, binding = CTL_B_CVMEAN) buffer Cvmean { vec4 cvmean[]; };
 
 const uint ALL_GROUPS = 0xFFFFFFFFu;
-
-// The sorted control particles of fine cell c: [start, end).
-uvec2 fine_range(ivec3 c) {
-    uint id = (uint(c.z) * C.fine_dims.y + uint(c.y)) * C.fine_dims.x + uint(c.x);
-    return uvec2(cstart[id], cstart[id] + ccount[id]);
-}
 bool controlled(uint i) { return C.group == ALL_GROUPS || floatBitsToUint(attr[i].w) == C.group; }
 
 // A control particle's velocity: from its previous pose (inv_frame > 0) or from its pose a

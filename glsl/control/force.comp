@@ -20,23 +20,20 @@ void main() {
     vec3 xi = pos[i].xyz;
 #if CONTROL_REFRESH == 1
     float hc = C.radius, hc2 = hc * hc;
-    ivec3 fd = ivec3(C.fine_dims.xyz);
-    ivec3 c0 = clamp(ivec3(floor((xi - C.fine.xyz) / C.fine.w)), ivec3(0), fd - 1);
+    ivec3 c0 = clamp(ivec3(floor((xi - C.grid.xyz) / C.grid.w)), ivec3(0), ivec3(C.dims.xyz) - 1);
     vec3 f = vec3(0.0);
     vec3 vsum = vec3(0.0);
     float wsum = 0.0;
-    // Eq. 7 and the velocity term walk the control particles within h_c: the fine cells
-    // (h_c / 2) whose box comes within h_c of xi; with both off (c_cp = K = 0) the walk is
-    // skipped.
-    int n = (C.pressure != 0.0 || C.velocity > 0.0) ? 2 : -3;
+    // Eq. 7 and the velocity term walk the control particles within h_c; with both off
+    // (c_cp = K = 0) the walk is skipped. (A grid of h_c / 2 cells, walking only those
+    // within h_c, visits about a third of the candidates but ran 37% slower on llvmpipe.)
+    int n = (C.pressure != 0.0 || C.velocity > 0.0) ? 1 : -2;
     for (int dz = -n; dz <= n; ++dz) for (int dy = -n; dy <= n; ++dy) for (int dx = -n; dx <= n; ++dx) {
         ivec3 c = c0 + ivec3(dx, dy, dz);
-        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, fd))) continue;
-        vec3 lo = C.fine.xyz + vec3(c) * C.fine.w;
-        vec3 out_by = max(max(lo - xi, xi - (lo + C.fine.w)), 0.0);
-        if (dot(out_by, out_by) >= hc2) continue;
-        uvec2 range = fine_range(c);
-        for (uint j = range.x; j < range.y; ++j) {
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
+        uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
+        uint s = cstart[id], e = s + ccount[id];
+        for (uint j = s; j < e; ++j) {
             vec3 d = xi - cpos[j].xyz;
             float r2 = dot(d, d);
             if (r2 >= hc2 || r2 == 0.0) continue;

@@ -53,12 +53,8 @@ pub struct ControlGpuParams {
     pub reach: f32,
     pub reach_cells: u32,
     pub damping: f32,
-    /// The grid the control set is sorted on (eq. 7's walk): the control grid's origin,
-    /// cell h_c / 2, and its dims.
-    pub fine: [f32; 4],
-    pub fine_dims: [u32; 4],
 }
-const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 128);
+const _: () = assert!(std::mem::size_of::<ControlGpuParams>() == 96);
 /// Byte offset of `live` (the rays placement copies its count there).
 pub const LIVE_OFFSET: u64 = std::mem::offset_of!(ControlGpuParams, live) as u64;
 
@@ -89,10 +85,7 @@ struct ControlGpu {
     mesh: SkinnedMesh,
     search: NeighborSearch,
     nb: NeighborBuffers,
-    /// Cells of h_c (the attraction's sums and field) ...
     grid: GridSpec,
-    /// ... each split in 2 x 2 x 2 cells that the control set is sorted on.
-    fine: GridSpec,
     gather: GatherPass,
     prev: Buffer,
     sorted_pos: Buffer,
@@ -213,9 +206,6 @@ impl ControlForce {
         let top = [domain.1[0], domain.1[1], domain.1[2] + spacing + 3.0 * r];
         let hi = if rays.is_some() { top } else { domain.1 };
         let grid = GridSpec::covering(domain.0, hi, r)?;
-        // Eq. 7's walk over cells of h_c / 2 near its sphere visits about 300 candidate
-        // control particles instead of the 27 cells of h_c's 1000.
-        let fine = GridSpec::covering(domain.0, hi, r / 2.0)?;
         let rays = match rays {
             Some((spacing, capacity)) => {
                 let g = super::rays::RaysGrid::new(domain.0, domain.1, spacing)?;
@@ -233,7 +223,7 @@ impl ControlForce {
             None => None,
         };
         let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
-        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &fine, 0)?);
+        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
         let skin = SkinPass::new(ctx, skinning, mesh.influence_sets)?;
         let skin = Guard::new(ctx, skin);
         let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
@@ -265,7 +255,6 @@ impl ControlForce {
                 search: search.take(),
                 nb: nb.take(),
                 grid,
-                fine,
                 gather: gather.take(),
                 prev: prev.take(),
                 sorted_pos: sorted_pos.take(),
@@ -340,13 +329,6 @@ impl ControlForce {
             reach: s.reach,
             reach_cells: (s.reach / g.grid.cell).ceil() as u32,
             damping: s.damping,
-            fine: [
-                g.fine.origin[0],
-                g.fine.origin[1],
-                g.fine.origin[2],
-                g.fine.cell,
-            ],
-            fine_dims: [g.fine.dims[0], g.fine.dims[1], g.fine.dims[2], 0],
         }
     }
 
@@ -438,7 +420,7 @@ impl ControlForce {
         };
         scopes.begin(ctx, cmd, "control-grid");
         g.search
-            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.fine)?;
+            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
         ctx.compute_barrier(cmd); // permutation -> gathers
         g.gather
             .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);

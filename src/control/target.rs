@@ -36,8 +36,10 @@ fn default_pressure() -> f32 {
 pub const FIDELITY_VELOCITY: f32 = 10.0;
 pub const FIDELITY_ATTRACTION: f32 = 120.0;
 pub const FIDELITY_DAMPING: f32 = 1.0;
-/// The fidelity preset's steps between refreshes of the control's sums (`--control-every`).
-pub const FIDELITY_EVERY: u32 = 1;
+/// The fidelity preset's time between refreshes of the control's sums (`--control-every`
+/// is this over the step, rounded): on the walker, 4 steps of 0.36 ms held every metric of
+/// a refresh each step; 6 doubled the speed excess (results/<device>/fidelity.md).
+pub const FIDELITY_REFRESH_S: f32 = 1.5e-3;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
 /// built-in walker fills from a pool in about two seconds).
@@ -180,7 +182,10 @@ impl ControlDesc {
             damping: self.damping.unwrap_or(d.damping),
             motion: self.motion.unwrap_or(d.motion),
             group: self.group.unwrap_or(ALL_GROUPS),
-            every: self.every.unwrap_or(d.every),
+            every: self.every.unwrap_or_else(|| match d.refresh_s {
+                Some(t) => ((t / fluid.dt).round() as u32).clamp(1, super::cache::MAX_EVERY),
+                None => 1,
+            }),
         }
     }
 }
@@ -193,8 +198,8 @@ struct Preset {
     reach: f32,
     damping: f32,
     motion: ControlMotion,
-    /// Steps between refreshes of the control's sums.
-    every: u32,
+    /// Simulated time between refreshes of the control's sums (None: every step).
+    refresh_s: Option<f32>,
 }
 
 impl Preset {
@@ -206,7 +211,7 @@ impl Preset {
                 reach: 3.0,
                 damping: 0.0,
                 motion: ControlMotion::Frames,
-                every: 1,
+                refresh_s: None,
             },
             ControlPreset::Fidelity => Self {
                 velocity: FIDELITY_VELOCITY,
@@ -214,7 +219,7 @@ impl Preset {
                 reach: 3.0,
                 damping: FIDELITY_DAMPING,
                 motion: ControlMotion::Skin,
-                every: FIDELITY_EVERY,
+                refresh_s: Some(FIDELITY_REFRESH_S),
             },
         }
     }

@@ -243,12 +243,10 @@ impl FluidParams {
                 set_path(table, &path, parsed.clone())?;
             }
         }
-        let out: FluidParams = value
-            .try_into()
-            .map_err(|e| {
-                let e = e.to_string().replace('\n', " ");
-                Error::Param(format!("--fluid: {}", e.trim()))
-            })?;
+        let out: FluidParams = value.try_into().map_err(|e| {
+            let e = e.to_string().replace('\n', " ");
+            Error::Param(format!("--fluid: {}", e.trim()))
+        })?;
         out.validate()?;
         Ok(out)
     }
