@@ -61,6 +61,10 @@ fn embed_commit() {
     }
 }
 
+#[allow(dead_code)]
+#[path = "src/psys/codes.rs"]
+mod psys_codes;
+
 fn embed_glsl() {
     let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("glsl");
     println!("cargo:rerun-if-changed={}", root.display());
@@ -82,6 +86,17 @@ fn embed_glsl() {
         )
         .unwrap();
     }
+    // Headers generated from Rust (one source for codes shared with the shaders).
+    let out_dir = PathBuf::from(env::var("OUT_DIR").unwrap());
+    println!("cargo:rerun-if-changed=src/psys/codes.rs");
+    let header = out_dir.join("psys_codes.glsl");
+    std::fs::write(&header, psys_codes::glsl_header()).unwrap();
+    writeln!(
+        out,
+        "    (\"generated/psys_codes.glsl\", include_str!({:?})),",
+        header.display().to_string()
+    )
+    .unwrap();
     out.push_str("];\n");
     std::fs::write(
         PathBuf::from(env::var("OUT_DIR").unwrap()).join("glsl_sources.rs"),

@@ -285,7 +285,8 @@ fn failed_construction_leaks_nothing() {
     common::finish(&ctx);
 }
 
-/// Rust mirrors of GPU structs against the offsets the GLSL compiler gave each member.
+/// Rust mirrors of GPU structs against the offsets the GLSL compiler gave each member: every
+/// `#[repr(C)]` struct in src (a test below counts them).
 #[test]
 fn gpu_struct_mirrors_match_glsl_field_offsets() {
     use fluidform::gpu::interface::member_offsets;
@@ -304,7 +305,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
                 end += field_size(|t: &$t| &t.$f);
             )*
             assert_eq!(end, size_of::<$t>(), "{}: fields missing from the list", stringify!($t));
-            (size_of::<$t>(), v)
+            (size_of::<$t>(), v, std::any::type_name::<$t>().rsplit("::").next().unwrap())
         }};
     }
     let c = fluidform::gpu::shader::ShaderCompiler::new().unwrap();
@@ -319,7 +320,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
     use fluidform::render::metaball::GpuStats;
     use fluidform::sph::params::{GpuCollider, SphGpuParams};
     // Every Rust field is listed (the list covers the whole struct: tested by count).
-    type Fields = (usize, Vec<(&'static str, usize)>);
+    type Fields = (usize, Vec<(&'static str, usize)>, &'static str);
     let cases: Vec<(&str, &str, Fields)> = vec![
         (
             "sph/integrate.comp",
@@ -393,8 +394,99 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             fields!(LiveCount;
             n, capacity, local_size, pad, groups, pad2),
         ),
+        (
+            "primitives/bounds.comp",
+            "Push",
+            fields!(fluidform::primitives::bounds::BoundsPush; n, pairs),
+        ),
+        (
+            "primitives/count.comp",
+            "Push",
+            fields!(fluidform::primitives::counting::CountPush; n, cells),
+        ),
+        (
+            "primitives/scan_chunk_reduce.comp",
+            "Push",
+            fields!(fluidform::primitives::scan::ScanPush; n, base, flags),
+        ),
+        (
+            "primitives/oddeven.comp",
+            "Push",
+            fields!(fluidform::primitives::sort::SortPush; n, p, k, mode),
+        ),
+        (
+            "sph/step_error.comp",
+            "Push",
+            fields!(fluidform::sph::errors::StepErrorPush; n, mode, step, rest_density, dt),
+        ),
+        (
+            "sph/constant_force.comp",
+            "Push",
+            fields!(fluidform::sph::hooks::ConstantForcePush; accel, n),
+        ),
+        (
+            "sph/health.comp",
+            "Health",
+            fields!(fluidform::sph::health::GpuHealth; nonfinite, max_speed2, max_density, pad),
+        ),
+        (
+            "primitives/nb_query.comp",
+            "Push",
+            fields!(fluidform::primitives::neighbors::NeighborPush;
+            origin_cell, dims, radius, n, max_neighbors, pad),
+        ),
+        (
+            "scene/orbits.comp",
+            "Push",
+            fields!(fluidform::scene::orbits::OrbitsPush; dt, strength, eps, n),
+        ),
+        (
+            "render/points.vert",
+            "Push",
+            fields!(fluidform::render::points::PointsPush; view_proj, right, up),
+        ),
+        (
+            "render/mesh.vert",
+            "Push",
+            fields!(fluidform::render::mesh::MeshPush; view_proj, eye, color),
+        ),
+        (
+            "character/skin.comp",
+            "Push",
+            fields!(fluidform::character::skin::SkinPush; n),
+        ),
+        (
+            "psys/draw.vert",
+            "Push",
+            fields!(fluidform::psys::gpu::DrawPush;
+            view_proj, right, up, screen, offset, identity, pad),
+        ),
+        (
+            "psys/emit.comp",
+            "Push",
+            fields!(fluidform::psys::gpu::StepPush;
+            view_proj, source, births, seed, cur, head, dt, capacity, mode, cells, near, far,
+            capsules, triangles),
+        ),
+        (
+            "psys/emit.comp",
+            "Counters",
+            fields!(fluidform::psys::gpu::Counters;
+            dead_count, alive, verts, update_args, draw_args, births, refused, died_life,
+            died_view, died_distance, died_collision, overwritten, changed, spawned,
+            spawn_refused, events_dropped, pad),
+        ),
+        (
+            "psys/emit.comp",
+            "SystemParams",
+            fields!(fluidform::psys::gpu::SystemParams;
+            emitter, extent, normal, offset_mean, offset_var, vel_mean, vel_var, color_mean,
+            color_var, scalar_mean, scalar_var, gravity, wind, death, counts, counts2,
+            size_keys, color_keys, opacity_keys, forces, colliders, boids, grid_dims),
+        ),
     ];
-    for (file, glsl, (size, rust)) in cases {
+    let checked: Vec<&str> = cases.iter().map(|c| c.2 .2).collect();
+    for (file, glsl, (size, rust, _)) in cases {
         let got = member_offsets(&spv(file), glsl);
         let want: Vec<(String, u32)> = rust
             .iter()
@@ -406,6 +498,38 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         }
         assert!(size > 0);
     }
+    // Every `#[repr(C)]` struct in src is among them.
+    let mut missing = Vec::new();
+    let mut stack = vec![std::path::PathBuf::from("src")];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            let text = std::fs::read_to_string(&p).unwrap_or_default();
+            let mut lines = text.lines();
+            while let Some(l) = lines.next() {
+                if l.trim() != "#[repr(C)]" {
+                    continue;
+                }
+                let decl = lines.by_ref().find(|l| l.contains("struct ")).unwrap_or("");
+                let name = decl.split("struct ").nth(1).unwrap_or("");
+                let name = name
+                    .split(|c: char| !c.is_alphanumeric() && c != '_')
+                    .next();
+                let name = name.unwrap_or("").to_string();
+                if !checked.contains(&name.as_str()) {
+                    missing.push(format!("{name} ({})", p.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "repr(C) structs with no offset check: {missing:?}"
+    );
 }
 
 /// `--validation` includes synchronization validation: a dispatch that reads a buffer a

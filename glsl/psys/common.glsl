@@ -2,37 +2,9 @@
 // Mirrors src/psys/gpu.rs (SystemParams, Counters); one source of truth for the layout.
 #ifndef PSYS_COMMON_GLSL
 #define PSYS_COMMON_GLSL
-#define MAX_KEYS 8
-#define MAX_FORCES 8
-#define MAX_COLLIDERS 8
-// Force kinds (Force.a.w).
-#define F_ATTRACTOR 1
-#define F_VORTEX 2
-#define F_CURL 3
-// Collider kinds (Collider.a.w).
-#define C_PLANE 1
-#define C_SPHERE 2
-#define C_BOX 3
-#define C_CAPSULE 4
-#define C_CHARACTER 5  // the scene character's capsules (update.comp)
-// Emitter shapes (emitter.w).
-#define E_POINT 0
-#define E_BOX 1
-#define E_SPHERE 2
-#define E_DISC 3
-#define E_MESH 4
-// Integrators.
-#define I_EULER 0
-#define I_VERLET 1
-#define I_CLOSED 2
-// Event flags (counts2.z) and kinds (Event.p.w).
-#define EV_COLLISION 1u
-#define EV_KEEP_PARENT 2u
-#define EV_DEATH 4u
-#define KIND_COLLISION 1u
-#define KIND_DEATH 2u
-// Slot of a free or culled entry in an order list.
-#define NO_SLOT 0xFFFFFFFFu
+// Limits, force, collider and emitter kinds, integrators, event flags and kinds, NO_SLOT:
+// generated from src/psys/codes.rs.
+#include "generated/psys_codes.glsl"
 
 struct Force {
     vec4 a;  // attractor: xyz point, w kind | vortex: xyz centre | curl: -

@@ -16,6 +16,5 @@ layout(push_constant) uniform Push {
     vec4 screen;  // x 2 / width, y 2 / height, z frame dt (s), w sprite texture side
     uint offset;  // first entry of `order`
     uint identity;  // 1: instance = slot (closed form, unsorted)
-    uint pad0;
-    uint pad1;
+    uint pad[2];
 } pc;

@@ -16,7 +16,12 @@ pub fn glsl_files() -> impl Iterator<Item = &'static str> {
 
 /// The text of glsl/`path`.
 pub fn glsl_source(path: &str) -> Result<Cow<'static, str>> {
-    if let Ok(dir) = std::env::var("FLUIDFORM_GLSL_DIR") {
+    // (Generated headers exist only in the build: always the embedded ones.)
+    let generated = path.starts_with("generated/");
+    if let Some(dir) = std::env::var("FLUIDFORM_GLSL_DIR")
+        .ok()
+        .filter(|_| !generated)
+    {
         let full = std::path::Path::new(&dir).join(path);
         return std::fs::read_to_string(&full)
             .map(Cow::Owned)

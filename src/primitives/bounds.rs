@@ -12,8 +12,8 @@ const BLOCK: u64 = (WG * ITEMS) as u64;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct BoundsPush {
-    n: u32,
-    pairs: u32,
+    pub n: u32,
+    pub pairs: u32,
 }
 const _: () = assert!(std::mem::size_of::<BoundsPush>() == 8);
 

@@ -10,8 +10,8 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct CountPush {
-    n: u32,
-    cells: u32,
+    pub n: u32,
+    pub cells: u32,
 }
 
 crate::gpu_interface! {

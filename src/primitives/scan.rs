@@ -38,10 +38,10 @@ pub enum ScanVariant {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct ScanPush {
-    n: u32,
+    pub n: u32,
     /// Index of this segment's first chunk in the chunk sums.
-    base: u32,
-    flags: u32,
+    pub base: u32,
+    pub flags: u32,
 }
 const _: () = assert!(std::mem::size_of::<ScanPush>() == 12);
 const INCLUSIVE: u32 = 1;

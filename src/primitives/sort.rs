@@ -19,10 +19,10 @@ pub enum Network {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct SortPush {
-    n: u32,
-    p: u32,
-    k: u32,
-    mode: u32,
+    pub n: u32,
+    pub p: u32,
+    pub k: u32,
+    pub mode: u32,
 }
 const _: () = assert!(std::mem::size_of::<SortPush>() == 16);
 const LOCAL_SORT: u32 = 0;

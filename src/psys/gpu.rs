@@ -1,5 +1,6 @@
 //! The GPU side of a particle system: the parameter block and counters (mirrored in
 //! glsl/psys/common.glsl), the passes' interfaces and pipelines (size-independent).
+use super::codes;
 use super::spec::{
     BoidsSpec, ColliderKind, EventKind, ForceKind, Shape, SystemSpec, MAX_COLLIDERS, MAX_FORCES,
     MAX_KEYS,
@@ -108,12 +109,12 @@ impl SystemParams {
         let mut p = Self::zeroed();
         let e = &spec.emitter;
         let shape = match e.shape {
-            Shape::Point => 0.0,
-            Shape::Box => 1.0,
-            Shape::Sphere => 2.0,
-            Shape::Disc => 3.0,
-            Shape::Mesh => 4.0,
-        };
+            Shape::Point => codes::E_POINT,
+            Shape::Box => codes::E_BOX,
+            Shape::Sphere => codes::E_SPHERE,
+            Shape::Disc => codes::E_DISC,
+            Shape::Mesh => codes::E_MESH,
+        } as f32;
         p.emitter = v3(e.centre, shape);
         p.extent = match e.shape {
             Shape::Box => v3(e.half, e.surface as u32 as f32),
@@ -145,9 +146,9 @@ impl SystemParams {
             o.color.len() as u32,
         ];
         let integrator = match spec.integrator() {
-            Integrator::Euler => 0,
-            Integrator::Verlet => 1,
-            Integrator::Closed => 2,
+            Integrator::Euler => codes::I_EULER,
+            Integrator::Verlet => codes::I_VERLET,
+            Integrator::Closed => codes::I_CLOSED,
         };
         let mut events = 0;
         for e in &spec.event {
@@ -167,11 +168,18 @@ impl SystemParams {
         for (k, s) in o.opacity.iter().enumerate() {
             p.opacity_keys[k] = [s[0], s[1], 0.0, 0.0];
         }
+        let code = |c: u32| c as f32;
         for (k, f) in spec.force.iter().enumerate() {
             p.forces[k] = match f.kind {
-                ForceKind::Attractor => [v3(f.at, 1.0), [f.strength, f.eps, 0.0, 0.0]],
-                ForceKind::Vortex => [v3(f.at, 2.0), v3(f.axis, f.strength)],
-                ForceKind::Curl => [[0.0, 0.0, 0.0, 3.0], [f.strength, f.scale, f.speed, 0.0]],
+                ForceKind::Attractor => [
+                    v3(f.at, code(codes::F_ATTRACTOR)),
+                    [f.strength, f.eps, 0.0, 0.0],
+                ],
+                ForceKind::Vortex => [v3(f.at, code(codes::F_VORTEX)), v3(f.axis, f.strength)],
+                ForceKind::Curl => [
+                    v3([0.0; 3], code(codes::F_CURL)),
+                    [f.strength, f.scale, f.speed, 0.0],
+                ],
             };
         }
         for (k, c) in spec.collider.iter().enumerate() {
@@ -182,11 +190,19 @@ impl SystemParams {
                 c.kill as u32 as f32,
             ];
             p.colliders[k] = match c.kind {
-                ColliderKind::Plane => [v3(c.normal, 1.0), [c.offset, 0.0, 0.0, 0.0], resp],
-                ColliderKind::Sphere => [v3(c.centre, 2.0), [c.radius, 0.0, 0.0, 0.0], resp],
-                ColliderKind::Box => [v3(c.min, 3.0), v3(c.max, 0.0), resp],
-                ColliderKind::Capsule => [v3(c.a, 4.0), v3(c.b, c.radius), resp],
-                ColliderKind::Character => [[0.0, 0.0, 0.0, 5.0], [0.0; 4], resp],
+                ColliderKind::Plane => [
+                    v3(c.normal, code(codes::C_PLANE)),
+                    [c.offset, 0.0, 0.0, 0.0],
+                    resp,
+                ],
+                ColliderKind::Sphere => [
+                    v3(c.centre, code(codes::C_SPHERE)),
+                    [c.radius, 0.0, 0.0, 0.0],
+                    resp,
+                ],
+                ColliderKind::Box => [v3(c.min, code(codes::C_BOX)), v3(c.max, 0.0), resp],
+                ColliderKind::Capsule => [v3(c.a, code(codes::C_CAPSULE)), v3(c.b, c.radius), resp],
+                ColliderKind::Character => [v3([0.0; 3], code(codes::C_CHARACTER)), [0.0; 4], resp],
             };
         }
         if let Some(b) = &spec.boids {
@@ -211,10 +227,7 @@ impl BoidsSpec {
     }
 }
 
-/// Event flags of `SystemParams::counts2.z` (glsl/psys/common.glsl).
-pub const EV_COLLISION: u32 = 1;
-pub const EV_KEEP_PARENT: u32 = 2;
-pub const EV_DEATH: u32 = 4;
+pub use super::codes::{EV_COLLISION, EV_DEATH, EV_KEEP_PARENT};
 
 /// The header of an event list (`Events` in glsl/psys/state.glsl): the count, then the
 /// spawn's indirect dispatch; the records follow.

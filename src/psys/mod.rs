@@ -4,6 +4,7 @@
 //! forces, collisions, death; alive and dead lists compacted on the GPU with indirect
 //! dispatch and draw; points, streaks and sprites sorted back to front.
 pub mod character;
+pub mod codes;
 pub mod cpu;
 pub mod frame;
 pub mod gpu;

@@ -358,10 +358,10 @@ pub enum SpriteTexture {
     Smoke,
 }
 
-/// Most keyframes per curve, forces and colliders per system (glsl/psys/common.glsl).
-pub const MAX_KEYS: usize = 8;
-pub const MAX_FORCES: usize = 8;
-pub const MAX_COLLIDERS: usize = 8;
+/// Most keyframes per curve, forces and colliders per system (src/psys/codes.rs).
+pub const MAX_KEYS: usize = super::codes::MAX_KEYS as usize;
+pub const MAX_FORCES: usize = super::codes::MAX_FORCES as usize;
+pub const MAX_COLLIDERS: usize = super::codes::MAX_COLLIDERS as usize;
 
 impl SystemSpec {
     /// Whether it emits from or collides with the scene character.

@@ -16,11 +16,11 @@ const BLOCK: u64 = (WG * ITEMS) as u64;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct StepErrorPush {
-    n: u32,
-    mode: u32,
-    step: u32,
-    rest_density: f32,
-    dt: f32,
+    pub n: u32,
+    pub mode: u32,
+    pub step: u32,
+    pub rest_density: f32,
+    pub dt: f32,
 }
 
 crate::gpu_interface! {
