@@ -141,6 +141,17 @@ pub struct Summary<C, S> {
     pub stats: S,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation: Option<ValidationCounts>,
+    /// Barriers the tracker placed beyond the hand-placed ones, and hazards it found in
+    /// draws where it may place none (`gpu::track`; both 0 when the hand placement is
+    /// complete).
+    #[serde(default)]
+    pub barriers: TrackedBarriers,
+}
+
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct TrackedBarriers {
+    pub placed: u64,
+    pub unplaced: u64,
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
@@ -158,6 +169,8 @@ pub struct Report<'a, C, S> {
     pub memory: BTreeMap<String, u64>,
     pub stats: S,
     pub validation: Option<(u32, u32)>,
+    /// `Context::tracked_barriers`.
+    pub barriers: (u64, u64),
 }
 
 impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
@@ -178,6 +191,10 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
             validation: self
                 .validation
                 .map(|(errors, warnings)| ValidationCounts { errors, warnings }),
+            barriers: TrackedBarriers {
+                placed: self.barriers.0,
+                unplaced: self.barriers.1,
+            },
         }
     }
 

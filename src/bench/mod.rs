@@ -245,6 +245,7 @@ pub fn measure(
             .common
             .validation
             .then(|| ctx.validation_counts()),
+        barriers: ctx.tracked_barriers(),
     };
     report.write(&opts.out.join("runs").join(&label))?;
     let passes = crate::report::pass_stats(&timings);

@@ -78,6 +78,8 @@ pub struct Context {
     pub(crate) memory: Mutex<BTreeMap<String, u64>>,
     /// Live pipelines, buffers, images, pools: what an error path could leak.
     objects: Mutex<BTreeMap<&'static str, i64>>,
+    /// Buffer hazards of the command buffers being recorded (`gpu::track`).
+    pub(crate) trackers: Mutex<super::track::Trackers>,
 }
 
 impl Context {
@@ -192,6 +194,7 @@ impl Context {
             one_shot_pool: Mutex::new(pool),
             memory: Mutex::new(BTreeMap::new()),
             objects: Mutex::new(BTreeMap::new()),
+            trackers: Mutex::new(Default::default()),
         };
         ctx.set_name(pool, "one-shot command pool");
         ctx.set_name(ctx.queue, "main queue");
@@ -280,6 +283,7 @@ impl Context {
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             unsafe { self.device.begin_command_buffer(cmd, &begin) }.ctx("begin command")?;
+            self.trackers.lock().unwrap().begin(cmd);
             let r = f(cmd);
             unsafe { self.device.end_command_buffer(cmd) }.ctx("end command")?;
             self.submit(cmd, fence)?;
@@ -296,6 +300,7 @@ impl Context {
     pub fn submit(&self, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<()> {
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+        self.trackers.lock().unwrap().end(cmd);
         unsafe { self.device.queue_submit2(self.queue, &[submit], fence) }.ctx("queue submit")
     }
 

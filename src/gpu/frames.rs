@@ -108,6 +108,7 @@ impl FrameLoop {
                     .begin_command_buffer(cmd, &begin)
                     .ctx("begin frame")?;
             }
+            ctx.trackers.lock().unwrap().begin(cmd);
             // Frame boundary: the previous frames' writes are visible to this one's passes,
             // so a frame's work needs no barrier before its first reads.
             ctx.barrier(

@@ -151,7 +151,7 @@ fn without_source_text(spv: &[u32]) -> Vec<u32> {
 
 /// The module's instructions after its 5-word header, each with its operands (the word
 /// count is in the upper half of the first word).
-fn instructions(spv: &[u32]) -> impl Iterator<Item = &[u32]> {
+pub(crate) fn instructions(spv: &[u32]) -> impl Iterator<Item = &[u32]> {
     let mut i = 5;
     std::iter::from_fn(move || {
         let first = *spv.get(i)?;

@@ -1,5 +1,6 @@
 //! Vulkan core. Knows no algorithm: context, devices, memory, shaders, pipelines,
 //! timestamps, frames in flight and the headless render target.
+pub mod access;
 pub mod context;
 pub mod device;
 pub mod frames;
@@ -12,6 +13,7 @@ pub mod profiler;
 pub mod shader;
 pub mod sync;
 pub mod target;
+pub mod track;
 
 pub use context::{Context, ContextOptions};
 pub use device::{list_devices, DeviceInfo};

@@ -3,7 +3,10 @@
 //! (of any size) can be bound per dispatch.
 //! Specialization constant 0 is the workgroup size (`layout(local_size_x_id = 0) in;`),
 //! constants 1.. are the pass's own.
+use super::access::{buffer_uses, Use};
 use super::interface::{check, BindingDecl, Interface, Reflected};
+use super::track::BufferUse;
+use std::collections::BTreeMap;
 use super::{Buffer, Context};
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
@@ -162,6 +165,8 @@ pub struct ComputePipeline<I: Interface> {
     pub set_layout: vk::DescriptorSetLayout,
     pub local_size: u32,
     pub name: String,
+    /// What the shader does with each binding (from its SPIR-V): the barrier tracker's input.
+    uses: BTreeMap<u32, Use>,
     interface: PhantomData<I>,
 }
 
@@ -230,12 +235,40 @@ impl<I: Interface> ComputePipeline<I> {
             set_layout,
             local_size: d.local_size,
             name: d.name.to_string(),
+            uses: buffer_uses(&spv[0]),
             interface: PhantomData,
         })
     }
 
-    /// Bind the pipeline, push its descriptors and constants.
-    fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
+    /// Bind the pipeline, push its descriptors and constants, after the barrier its buffers'
+    /// hazards need (and `args`', read as indirect arguments).
+    fn bind(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        bufs: &I::Bufs<'_>,
+        push: &I::Push,
+        args: Option<&Buffer>,
+    ) {
+        let buffers = I::buffers(bufs);
+        let mut uses: Vec<BufferUse> = buffers
+            .iter()
+            .filter_map(|(b, info)| {
+                let u = self.uses.get(b)?;
+                let c = BufferUse::compute(info.buffer, u.read, u.write);
+                Some(c.bytes(info.offset, info.range))
+            })
+            .collect();
+        uses.extend(args.map(|a| BufferUse::indirect(a.raw)));
+        if std::env::var("FLUIDFORM_TRACK_DEBUG").is_ok() {
+            let before = ctx.trackers.lock().unwrap().get(cmd).placed;
+            ctx.track(cmd, &uses, true);
+            if ctx.trackers.lock().unwrap().get(cmd).placed > before {
+                eprintln!("track: placed before {}", self.name);
+            }
+        } else {
+            ctx.track(cmd, &uses, true);
+        }
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
@@ -244,7 +277,7 @@ impl<I: Interface> ComputePipeline<I> {
                 cmd,
                 vk::PipelineBindPoint::COMPUTE,
                 self.layout,
-                &I::buffers(bufs),
+                &buffers,
             );
             let bytes = bytemuck::bytes_of(push);
             if !bytes.is_empty() {
@@ -274,7 +307,7 @@ impl<I: Interface> ComputePipeline<I> {
         }
         let gx = groups.min(MAX_GROUPS_X as u64) as u32;
         let gy = groups.div_ceil(gx as u64) as u32;
-        self.bind(ctx, cmd, bufs, push);
+        self.bind(ctx, cmd, bufs, push, None);
         unsafe { ctx.device.cmd_dispatch(cmd, gx, gy, 1) };
     }
 
@@ -307,7 +340,7 @@ impl<I: Interface> ComputePipeline<I> {
         args: &Buffer,
         offset: u64,
     ) {
-        self.bind(ctx, cmd, bufs, push);
+        self.bind(ctx, cmd, bufs, push, Some(args));
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
     }
 
@@ -351,6 +384,8 @@ pub struct GraphicsPipeline<I: Interface> {
     pub layout: vk::PipelineLayout,
     pub set_layout: vk::DescriptorSetLayout,
     pub name: String,
+    /// What each stage does with each binding (from the SPIR-V), for the barrier tracker.
+    uses: Vec<(vk::PipelineStageFlags2, BTreeMap<u32, Use>)>,
     interface: PhantomData<I>,
 }
 
@@ -456,12 +491,34 @@ impl<I: Interface> GraphicsPipeline<I> {
             layout,
             set_layout,
             name: d.name.to_string(),
+            uses: vec![
+                (vk::PipelineStageFlags2::VERTEX_SHADER, buffer_uses(&spv[0])),
+                (vk::PipelineStageFlags2::FRAGMENT_SHADER, buffer_uses(&spv[1])),
+            ],
             interface: PhantomData,
         })
     }
 
-    /// Bind the pipeline, its buffers and push constants (inside a rendering scope).
+    /// Bind the pipeline, its buffers and push constants (inside a rendering scope: the
+    /// tracker records the draws' uses but places no barrier there).
     pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
+        let buffers = I::buffers(bufs);
+        let (read, write) = (
+            vk::AccessFlags2::SHADER_STORAGE_READ,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        );
+        let uses: Vec<BufferUse> = self
+            .uses
+            .iter()
+            .flat_map(|(stage, map)| {
+                buffers.iter().filter_map(move |(b, info)| {
+                    let u = map.get(b)?;
+                    let at = BufferUse::at(info.buffer, *stage, (u.read, read), (u.write, write));
+                    Some(at.bytes(info.offset, info.range))
+                })
+            })
+            .collect();
+        ctx.track(cmd, &uses, false);
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);

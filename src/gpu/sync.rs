@@ -7,6 +7,7 @@
 //! them, read-after-write and write-after-read (a buffer overwritten while earlier commands
 //! may still read it); the frame loop issues one barrier at every frame boundary. Each call
 //! carries a comment naming what it protects.
+use super::track::BufferUse;
 use super::Context;
 use ash::vk;
 use std::ops::BitOr;
@@ -104,6 +105,36 @@ pub const HOST_READ: Access = acc(vk::PipelineStageFlags2::HOST, vk::AccessFlags
 impl Context {
     /// A memory dependency from `from` (earlier commands) to `to` (later commands).
     pub fn barrier(&self, cmd: vk::CommandBuffer, from: Access, to: Access) {
+        self.trackers.lock().unwrap().get(cmd).barrier(from, to);
+        self.record_barrier(cmd, from, to);
+    }
+
+    /// Record the buffer uses of the next command (`gpu::track`); `place`: record the
+    /// barrier it needs, if any (never inside a rendering scope).
+    pub fn track(&self, cmd: vk::CommandBuffer, uses: &[BufferUse], place: bool) {
+        let need = self.trackers.lock().unwrap().get(cmd).before(uses, place);
+        if need.is_some() && std::env::var("FLUIDFORM_TRACK_DEBUG").is_ok() {
+            let bt = std::backtrace::Backtrace::force_capture().to_string();
+            let at: Vec<&str> = bt
+                .lines()
+                .filter(|l| l.contains("fluidform::") && !l.contains("gpu::"))
+                .take(3)
+                .collect();
+            eprintln!("track: place={place} {need:?} at {}", at.join(" < "));
+        }
+        if let (Some((from, to)), true) = (need, place) {
+            self.record_barrier(cmd, from, to);
+        }
+    }
+
+    /// Barriers the tracker placed and hazards it could not place a barrier for (in draws),
+    /// over the command buffers submitted so far.
+    pub fn tracked_barriers(&self) -> (u64, u64) {
+        let t = self.trackers.lock().unwrap();
+        (t.placed, t.unplaced)
+    }
+
+    fn record_barrier(&self, cmd: vk::CommandBuffer, from: Access, to: Access) {
         let b = [vk::MemoryBarrier2::default()
             .src_stage_mask(from.stage)
             .src_access_mask(from.access)
@@ -128,6 +159,11 @@ impl Context {
         dst_offset: u64,
         size: u64,
     ) {
+        let uses = [
+            BufferUse::transfer(src.raw, false).bytes(src_offset, size),
+            BufferUse::transfer(dst.raw, true).bytes(dst_offset, size),
+        ];
+        self.track(cmd, &uses, true);
         let region = vk::BufferCopy {
             src_offset,
             dst_offset,
@@ -141,6 +177,7 @@ impl Context {
 
     /// Fill the whole buffer with a u32 value.
     pub fn fill(&self, cmd: vk::CommandBuffer, b: &super::Buffer, value: u32) {
+        self.track(cmd, &[BufferUse::transfer(b.raw, true)], true);
         unsafe {
             self.device
                 .cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, value)
@@ -157,6 +194,8 @@ impl Context {
     ) {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         if !bytes.is_empty() {
+            let u = BufferUse::transfer(b.raw, true).bytes(offset, bytes.len() as u64);
+            self.track(cmd, &[u], true);
             unsafe { self.device.cmd_update_buffer(cmd, b.raw, offset, bytes) };
         }
     }
@@ -170,6 +209,7 @@ impl Context {
     /// End a dynamic-rendering scope.
     pub fn end_rendering(&self, cmd: vk::CommandBuffer) {
         unsafe { self.device.cmd_end_rendering(cmd) };
+        self.trackers.lock().unwrap().get(cmd).end_scope();
     }
 
     /// Non-indexed draw of `vertices` x `instances` (inside a rendering scope).
@@ -179,6 +219,7 @@ impl Context {
 
     /// One draw whose VkDrawIndirectCommand a GPU pass wrote into `args` at byte `offset`.
     pub fn draw_indirect(&self, cmd: vk::CommandBuffer, args: &super::Buffer, offset: u64) {
+        self.track(cmd, &[BufferUse::indirect(args.raw)], false);
         unsafe { self.device.cmd_draw_indirect(cmd, args.raw, offset, 1, 16) };
     }
 

@@ -229,6 +229,7 @@ pub(crate) fn finish_fluidless(
         memory,
         stats,
         validation: sw.common.validation.then(|| ctx.validation_counts()),
+        barriers: ctx.tracked_barriers(),
     };
     let summary = report.write(&opts.out)?;
     check_validation(ctx)?;

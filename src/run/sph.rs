@@ -319,6 +319,7 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
         memory,
         stats: RunStats::Sph(Box::new(stats)),
         validation: sw.common.validation.then(|| ctx.validation_counts()),
+        barriers: ctx.tracked_barriers(),
     };
     let summary = report.write(&opts.out)?;
     check_validation(&ctx)?;

@@ -1,0 +1,95 @@
+//! The barrier tracker (gpu::track): known command sequences and the barriers it places,
+//! and the uses it reads from SPIR-V.
+mod common;
+use ash::vk;
+use fluidform::gpu::access::buffer_uses;
+use fluidform::gpu::sync;
+use fluidform::gpu::track::{BufferUse, Tracker};
+use vk::Handle;
+
+fn buf(i: u64) -> vk::Buffer {
+    vk::Buffer::from_raw(i)
+}
+fn read(i: u64) -> BufferUse {
+    BufferUse::compute(buf(i), true, false)
+}
+fn write(i: u64) -> BufferUse {
+    BufferUse::compute(buf(i), false, true)
+}
+
+#[test]
+fn write_then_read_gets_one_barrier_reads_and_other_buffers_none() {
+    let mut t = Tracker::default();
+    assert!(t.before(&[write(1)], true).is_none(), "a first write");
+    let (from, to) = t.before(&[read(1)], true).expect("write -> read");
+    assert!(from.stage.contains(vk::PipelineStageFlags2::COMPUTE_SHADER));
+    assert!(from.access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
+    assert!(to.access.contains(vk::AccessFlags2::SHADER_STORAGE_READ));
+    assert!(t.before(&[read(1)], true).is_none(), "read -> read");
+    assert!(t.before(&[write(2)], true).is_none(), "another buffer");
+    assert!(t.before(&[read(3)], true).is_none(), "never written");
+    // Write after read waits for the read (an execution dependency).
+    let (from, to) = t.before(&[write(1)], true).expect("read -> write");
+    assert!(from.stage.contains(vk::PipelineStageFlags2::COMPUTE_SHADER));
+    assert!(to.stage.contains(vk::PipelineStageFlags2::COMPUTE_SHADER));
+    // Write after write, through a transfer: the fill waits for the dispatch's write.
+    let (from, to) = t
+        .before(&[BufferUse::transfer(buf(1), true)], true)
+        .expect("write -> write");
+    assert!(from.access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
+    assert!(to.access.contains(vk::AccessFlags2::TRANSFER_WRITE));
+    assert_eq!(t.placed, 3);
+}
+
+#[test]
+fn a_hand_barrier_that_covers_the_hazard_leaves_nothing_to_place() {
+    let mut t = Tracker::default();
+    t.before(&[write(1), write(2)], true);
+    t.barrier(sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    assert!(t.before(&[read(1), read(2)], true).is_none());
+    // A barrier to the wrong stage does not cover an indirect read or a copy.
+    t.before(&[write(3)], true);
+    t.barrier(sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    assert!(t.before(&[BufferUse::indirect(buf(3))], true).is_some());
+    t.before(&[write(4)], true);
+    t.barrier(sync::COMPUTE_WRITE, sync::COMPUTE_READ);
+    // Chained: compute -> compute, then compute -> transfer makes the write visible to a copy.
+    t.barrier(sync::COMPUTE_READ, sync::TRANSFER_READ);
+    assert!(t.before(&[BufferUse::transfer(buf(4), false)], true).is_none());
+    // ALL_COMMANDS covers everything.
+    t.before(&[write(5)], true);
+    t.barrier(sync::ALL, sync::ALL);
+    assert!(t.before(&[BufferUse::indirect(buf(5))], true).is_none());
+    assert_eq!(t.placed, 1);
+    // Inside a rendering scope a hazard is counted, not placed.
+    t.before(&[write(6)], true);
+    assert!(t.before(&[read(6)], false).is_some());
+    assert_eq!((t.placed, t.unplaced), (1, 1));
+}
+
+/// Uses come from what a shader does, not from how it declares a block.
+#[test]
+fn buffer_uses_follow_loads_stores_and_atomics() {
+    let c = fluidform::gpu::shader::ShaderCompiler::new().unwrap();
+    let src = r#"#version 450
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) buffer A { float a[]; };          // read only (declared rw)
+layout(std430, binding = 1) buffer B { float b[]; };          // written
+layout(std430, binding = 2) buffer C { uint c[]; };           // atomic: read and write
+layout(std430, binding = 3) readonly buffer D { float d[]; }; // unused
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    b[i] = a[i] * 2.0;
+    atomicAdd(c[0], 1u);
+}
+"#;
+    let spv = c
+        .compile_source("test/uses.comp", src, shaderc::ShaderKind::Compute, &[])
+        .unwrap();
+    let u = buffer_uses(&spv);
+    let rw = |b: u32| u.get(&b).map(|u| (u.read, u.write));
+    assert_eq!(rw(0), Some((true, false)));
+    assert_eq!(rw(1), Some((false, true)));
+    assert_eq!(rw(2), Some((true, true)));
+    assert_eq!(rw(3), None);
+}
