@@ -5,7 +5,7 @@
 //! the host (`live`) and on the GPU (`count`: the count and indirect-dispatch arguments that
 //! GPU passes such as emission and death can change with no CPU round trip).
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Destroy, Guard, Scopes};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Destroy, Guard, Scopes};
 use crate::primitives::counting::GatherPass;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -243,7 +243,6 @@ impl ParticleStore {
                 let i = if a.decl.reorder { cur } else { 0 };
                 ctx.copy(cmd, &a.bufs[i], 0, &new[i], 0, live * a.decl.bytes as u64);
             }
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // copies -> passes
         })?;
         for (a, new) in self.attrs.iter_mut().zip(fresh.take()) {
             a.bufs.destroy(ctx);

@@ -265,8 +265,6 @@ impl MetaballViewer {
         overlay: Option<&dyn Overlay>,
         slot: usize,
     ) -> Result<()> {
-        // The march's pixels and depths (and stats) -> copies.
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
         let b = &self.buffers;
         if let Some(o) = overlay.filter(|o| o.has_blended()) {
             let target = self.target.as_ref().ok_or_else(|| {
@@ -277,10 +275,7 @@ impl MetaballViewer {
             target.begin_rendering_loaded(ctx, cmd);
             o.draw_blended(ctx, cmd);
             target.end_rendering(ctx, cmd);
-            // The load's read of the pixels -> this copy's write of them.
-            ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
             target.copy_color(ctx, cmd, &b.pixels, 0);
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::TRANSFER_READ);
             scopes.end(ctx, cmd);
         }
         self.renderer.record_readback(ctx, cmd, b, slot);

@@ -561,11 +561,19 @@ fn sync_validation_reports_a_missing_barrier() {
         p.dispatch(&ctx, cmd, &bufs, &push, 1024); // no hand barrier after the fill
     })
     .unwrap();
-    assert_eq!(ctx.validation_counts().0, 0, "{:?}", ctx.validation_messages());
+    assert_eq!(
+        ctx.validation_counts().0,
+        0,
+        "{:?}",
+        ctx.validation_messages()
+    );
     assert_eq!(ctx.tracked_barriers(), (1, 0));
     // A fill recorded behind the tracker's back is a hazard the layer reports.
     ctx.one_shot(|cmd| {
-        unsafe { ctx.device.cmd_fill_buffer(cmd, b[1].raw, 0, ash::vk::WHOLE_SIZE, 0) };
+        unsafe {
+            ctx.device
+                .cmd_fill_buffer(cmd, b[1].raw, 0, ash::vk::WHOLE_SIZE, 0)
+        };
         p.dispatch(&ctx, cmd, &bufs, &push, 1024);
     })
     .unwrap();

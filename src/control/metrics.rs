@@ -170,7 +170,6 @@ impl ControlMetrics {
         slot: usize,
     ) -> Result<()> {
         let s = &self.slots[slot];
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
         ctx.copy(cmd, st.pos(), 0, &s.pos, 0, self.n as u64 * 16);
         ctx.copy(cmd, st.vel(), 0, &s.vel, 0, self.n as u64 * 16);
         ctx.copy(cmd, st.rho_p(), 0, &s.rho, 0, self.n as u64 * 8);

@@ -231,21 +231,15 @@ impl RaysPlacer {
             sync::GRAPHICS_READ | sync::TRANSFER_READ,
         );
         ctx.copy(cmd, &self.offsets, px * 4, &self.stats, STATS_FRAGMENTS, 4);
+        // The total's copy -> the fill pass's atomics on the same buffer (no barrier may
+        // be placed inside the draw's rendering scope).
+        ctx.barrier(cmd, sync::TRANSFER_READ, sync::GRAPHICS_READ);
         draw(&self.fill);
         ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::COMPUTE_READ); // lists -> sort
         self.sort_count.dispatch(ctx, cmd, &bufs, &push, px);
-        ctx.compute_barrier(cmd); // counts -> scan
         scan(&self.emit_buf)?;
-        ctx.compute_barrier(cmd); // starts -> emit
         self.emit.dispatch(ctx, cmd, &bufs, &push, px);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
         ctx.copy(cmd, &self.emit_buf, px * 4, &self.stats, STATS_PARTICLES, 4);
-        // Particles -> the control grid; totals -> the force's parameters and readbacks.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE | sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::TRANSFER_READ,
-        );
         scopes.end(ctx, cmd);
         Ok(())
     }

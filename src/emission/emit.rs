@@ -5,7 +5,7 @@
 //! step (due, alive, birth requests), per frame (births, speeds) and per emitting
 //! primitive (births) stay on the GPU.
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -146,29 +146,13 @@ impl EmitPass {
 
     /// Zero the per-frame stats and the histogram.
     pub fn record_clear(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::COMPUTE_WRITE | sync::TRANSFER_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.fill(cmd, &self.stats, 0);
         ctx.fill(cmd, &self.hist, 0);
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
-        );
     }
 
     /// Zero the per-frame stats (after the frame's copy of them).
     pub fn record_clear_stats(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
         ctx.fill(cmd, &self.stats, 0);
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::COMPUTE_WRITE,
-        );
     }
 
     /// Record one step over `p.n` slots (in the caller's scope).
@@ -179,14 +163,8 @@ impl EmitPass {
         p: &EmitGpuParams,
         input: &EmitInput,
     ) {
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::TRANSFER_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.update(cmd, &self.params, 0, &[*p]);
         ctx.fill(cmd, &self.counts, 0);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
         let bufs = EmitBufs {
             params: &self.params,
             cur: input.cur,
@@ -201,11 +179,6 @@ impl EmitPass {
             hist: &self.hist,
         };
         self.pipeline.dispatch(ctx, cmd, &bufs, &(), p.n as u64);
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::COMPUTE_READ | sync::TRANSFER_READ,
-        );
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

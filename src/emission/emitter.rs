@@ -8,7 +8,7 @@ use super::emit::{EmitGpuParams, EmitInput, EmitPass, EmitSettings};
 use super::layout::UvLayout;
 use super::uv::UvSurface;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
+use crate::gpu::{Buffer, Context, Guard, Scopes};
 use crate::kinds::EmitterKind;
 use crate::particles::{AttrId, AttributeDecl};
 use crate::sph::hooks::SphHook;
@@ -103,14 +103,7 @@ impl EmitSource {
             EmitSource::Vertices(v) => {
                 let next = 1 - v.current;
                 scopes.begin(ctx, cmd, "vertices");
-                // The skinned vertices -> the copy; earlier emits' reads -> its write.
-                ctx.barrier(
-                    cmd,
-                    sync::COMPUTE_WRITE | sync::COMPUTE_READ,
-                    sync::TRANSFER_READ | sync::TRANSFER_WRITE,
-                );
                 ctx.copy(cmd, verts, 0, &v.pos[next], 0, v.vertices as u64 * 16);
-                ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
                 scopes.end(ctx, cmd);
                 v.current = next;
                 Ok(())
@@ -281,8 +274,6 @@ impl Emitter {
             life: st.particles.get(self.life),
         };
         self.pass.record(ctx, cmd, &p, &input);
-        // The alive count -> the step's parameters (every later pass of the step).
-        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
         ctx.copy(
             cmd,
             &self.pass.counts,
@@ -291,7 +282,6 @@ impl Emitter {
             SphGpuParams::LIVE_OFFSET,
             4,
         );
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
         Ok(())
     }
 

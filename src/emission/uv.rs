@@ -258,7 +258,6 @@ impl UvSurface {
         let bufs = self.bufs(i, v);
         self.flags_pass
             .dispatch(ctx, cmd, &bufs, &self.push, texels + 1);
-        ctx.compute_barrier(cmd);
         self.scan.record(
             ctx,
             cmd,
@@ -268,7 +267,6 @@ impl UvSurface {
             ScanKind::Exclusive,
             &self.scratch,
         )?;
-        ctx.compute_barrier(cmd);
         self.compact.dispatch(ctx, cmd, &bufs, &self.push, texels);
         ctx.barrier(
             cmd,

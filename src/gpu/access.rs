@@ -59,7 +59,10 @@ pub fn buffer_uses(spv: &[u32]) -> BTreeMap<u32, Use> {
                 None => break,
             }
         }
-        binding.get(&id).copied().filter(|_| variables.contains(&id))
+        binding
+            .get(&id)
+            .copied()
+            .filter(|_| variables.contains(&id))
     };
     let mut uses: BTreeMap<u32, Use> = BTreeMap::new();
     let mut mark = |ptr: u32, read: bool, write: bool| {

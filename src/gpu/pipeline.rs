@@ -6,10 +6,10 @@
 use super::access::{buffer_uses, Use};
 use super::interface::{check, BindingDecl, Interface, Reflected};
 use super::track::BufferUse;
-use std::collections::BTreeMap;
 use super::{Buffer, Context};
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
+use std::collections::BTreeMap;
 use std::marker::PhantomData;
 
 /// Most workgroups one dimension of a dispatch may have on every Vulkan device.
@@ -493,7 +493,10 @@ impl<I: Interface> GraphicsPipeline<I> {
             name: d.name.to_string(),
             uses: vec![
                 (vk::PipelineStageFlags2::VERTEX_SHADER, buffer_uses(&spv[0])),
-                (vk::PipelineStageFlags2::FRAGMENT_SHADER, buffer_uses(&spv[1])),
+                (
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    buffer_uses(&spv[1]),
+                ),
             ],
             interface: PhantomData,
         })

@@ -1,12 +1,11 @@
-//! Barriers that say what they protect.
-//!
-//! The rule: **the code that sequences two commands issues the barrier between them**,
-//! from the first one's stage and access to the second one's, because it alone knows both.
-//! A pass's `record` orders its own dispatches and leaves its last writes unguarded; the
-//! caller that chains passes (the SPH step, the metaball frame, the frame's work) orders
-//! them, read-after-write and write-after-read (a buffer overwritten while earlier commands
-//! may still read it); the frame loop issues one barrier at every frame boundary. Each call
-//! carries a comment naming what it protects.
+//! Barriers, placed by the tracker (`gpu::track`) from what each command reads and writes:
+//! a dispatch, copy, fill or update through the context gets the barrier its buffers'
+//! hazards need, and code that sequences compute and transfer work places none by hand.
+//! By hand, each with a comment naming what it protects, remain only what the tracker
+//! cannot see or may not place: buffers a draw reads or writes (no barrier may be recorded
+//! inside a rendering scope, so they go before it; the tracker counts any it finds
+//! uncovered), images, host reads after the fence, the frame boundary, and the profiler's
+//! settle.
 use super::track::BufferUse;
 use super::Context;
 use ash::vk;

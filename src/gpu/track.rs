@@ -41,7 +41,12 @@ impl BufferUse {
 
     pub fn indirect(buffer: vk::Buffer) -> Self {
         let a = vk::AccessFlags2::INDIRECT_COMMAND_READ;
-        Self::at(buffer, Stages::DRAW_INDIRECT, (true, a), (false, Accesses::NONE))
+        Self::at(
+            buffer,
+            Stages::DRAW_INDIRECT,
+            (true, a),
+            (false, Accesses::NONE),
+        )
     }
 
     pub fn at(
@@ -245,7 +250,11 @@ impl Tracker {
     /// A barrier from `from` to `to` was recorded (by hand, or placed by `before`).
     pub fn barrier(&mut self, from: Access, to: Access) {
         // Memory: only the stages named; execution: the logically earlier ones too.
-        let (fs, fa, wait) = (stages(from.stage), accesses(from.access), earlier(from.stage));
+        let (fs, fa, wait) = (
+            stages(from.stage),
+            accesses(from.access),
+            earlier(from.stage),
+        );
         for s in self.buffers.values_mut() {
             if let Some(w) = s.write {
                 let direct = fs.contains(w.stage) && fa.contains(w.access);

@@ -99,7 +99,6 @@ impl BoundsPass {
         };
         self.pipeline
             .dispatch_groups(ctx, cmd, &bufs, &push, groups);
-        ctx.compute_barrier(cmd); // partial boxes -> the final reduction
         let push = BoundsPush {
             n: groups as u32,
             pairs: 1,

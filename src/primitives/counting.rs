@@ -3,7 +3,7 @@
 //! start + rank. O(N + cells); order inside a cell is arbitrary.
 use super::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -114,17 +114,13 @@ impl CountingSort {
             n: n as u32,
             cells: b.cells,
         };
-        // Earlier sorts' scans still read the counts.
-        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
         ctx.fill(cmd, &b.counts, 0);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // zeroed counts -> count
         let bufs = CountBufs {
             keys,
             counts: &b.counts,
             rank: &b.rank,
         };
         self.count.dispatch(ctx, cmd, &bufs, &push, n);
-        ctx.compute_barrier(cmd); // counts -> scan
         scan.record(
             ctx,
             cmd,
@@ -134,7 +130,6 @@ impl CountingSort {
             ScanKind::Exclusive,
             &b.scan,
         )?;
-        ctx.compute_barrier(cmd); // cell starts -> scatter
         let bufs = ScatterBufs {
             keys,
             rank: &b.rank,

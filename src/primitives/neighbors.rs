@@ -13,7 +13,7 @@ use super::morton::MortonPass;
 use super::scan::{ScanPass, ScanVariant};
 use super::sort::{Network, NetworkSort};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -393,7 +393,6 @@ impl NeighborSearch {
         scopes.begin(ctx, cmd, "keys");
         if let (Some(bounds), Some(morton), Some(bb)) = (&self.bounds, &self.morton, &b.bounds) {
             bounds.record(ctx, cmd, pos, n as u64, bb)?;
-            ctx.compute_barrier(cmd); // box -> Morton codes
             morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
         } else if let Some(keys) = &self.keys {
             let bufs = NbKeysBufs {
@@ -404,7 +403,6 @@ impl NeighborSearch {
             keys.dispatch(ctx, cmd, &bufs, &push, n as u64);
         }
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd); // keys -> sort
         scopes.begin(ctx, cmd, "sort");
         match &self.sorter {
             Sorter::Counting(c) => {
@@ -428,16 +426,8 @@ impl NeighborSearch {
         scopes.end(ctx, cmd);
         if !counting && self.strategy != Neighbors::Morton {
             scopes.begin(ctx, cmd, "ranges");
-            // Earlier steps' passes still read the cell ranges about to be cleared.
-            ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
             ctx.fill(cmd, &b.starts, 0);
             ctx.fill(cmd, &b.ends, 0);
-            // Cleared ranges and sorted keys -> the ranges pass.
-            ctx.barrier(
-                cmd,
-                sync::TRANSFER_WRITE | sync::COMPUTE_WRITE,
-                sync::COMPUTE_READ,
-            );
             let bufs = NbRangesBufs {
                 keys: &b.sorted_keys,
                 start: &b.starts,
@@ -471,11 +461,9 @@ impl NeighborSearch {
         }
         let push = Self::push(b, grid, radius, n);
         let (starts, ends) = b.cell_buffers();
-        ctx.compute_barrier(cmd); // the build's permutation and cell ranges -> query
         scopes.begin(ctx, cmd, "reorder");
         self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd); // sorted positions -> query
         scopes.begin(ctx, cmd, "query");
         let bufs = NbQueryBufs {
             pos: &b.sorted_pos,

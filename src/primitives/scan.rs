@@ -289,7 +289,6 @@ impl ScanPass {
             }
         };
         dispatch(&self.chunk_reduce, 0);
-        ctx.compute_barrier(cmd); // chunk sums -> their scan
         let next = scratch.levels[level].raw;
         let chunks = n.div_ceil(chunk);
         self.level(
@@ -302,7 +301,6 @@ impl ScanPass {
             scratch,
             level + 1,
         );
-        ctx.compute_barrier(cmd); // scanned chunk sums -> the chunks' scan
         dispatch(&self.chunk_down, inclusive);
     }
 

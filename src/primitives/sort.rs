@@ -88,9 +88,6 @@ impl NetworkSort {
         let pow2 = n.next_power_of_two();
         let mut dispatches = 0;
         let mut run = |push: SortPush, groups: u64| {
-            if dispatches > 0 {
-                ctx.compute_barrier(cmd); // the previous comparator stage's swaps
-            }
             self.pipeline
                 .dispatch_groups(ctx, cmd, &bufs, &push, groups);
             dispatches += 1;

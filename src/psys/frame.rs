@@ -33,7 +33,6 @@ pub fn record_simulation(
     for s in systems.iter_mut() {
         s.record_step(ctx, cmd, prof, passes, f);
     }
-    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
     record_events(ctx, cmd, prof, passes, systems, f)?;
     for s in systems.iter_mut() {
         s.record_sort(ctx, cmd, prof, passes, f)?;
@@ -80,15 +79,8 @@ fn record_events(
             s.record_event_args(ctx, cmd, passes, f);
         }
     }
-    ctx.barrier(
-        cmd,
-        sync::COMPUTE_WRITE,
-        sync::COMPUTE_READ | sync::INDIRECT_READ,
-    );
     for &(i, j, e) in &links {
         systems[j].record_spawn(ctx, cmd, passes, f, &systems[i], e);
-        // Spawns into one system pop its dead stack and append to its list in turn.
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
     }
     let mut targets: Vec<usize> = links.iter().map(|l| l.1).collect();
     targets.sort_unstable();
@@ -96,7 +88,6 @@ fn record_events(
     for j in targets {
         systems[j].record_draw_count(ctx, cmd, passes, f);
     }
-    ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
     prof.end(ctx, cmd);
     Ok(())
 }

@@ -417,14 +417,8 @@ impl ParticleSystem {
             self.head = ((self.head as u64 + births as u64) % self.capacity as u64) as u32;
             return;
         }
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ); // births -> args, update
         scopes.begin(ctx, cmd, Passes::UPDATE);
         passes.args.dispatch_groups(ctx, cmd, &bufs, &push, 1);
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::COMPUTE_READ | sync::INDIRECT_READ,
-        );
         if let (Some(nb), Some(b)) = (&self.flock, &self.spec.boids) {
             // The grid over every slot (dead ones sort last), then each boid's steering.
             scopes.begin(ctx, cmd, Passes::BOIDS);
@@ -433,7 +427,6 @@ impl ParticleSystem {
                     .grid
                     .record_build(ctx, cmd, scopes, nb, &self.pos, self.capacity, &b.grid());
             debug_assert!(r.is_ok(), "the grid was sized for every slot");
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
             let (nb_start, nb_end) = nb.cell_buffers();
             let b = BoidsBufs {
                 params: &self.params,
@@ -457,7 +450,6 @@ impl ParticleSystem {
                 &self.counters,
                 Counters::UPDATE_ARGS,
             );
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
             scopes.end(ctx, cmd);
         }
         passes.update.dispatch_indirect(
@@ -468,7 +460,6 @@ impl ParticleSystem {
             &self.counters,
             Counters::UPDATE_ARGS,
         );
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ); // list length -> args
         self.drawn = 1 - self.drawn;
         self.record_draw_count(ctx, cmd, passes, f);
         scopes.end(ctx, cmd);

@@ -1,7 +1,7 @@
 //! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
 use crate::config::Group;
 use crate::error::Result;
-use crate::gpu::{sync, ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
+use crate::gpu::{ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
 use crate::kinds::{Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
 use crate::psys::character::{CharacterBufs, CharacterLink};
 use crate::psys::frame::{frame_info, record_simulation};
@@ -237,7 +237,6 @@ impl FrameWork for ParticleWork<'_> {
             let t = frame as f64 * self.scene.dt as f64;
             body.ch.record(ctx, cmd, prof, t)?;
             body.link.record(ctx, cmd, &body.ch.matrices(t));
-            ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
         }
         let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;

@@ -259,7 +259,6 @@ impl EmissionMetrics {
     ) {
         self.times[slot] = (frame, t);
         let rb = &self.readbacks[slot];
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ);
         ctx.copy(cmd, &e.pass.stats, 0, rb, 0, 16);
         ctx.copy(cmd, &e.pass.counts, 0, rb, 16, 16);
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ);

@@ -184,11 +184,8 @@ impl StepErrors {
             records: &self.records[slot],
             solve: st.pressure.as_ref().map_or(&self.no_solve, |p| p.solve()),
         };
-        // The previous reduction may still read the partials.
-        ctx.compute_barrier(cmd);
         self.pipeline
             .dispatch_groups(ctx, cmd, &bufs, &push, groups);
-        ctx.compute_barrier(cmd); // partials -> the final reduction
         push.n = groups as u32;
         push.mode = 1;
         self.pipeline.dispatch_groups(ctx, cmd, &bufs, &push, 1);

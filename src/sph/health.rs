@@ -74,17 +74,13 @@ impl Health {
     /// Record the health of the state after a frame of steps of `dt` into `slot`.
     pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState, slot: usize) {
         self.limits[slot] = st.fluid.h / st.dt;
-        // The previous frame's copy may still read the counters.
-        ctx.barrier(cmd, sync::TRANSFER_READ, sync::TRANSFER_WRITE);
         ctx.fill(cmd, &self.out, 0);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ); // zeroed -> atomics
         let bufs = HealthBufs {
             vel: st.vel(),
             rho_p: st.rho_p(),
             out: &self.out,
         };
         self.pipeline.dispatch(ctx, cmd, &bufs, &st.n, st.n as u64);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // counters -> copy
         ctx.copy(cmd, &self.out, 0, &self.readbacks[slot], 0, 16);
         ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // copy -> the host
     }

@@ -7,7 +7,7 @@ use super::pressure::{
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
-use crate::gpu::{sync, Context, Scopes};
+use crate::gpu::{Context, Scopes};
 use crate::kinds::Solver;
 use ash::vk;
 
@@ -95,9 +95,7 @@ impl PressureSolver for Pcisph {
         p.scoped(ctx, cmd, scopes, st, Pass::Factor as usize)?;
         // The pressure acceleration starts at zero.
         let aux2 = st.pressure()?.aux2();
-        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
         ctx.fill(cmd, aux2, 0);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
         let body = [Pass::Predict, Pass::Pressure, Pass::Accel].map(|k| k as usize);
         p.solve(
             ctx,

@@ -6,7 +6,7 @@
 //! remain: no read-back per iteration, and skipped iterations cost an empty dispatch.
 use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::Solver;
 use crate::primitives::neighbors::NeighborPush;
 use ash::vk;
@@ -236,7 +236,6 @@ impl Pipelines {
         self.pass(k)
             .1
             .dispatch(ctx, cmd, &b, &st.neighbor_push(), st.n as u64);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
         Ok(())
     }
 
@@ -284,32 +283,14 @@ impl Pipelines {
             b => b.clamp(min_iter.max(1), max_iter),
         };
         scopes.begin(ctx, cmd, scope);
-        // The last solve's loop passes and dispatches may still read the state.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::INDIRECT_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.update(cmd, solve, 0, &[gx, gy, 1, 0, 0, 1, 1, 1]);
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::INDIRECT_READ,
-        );
         let check = self.pass(check).1;
         let body: Vec<_> = body.iter().map(|k| self.pass(*k).1).collect();
         for _ in 0..recorded {
             for p in &body {
                 p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
-                ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
             }
             check.dispatch_indirect(ctx, cmd, &b, &push, solve, LOOP_ARGS_OFFSET);
-            // The decision -> the next iteration's dispatches and passes.
-            ctx.barrier(
-                cmd,
-                sync::COMPUTE_WRITE,
-                sync::COMPUTE_READ | sync::INDIRECT_READ,
-            );
         }
         scopes.end(ctx, cmd);
         Ok(())

@@ -8,7 +8,7 @@ use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
 use super::pressure::{PressureBuffers, PressureSolver};
 use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, Solver, SortAlgo};
 use crate::particles::{AttrId, AttributeDecl, ParticleStore};
 use crate::primitives::counting::GatherPass;
@@ -364,15 +364,11 @@ impl SphSolver {
     /// Upload parameters and colliders for the next step (inside the command buffer).
     pub fn record_params(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) {
         let p = st.gpu_params();
-        // Earlier steps' passes (in submission order) may still read them.
-        ctx.barrier(cmd, sync::COMPUTE_READ, sync::TRANSFER_WRITE);
         ctx.update(cmd, &st.params, 0, &[p]);
         ctx.update(cmd, &st.colliders, 0, &st.collider_list);
         if let Some(b) = &st.pressure {
             b.record_reset(ctx, cmd);
         }
-        // New parameters -> every pass of the step.
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::COMPUTE_READ);
     }
 
     /// Neighbour structure and every reordered attribute in sorted order.
@@ -386,11 +382,9 @@ impl SphSolver {
         scopes.begin(ctx, cmd, "arrange");
         self.search
             .record_build(ctx, cmd, scopes, &st.nb, st.pos(), st.n, &st.grid)?;
-        ctx.compute_barrier(cmd); // permutation -> reorder
         st.particles
             .record_reorder(ctx, cmd, scopes, &self.gather, &st.nb.perm);
         scopes.end(ctx, cmd);
-        ctx.compute_barrier(cmd); // sorted attributes and cell ranges -> density
         Ok(())
     }
 
@@ -402,7 +396,6 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.density, "density");
-        ctx.compute_barrier(cmd); // density, pressure -> forces
     }
 
     pub fn record_forces(
@@ -413,7 +406,6 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.forces, "forces");
-        ctx.compute_barrier(cmd); // accelerations -> extra forces, integrate
     }
 
     pub fn record_integrate(
@@ -424,9 +416,6 @@ impl SphSolver {
         st: &SphState,
     ) {
         self.run(ctx, cmd, scopes, st, &self.integrate, "integrate");
-        // New positions and velocities -> the next step's arrange (or the renderer, whose
-        // caller orders its own copy).
-        ctx.compute_barrier(cmd);
     }
 
     fn run(
@@ -454,7 +443,6 @@ impl SphSolver {
             scopes.begin(ctx, cmd, h.name());
             h.record(ctx, cmd, scopes, st)?;
             scopes.end(ctx, cmd);
-            ctx.compute_barrier(cmd); // the hook's writes -> the next pass
         }
         Ok(())
     }
@@ -496,8 +484,6 @@ impl SphSolver {
         p.record_forces(self, ctx, cmd, scopes, st)?;
         Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
         p.record_solve(self, ctx, cmd, scopes, st)?;
-        // The step's state -> the next step or its readers.
-        ctx.compute_barrier(cmd);
         scopes.end(ctx, cmd);
         Ok(())
     }

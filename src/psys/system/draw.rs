@@ -58,10 +58,8 @@ impl ParticleSystem {
         if self.closed() {
             let zero = StepPush { mode: 2, ..push };
             passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);
-            ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
         }
         passes.keys.dispatch(ctx, cmd, &bufs, &push, cap);
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::COMPUTE_READ);
         match (self.sort, &self.counting) {
             (SortAlgo::Counting, Some(d)) => {
                 passes.counting.record(

@@ -172,7 +172,6 @@ impl MetaballRenderer {
         slot: usize,
     ) -> Result<()> {
         self.record_picture(ctx, cmd, scopes, b, centers, n, cam)?;
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::TRANSFER_READ); // pixels, stats -> copies
         self.record_readback(ctx, cmd, b, slot);
         Ok(())
     }
@@ -283,10 +282,8 @@ impl MetaballRenderer {
             scopes.begin(ctx, cmd, "sort");
             let metaball_groups = (n as u64).div_ceil(depths.local_size as u64);
             depths.dispatch_groups(ctx, cmd, &bufs, &(), metaball_groups);
-            ctx.compute_barrier(cmd); // depths -> the per-pixel sort
             sort.dispatch_groups(ctx, cmd, &bufs, &(), groups);
             scopes.end(ctx, cmd);
-            ctx.compute_barrier(cmd); // sorted ranges -> march
         }
         scopes.begin(ctx, cmd, "march");
         self.march.dispatch_groups(ctx, cmd, &bufs, &(), groups);
