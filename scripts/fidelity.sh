@@ -25,6 +25,8 @@ runs=(
   "walker|fidelity with frictionless walls|--fluid friction=0"
   "walker|fidelity with motion frames|--control-motion frames"
   "walker|fidelity with adaptive smooth|--adaptive smooth"
+  "walker|fidelity refreshed every step|--control-every 1"
+  "walker|fidelity refreshed every 8 steps|--control-every 8"
   "cesium|thesis|--control-preset thesis"
   "cesium|fidelity (default)|"
   "cesium|fidelity with frictionless walls|--fluid friction=0"
