@@ -174,6 +174,9 @@ impl State {
                 false => hull(self.read, u.range),
             };
             self.reads |= u.stage;
+            // This read is ordered before nothing yet (an earlier barrier covered only the
+            // reads before it).
+            self.after_reads = Stages::NONE;
         }
     }
 }

@@ -255,18 +255,22 @@ impl NeighborSearch {
     }
 
     pub fn defines_for(strategy: Neighbors, sort: SortAlgo) -> Vec<(&'static str, String)> {
-        // The strategy's values, emitted for neighbors.glsl's #if chains.
-        let ids = [
+        // The strategy's values, emitted for neighbors.glsl's #if chains (an exhaustive
+        // match: a new strategy cannot fall back to another's code).
+        let code = |n: Neighbors| match n {
+            Neighbors::Grid => 0u32,
+            Neighbors::Hash => 1,
+            Neighbors::Morton => 2,
+        };
+        let mut d: Vec<(&'static str, String)> = [
             (Neighbors::Grid, "NB_GRID"),
             (Neighbors::Hash, "NB_HASH"),
             (Neighbors::Morton, "NB_MORTON"),
-        ];
-        let mut d: Vec<(&'static str, String)> = ids
-            .iter()
-            .enumerate()
-            .map(|(i, (_, name))| (*name, i.to_string()))
-            .collect();
-        let s = ids.iter().position(|(k, _)| *k == strategy).unwrap_or(0);
+        ]
+        .iter()
+        .map(|(n, name)| (*name, code(*n).to_string()))
+        .collect();
+        let s = code(strategy);
         d.extend([
             ("NB_STRATEGY", s.to_string()),
             (
