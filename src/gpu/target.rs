@@ -193,6 +193,7 @@ impl ColorTarget {
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
         let region = self.region(vk::ImageAspectFlags::COLOR, offset);
+        track_copy(ctx, cmd, dst, &region, true);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,
@@ -263,6 +264,7 @@ impl ColorTarget {
             (S::COPY, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
         );
         let region = self.region(vk::ImageAspectFlags::DEPTH, depth_at);
+        track_copy(ctx, cmd, dst, &region, true);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,
@@ -302,6 +304,7 @@ impl ColorTarget {
                 (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
             );
             let region = self.region(aspect, at);
+            track_copy(ctx, cmd, src, &region, false);
             unsafe {
                 ctx.device.cmd_copy_buffer_to_image(
                     cmd,
@@ -378,3 +381,18 @@ pub fn save_rgba(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()
     })
 }
 crate::impl_destroy!(ColorTarget);
+
+/// The buffer side of an image copy (4 bytes a texel, tightly packed) for the barrier
+/// tracker: written by a copy out of the image, read by a copy into it.
+fn track_copy(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    b: &super::Buffer,
+    region: &vk::BufferImageCopy,
+    write: bool,
+) {
+    let e = region.image_extent;
+    let bytes = e.width as u64 * e.height as u64 * e.depth.max(1) as u64 * 4;
+    let u = super::track::BufferUse::transfer(b.raw, write).bytes(region.buffer_offset, bytes);
+    ctx.track(cmd, &[u], true);
+}
