@@ -435,7 +435,7 @@ fn real_main() -> Result<()> {
                 save_every,
                 switches,
             })?;
-            print_summary(&r.summary);
+            fluidform::run::print_summary(&r.summary);
             // One closing line: where the files went.
             let anim = r
                 .animation
@@ -502,29 +502,8 @@ fn real_main() -> Result<()> {
         Command::Scene { what } => {
             use fluidform::scene::builtin;
             match what {
-                SceneWhat::List => {
-                    for b in builtin::BUILT_IN {
-                        let kind = match fluidform::scene::load::kind_of(b.text) {
-                            fluidform::scene::load::SceneKind::Fluid => "fluid",
-                            fluidform::scene::load::SceneKind::Particles => "particles",
-                        };
-                        println!("{:<14} {kind:<10} {}", b.name, b.summary());
-                    }
-                    println!(
-                        "{:<14} {:<10} particles orbiting an attractor, made in code (no file)",
-                        "orbits", "test"
-                    );
-                }
-                SceneWhat::Show { name } => match builtin::find(&name) {
-                    Some(b) => print!("{}", b.text),
-                    None if name == "orbits" => {
-                        anyhow::bail!("orbits makes its particles in code: it has no scene file")
-                    }
-                    None => anyhow::bail!(
-                        "no built-in scene '{name}' (fluidform scene list: {})",
-                        builtin::names().join(", ")
-                    ),
-                },
+                SceneWhat::List => print!("{}", builtin::listing()),
+                SceneWhat::Show { name } => print!("{}", builtin::shown(&name)?),
             }
             Ok(())
         }
@@ -589,24 +568,6 @@ fn devices(json: bool) -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn print_summary(s: &fluidform::run::RunSummary) {
-    println!(
-        "device: {}  frames: {}  GPU frame median {:.3} ms",
-        s.device.name,
-        s.frames,
-        s.frame_ms.map(|f| f.median).unwrap_or(f64::NAN)
-    );
-    for (name, st) in &s.pass_ms.0 {
-        println!(
-            "  {name:<24} median {:8.3} ms  min {:8.3}  max {:8.3}",
-            st.median, st.min, st.max
-        );
-    }
-    if let Some(v) = &s.validation {
-        println!("validation: {} errors, {} warnings", v.errors, v.warnings);
-    }
 }
 
 trait ParseDefault {

@@ -240,3 +240,22 @@ pub(crate) fn finish_fluidless(
         exports: Vec::new(),
     })
 }
+
+/// The run's device, GPU frame median, pass medians and validation counts on stdout.
+pub fn print_summary(s: &RunSummary) {
+    println!(
+        "device: {}  frames: {}  GPU frame median {:.3} ms",
+        s.device.name,
+        s.frames,
+        s.frame_ms.map(|f| f.median).unwrap_or(f64::NAN)
+    );
+    for (name, st) in &s.pass_ms.0 {
+        println!(
+            "  {name:<24} median {:8.3} ms  min {:8.3}  max {:8.3}",
+            st.median, st.min, st.max
+        );
+    }
+    if let Some(v) = &s.validation {
+        println!("validation: {} errors, {} warnings", v.errors, v.warnings);
+    }
+}

@@ -57,3 +57,36 @@ impl BuiltIn {
         comment.join(" ")
     }
 }
+
+/// `fluidform scene list`: a line per built-in (name, kind, opening comment), then orbits.
+pub fn listing() -> String {
+    use super::load::{kind_of, SceneKind};
+    let mut out = String::new();
+    for b in BUILT_IN {
+        let kind = match kind_of(b.text) {
+            SceneKind::Fluid => "fluid",
+            SceneKind::Particles => "particles",
+        };
+        out += &format!("{:<14} {kind:<10} {}\n", b.name, b.summary());
+    }
+    out += &format!(
+        "{:<14} {:<10} particles orbiting an attractor, made in code (no file)\n",
+        "orbits", "test"
+    );
+    out
+}
+
+/// `fluidform scene show NAME`: the built-in's TOML.
+pub fn shown(name: &str) -> crate::error::Result<&'static str> {
+    use crate::error::Error;
+    match find(name) {
+        Some(b) => Ok(b.text),
+        None if name == "orbits" => Err(Error::Param(
+            "orbits makes its particles in code: it has no scene file".into(),
+        )),
+        None => Err(Error::Param(format!(
+            "no built-in scene '{name}' (fluidform scene list: {})",
+            names().join(", ")
+        ))),
+    }
+}
