@@ -20,11 +20,10 @@ pub struct ForceCache {
     /// Which of the two holds the latest values.
     cur: usize,
     capacity: u64,
-    /// Steps recorded since the last refresh, and the particle count then.
+    /// Steps recorded since the last refresh, and the particle count then (the first step
+    /// always refreshes: it has a new pose).
     since: u32,
     n: u32,
-    /// The next step must refresh.
-    stale: bool,
 }
 
 impl ForceCache {
@@ -43,12 +42,7 @@ impl ForceCache {
             capacity,
             since: 0,
             n: 0,
-            stale: true,
         })
-    }
-
-    pub fn capacity(&self) -> u64 {
-        self.capacity
     }
 
     /// Whether the step about to be recorded for `st` refreshes (every `every` steps, and
@@ -61,9 +55,9 @@ impl ForceCache {
                 self.capacity, st.particles.capacity
             )));
         }
-        let refresh = posed || self.stale || st.n != self.n || self.since + 1 >= every.max(1);
+        let refresh = posed || st.n != self.n || self.since + 1 >= every.max(1);
         if refresh {
-            (self.since, self.n, self.stale) = (0, st.n, false);
+            (self.since, self.n) = (0, st.n);
         } else {
             self.since += 1;
             self.cur = 1 - self.cur;

@@ -194,7 +194,7 @@ impl Context {
             one_shot_pool: Mutex::new(pool),
             memory: Mutex::new(BTreeMap::new()),
             objects: Mutex::new(BTreeMap::new()),
-            trackers: Mutex::new(Default::default()),
+            trackers: Mutex::new(super::track::Trackers::new()),
         };
         ctx.set_name(pool, "one-shot command pool");
         ctx.set_name(ctx.queue, "main queue");

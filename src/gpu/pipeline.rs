@@ -12,6 +12,24 @@ use ash::vk;
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
 
+/// The tracker's view of a dispatch's or draw's bound buffers: each binding the stage's
+/// SPIR-V touches, over the bytes its descriptor views.
+fn bound_uses<'a>(
+    buffers: &'a [(u32, vk::DescriptorBufferInfo)],
+    uses: &'a BTreeMap<u32, Use>,
+    stage: vk::PipelineStageFlags2,
+) -> impl Iterator<Item = BufferUse> + 'a {
+    let (read, write) = (
+        vk::AccessFlags2::SHADER_STORAGE_READ,
+        vk::AccessFlags2::SHADER_STORAGE_WRITE,
+    );
+    buffers.iter().filter_map(move |(b, info)| {
+        let u = uses.get(b)?;
+        let at = BufferUse::at(info.buffer, stage, (u.read, read), (u.write, write));
+        Some(at.bytes(info.offset, info.range))
+    })
+}
+
 /// Most workgroups one dimension of a dispatch may have on every Vulkan device.
 pub const MAX_GROUPS_X: u32 = 65535;
 
@@ -251,24 +269,10 @@ impl<I: Interface> ComputePipeline<I> {
         args: Option<&Buffer>,
     ) {
         let buffers = I::buffers(bufs);
-        let mut uses: Vec<BufferUse> = buffers
-            .iter()
-            .filter_map(|(b, info)| {
-                let u = self.uses.get(b)?;
-                let c = BufferUse::compute(info.buffer, u.read, u.write);
-                Some(c.bytes(info.offset, info.range))
-            })
-            .collect();
+        let stage = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        let mut uses: Vec<BufferUse> = bound_uses(&buffers, &self.uses, stage).collect();
         uses.extend(args.map(|a| BufferUse::indirect(a.raw)));
-        if std::env::var("FLUIDFORM_TRACK_DEBUG").is_ok() {
-            let before = ctx.trackers.lock().unwrap().get(cmd).placed;
-            ctx.track(cmd, &uses, true);
-            if ctx.trackers.lock().unwrap().get(cmd).placed > before {
-                eprintln!("track: placed before {}", self.name);
-            }
-        } else {
-            ctx.track(cmd, &uses, true);
-        }
+        ctx.track(cmd, &uses, true);
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
@@ -506,20 +510,10 @@ impl<I: Interface> GraphicsPipeline<I> {
     /// tracker records the draws' uses but places no barrier there).
     pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
         let buffers = I::buffers(bufs);
-        let (read, write) = (
-            vk::AccessFlags2::SHADER_STORAGE_READ,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        );
         let uses: Vec<BufferUse> = self
             .uses
             .iter()
-            .flat_map(|(stage, map)| {
-                buffers.iter().filter_map(move |(b, info)| {
-                    let u = map.get(b)?;
-                    let at = BufferUse::at(info.buffer, *stage, (u.read, read), (u.write, write));
-                    Some(at.bytes(info.offset, info.range))
-                })
-            })
+            .flat_map(|(stage, map)| bound_uses(&buffers, map, *stage))
             .collect();
         ctx.track(cmd, &uses, false);
         unsafe {

@@ -111,8 +111,11 @@ impl Context {
     /// Record the buffer uses of the next command (`gpu::track`); `place`: record the
     /// barrier it needs, if any (never inside a rendering scope).
     pub fn track(&self, cmd: vk::CommandBuffer, uses: &[BufferUse], place: bool) {
-        let need = self.trackers.lock().unwrap().get(cmd).before(uses, place);
-        if need.is_some() && std::env::var("FLUIDFORM_TRACK_DEBUG").is_ok() {
+        let (need, debug) = {
+            let mut t = self.trackers.lock().unwrap();
+            (t.get(cmd).before(uses, place), t.debug)
+        };
+        if need.is_some() && debug {
             let bt = std::backtrace::Backtrace::force_capture().to_string();
             let at: Vec<&str> = bt
                 .lines()

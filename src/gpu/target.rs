@@ -172,8 +172,7 @@ impl ColorTarget {
     }
 
     pub fn end_rendering(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
-        ctx.trackers.lock().unwrap().get(cmd).end_scope();
+        ctx.end_rendering(cmd);
     }
 
     /// The colour image into `dst` at byte `offset`, after rendering (the caller makes

@@ -286,9 +286,18 @@ pub struct Trackers {
     /// Barriers placed and hazards left unplaced in the command buffers submitted so far.
     pub placed: u64,
     pub unplaced: u64,
+    /// `FLUIDFORM_TRACK_DEBUG` set (read once, with the context): print each barrier placed.
+    pub debug: bool,
 }
 
 impl Trackers {
+    pub fn new() -> Self {
+        Self {
+            debug: std::env::var_os("FLUIDFORM_TRACK_DEBUG").is_some(),
+            ..Self::default()
+        }
+    }
+
     pub fn begin(&mut self, cmd: vk::CommandBuffer) {
         self.open.insert(cmd, Tracker::default());
     }
