@@ -71,7 +71,7 @@ pub const MAX_PARTICLES: u64 = 1 << 26;
 
 /// Device bytes per particle, an upper bound for the solver's state and neighbour buffers
 /// (the pressure solvers' included) and a view's per-particle buffers (measured in
-/// tests/sph.rs), for refusing scenes that cannot fit before anything is made.
+/// tests/sph), for refusing scenes that cannot fit before anything is made.
 pub const BYTES_PER_PARTICLE: u64 = 320 + super::pressure::BYTES_PER_PARTICLE;
 
 /// [`BYTES_PER_PARTICLE`] with the fluid's neighbour lists.
