@@ -4,13 +4,13 @@
 //! requires); rigid meshes become skinned to their own node with weight 1.
 use super::model::*;
 use crate::error::{Error, Result};
-use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
 use std::path::Path;
 
-fn err(path: &Path, message: impl Into<String>) -> Error {
+pub(super) fn err(path: &Path, message: impl Into<String>) -> Error {
     Error::Model {
         path: path.display().to_string(),
         message: message.into(),
@@ -19,7 +19,7 @@ fn err(path: &Path, message: impl Into<String>) -> Error {
 
 /// Refuse an accessor the gltf reader would panic on: empty, or of a type the spec does
 /// not allow for its use (`allowed`: dimensions and component types).
-fn check_accessor(
+pub(super) fn check_accessor(
     path: &Path,
     what: &str,
     a: &gltf::Accessor,
@@ -114,9 +114,74 @@ pub fn load(path: &Path) -> Result<Character> {
     })?;
     let gltf =
         gltf::Gltf::open(path).map_err(|e| err(path, format!("not a valid glTF 2.0 file: {e}")))?;
-    let base = path.parent().unwrap_or(Path::new("."));
     let doc = &gltf.document;
-    for b in doc.buffers() {
+    let buffers = read_buffers(path, &gltf)?;
+    let mut warnings = Vec::new();
+    let nodes = read_nodes(doc);
+    let order =
+        Skeleton::sort(&nodes).ok_or_else(|| err(path, "its node hierarchy has a cycle"))?;
+
+    let mut joints = Joints::default();
+    let mut parts = Vec::new();
+    let mut skinned = false;
+    let mut morph_warned = false;
+    let mut computed_normals = false;
+    for ni in scene_nodes(doc, &nodes) {
+        let node = doc.nodes().nth(ni).unwrap();
+        let Some(mesh) = node.mesh() else { continue };
+        let (offset, skin_joints) = joints.of_node(path, &node, &buffers)?;
+        skinned |= skin_joints.is_some();
+        for prim in mesh.primitives() {
+            let what = format!(
+                "mesh {} ('{}') primitive {}",
+                mesh.index(),
+                mesh.name().unwrap_or(""),
+                prim.index()
+            );
+            if prim.morph_targets().next().is_some() && !morph_warned {
+                warnings.push("morph targets are ignored (the rest shape is used)".to_string());
+                morph_warned = true;
+            }
+            let (part, computed) = read_part(
+                path,
+                &what,
+                &prim,
+                &buffers,
+                offset,
+                skin_joints,
+                &mut warnings,
+            )?;
+            computed_normals |= computed;
+            parts.push(part);
+        }
+    }
+    if parts.is_empty() {
+        return Err(err(path, "has no mesh in its scene"));
+    }
+    // Rigid mesh nodes add a joint each.
+    check_joint_count(path, joints.list.len())?;
+    let clips = super::gltf_clips::read_clips(path, doc, &buffers, &mut warnings)?;
+    let skeleton = Skeleton {
+        nodes,
+        joints: joints.list,
+        order,
+    };
+    let mut ch = super::assemble(
+        path.display().to_string(),
+        merge(parts, &mut warnings),
+        skeleton,
+        clips,
+        skinned,
+        warnings,
+    )?;
+    ch.normals_computed |= computed_normals;
+    Ok(ch)
+}
+
+/// The file's buffers; a missing external buffer file is named before the reader fails.
+fn read_buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<gltf::buffer::Data>> {
+    let base = path.parent().unwrap_or(Path::new("."));
+    for b in gltf.document.buffers() {
         if let gltf::buffer::Source::Uri(uri) = b.source() {
             if !uri.starts_with("data:") {
                 let file = base.join(urlencoding_decode(uri));
@@ -133,11 +198,12 @@ pub fn load(path: &Path) -> Result<Character> {
             }
         }
     }
-    let buffers = gltf::import_buffers(doc, Some(base), gltf.blob.clone())
-        .map_err(|e| err(path, format!("cannot read its buffers: {e}")))?;
-    let mut warnings = Vec::new();
+    gltf::import_buffers(&gltf.document, Some(base), gltf.blob.clone())
+        .map_err(|e| err(path, format!("cannot read its buffers: {e}")))
+}
 
-    // Node hierarchy.
+/// Every node with its rest transform and parent.
+fn read_nodes(doc: &gltf::Document) -> Vec<Node> {
     let mut nodes: Vec<Node> = doc
         .nodes()
         .map(|n| {
@@ -161,10 +227,11 @@ pub fn load(path: &Path) -> Result<Character> {
             nodes[c.index()].parent = Some(n.index());
         }
     }
-    let order =
-        Skeleton::sort(&nodes).ok_or_else(|| err(path, "its node hierarchy has a cycle"))?;
+    nodes
+}
 
-    // Mesh nodes of the scene shown (the default scene, else the first, else every root).
+/// Nodes of the scene shown (the default scene, else the first, else every root), sorted.
+fn scene_nodes(doc: &gltf::Document, nodes: &[Node]) -> Vec<usize> {
     let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(s) => s.nodes().map(|n| n.index()).collect(),
         None => (0..nodes.len())
@@ -178,193 +245,184 @@ pub fn load(path: &Path) -> Result<Character> {
         stack.extend(doc.nodes().nth(i).unwrap().children().map(|c| c.index()));
     }
     in_scene.sort_unstable();
+    in_scene
+}
 
-    let mut joints: Vec<Joint> = Vec::new();
-    let mut skin_offset: HashMap<usize, usize> = HashMap::new();
-    let mut rigid_joint: HashMap<usize, usize> = HashMap::new();
-    let mut parts = Vec::new();
-    let mut skinned = false;
-    let mut morph_warned = false;
-    let mut computed_normals = false;
-    for &ni in &in_scene {
-        let node = doc.nodes().nth(ni).unwrap();
-        let Some(mesh) = node.mesh() else { continue };
-        // Joint indices of this node's vertices map to joints[offset + j].
-        let (offset, skin_joints) = match node.skin() {
-            Some(skin) => {
-                skinned = true;
-                let n = skin.joints().count();
-                let off = match skin_offset.get(&skin.index()) {
-                    Some(&o) => o,
-                    None => {
-                        let o = joints.len();
-                        let label = format!("skin {}", skin.index());
-                        if n == 0 {
-                            return Err(err(path, format!("{label} has no joints")));
-                        }
-                        if let Some(a) = skin.inverse_bind_matrices() {
-                            check_accessor(
-                                path,
-                                &label,
-                                &a,
-                                &[(Dimensions::Mat4, &[DataType::F32])],
-                            )?;
-                        }
-                        let ibm: Vec<Mat4> = match skin
-                            .reader(|b| Some(&buffers[b.index()]))
-                            .read_inverse_bind_matrices()
-                        {
-                            Some(it) => it.map(|m| Mat4::from_cols_array_2d(&m)).collect(),
-                            None => vec![Mat4::IDENTITY; n],
-                        };
-                        if ibm.len() < n {
-                            return Err(err(
-                                path,
-                                format!(
-                                    "skin {} has {} inverse bind matrices for {n} joints",
-                                    skin.index(),
-                                    ibm.len()
-                                ),
-                            ));
-                        }
-                        for (j, jn) in skin.joints().enumerate() {
-                            joints.push(Joint {
-                                node: jn.index(),
-                                inverse_bind: ibm[j],
-                            });
-                        }
-                        // Before the skin's primitives are read, so the count is the error.
-                        check_joint_count(path, joints.len())?;
-                        skin_offset.insert(skin.index(), o);
-                        o
-                    }
-                };
-                (off, Some(n))
-            }
-            None => {
-                let o = *rigid_joint.entry(ni).or_insert_with(|| {
-                    joints.push(Joint {
-                        node: ni,
-                        inverse_bind: Mat4::IDENTITY,
-                    });
-                    joints.len() - 1
+/// The skeleton's joints as mesh nodes name them: each skin's joints once, and one joint
+/// for each rigid mesh node.
+#[derive(Default)]
+struct Joints {
+    list: Vec<Joint>,
+    skin_offset: HashMap<usize, usize>,
+    rigid_joint: HashMap<usize, usize>,
+}
+
+impl Joints {
+    /// Where a mesh node's joint indices start in the list, and its skin's joint count
+    /// (None for a rigid node).
+    fn of_node(
+        &mut self,
+        path: &Path,
+        node: &gltf::Node,
+        buffers: &[gltf::buffer::Data],
+    ) -> Result<(usize, Option<usize>)> {
+        let Some(skin) = node.skin() else {
+            let list = &mut self.list;
+            let o = *self.rigid_joint.entry(node.index()).or_insert_with(|| {
+                list.push(Joint {
+                    node: node.index(),
+                    inverse_bind: Mat4::IDENTITY,
                 });
-                (o, None)
-            }
+                list.len() - 1
+            });
+            return Ok((o, None));
         };
-        for prim in mesh.primitives() {
-            let what = format!(
-                "mesh {} ('{}') primitive {}",
-                mesh.index(),
-                mesh.name().unwrap_or(""),
-                prim.index()
-            );
-            check_primitive(path, &what, &prim)?;
-            let reader = prim.reader(|b| Some(&buffers[b.index()]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| err(path, format!("{what} has no POSITION")))?
-                .map(Vec3::from)
-                .collect();
-            let n = positions.len();
-            let list: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n as u32).collect(),
-            };
-            if let Some(&bad) = list.iter().find(|&&i| i as usize >= n) {
-                return Err(err(
-                    path,
-                    format!("{what}: index {bad} is past its {n} vertices"),
-                ));
-            }
-            let indices = triangles(prim.mode(), &list).ok_or_else(|| {
-                err(path, format!("{what} draws {:?}; only triangle primitives (triangles, strips, fans) can be loaded", prim.mode()))
-            })?;
-            let normals = reader
-                .read_normals()
-                .map(|it| it.map(Vec3::from).collect::<Vec<_>>());
-            let uvs = reader
-                .read_tex_coords(0)
-                .map(|it| it.into_f32().map(Vec2::from).collect());
-            if prim.morph_targets().next().is_some() && !morph_warned {
-                warnings.push("morph targets are ignored (the rest shape is used)".to_string());
-                morph_warned = true;
-            }
-            let mut influences = vec![Vec::new(); n];
-            match skin_joints {
-                Some(count) => {
-                    let mut sets = 0;
-                    for set in 0..3u32 {
-                        let (Some(js), Some(ws)) =
-                            (reader.read_joints(set), reader.read_weights(set))
-                        else {
-                            break;
-                        };
-                        if set == 2 {
-                            warnings.push(format!("{what}: JOINTS_2 and later sets are ignored (at most {MAX_INFLUENCES} influences per vertex)"));
-                            break;
-                        }
-                        sets += 1;
-                        for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate() {
-                            for k in 0..4 {
-                                if w[k] > 0.0 && w[k].is_finite() {
-                                    if j[k] as usize >= count {
-                                        return Err(err(path, format!("{what}: vertex {v} names joint {} of a skin with {count}", j[k])));
-                                    }
-                                    influences[v].push(((offset + j[k] as usize) as u16, w[k]));
-                                }
-                            }
-                        }
-                    }
-                    if sets == 0 {
+        let n = skin.joints().count();
+        if let Some(&o) = self.skin_offset.get(&skin.index()) {
+            return Ok((o, Some(n)));
+        }
+        let o = self.list.len();
+        let label = format!("skin {}", skin.index());
+        if n == 0 {
+            return Err(err(path, format!("{label} has no joints")));
+        }
+        if let Some(a) = skin.inverse_bind_matrices() {
+            check_accessor(path, &label, &a, &[(Dimensions::Mat4, &[DataType::F32])])?;
+        }
+        let ibm: Vec<Mat4> = match skin
+            .reader(|b| Some(&buffers[b.index()]))
+            .read_inverse_bind_matrices()
+        {
+            Some(it) => it.map(|m| Mat4::from_cols_array_2d(&m)).collect(),
+            None => vec![Mat4::IDENTITY; n],
+        };
+        if ibm.len() < n {
+            return Err(err(
+                path,
+                format!(
+                    "skin {} has {} inverse bind matrices for {n} joints",
+                    skin.index(),
+                    ibm.len()
+                ),
+            ));
+        }
+        for (j, jn) in skin.joints().enumerate() {
+            self.list.push(Joint {
+                node: jn.index(),
+                inverse_bind: ibm[j],
+            });
+        }
+        // Before the skin's primitives are read, so the count is the error.
+        check_joint_count(path, self.list.len())?;
+        self.skin_offset.insert(skin.index(), o);
+        Ok((o, Some(n)))
+    }
+}
+
+/// One primitive's vertices, with joint indices offset into the skeleton's list; true
+/// when its normals had to be computed.
+fn read_part(
+    path: &Path,
+    what: &str,
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    offset: usize,
+    skin_joints: Option<usize>,
+    warnings: &mut Vec<String>,
+) -> Result<(Part, bool)> {
+    check_primitive(path, what, prim)?;
+    let reader = prim.reader(|b| Some(&buffers[b.index()]));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or_else(|| err(path, format!("{what} has no POSITION")))?
+        .map(Vec3::from)
+        .collect();
+    let n = positions.len();
+    let list: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if let Some(&bad) = list.iter().find(|&&i| i as usize >= n) {
+        return Err(err(
+            path,
+            format!("{what}: index {bad} is past its {n} vertices"),
+        ));
+    }
+    let indices = triangles(prim.mode(), &list).ok_or_else(|| {
+        err(path, format!("{what} draws {:?}; only triangle primitives (triangles, strips, fans) can be loaded", prim.mode()))
+    })?;
+    let normals = reader
+        .read_normals()
+        .map(|it| it.map(Vec3::from).collect::<Vec<_>>());
+    let uvs = reader
+        .read_tex_coords(0)
+        .map(|it| it.into_f32().map(Vec2::from).collect());
+    let influences = match skin_joints {
+        Some(count) => read_influences(path, what, &reader, n, offset, count, warnings)?,
+        None => vec![vec![(offset as u16, 1.0)]; n],
+    };
+    // Normals computed per part: parts stored in their own nodes' spaces may overlap.
+    let computed = normals.is_none();
+    let normals = normals.unwrap_or_else(|| super::check::area_normals(&positions, &indices));
+    let part = Part {
+        positions,
+        normals,
+        uvs,
+        indices,
+        influences,
+        fallback: offset as u16,
+    };
+    Ok((part, computed))
+}
+
+/// A skinned primitive's joint influences from JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1.
+fn read_influences<'a, 's, F>(
+    path: &Path,
+    what: &str,
+    reader: &gltf::mesh::Reader<'a, 's, F>,
+    n: usize,
+    offset: usize,
+    count: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Vec<(u16, f32)>>>
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    let mut influences = vec![Vec::new(); n];
+    let mut sets = 0;
+    for set in 0..3u32 {
+        let (Some(js), Some(ws)) = (reader.read_joints(set), reader.read_weights(set)) else {
+            break;
+        };
+        if set == 2 {
+            warnings.push(format!("{what}: JOINTS_2 and later sets are ignored (at most {MAX_INFLUENCES} influences per vertex)"));
+            break;
+        }
+        sets += 1;
+        for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate() {
+            for k in 0..4 {
+                if w[k] > 0.0 && w[k].is_finite() {
+                    if j[k] as usize >= count {
                         return Err(err(
                             path,
                             format!(
-                                "{what} belongs to a skinned node but has no JOINTS_0/WEIGHTS_0"
+                                "{what}: vertex {v} names joint {} of a skin with {count}",
+                                j[k]
                             ),
                         ));
                     }
+                    influences[v].push(((offset + j[k] as usize) as u16, w[k]));
                 }
-                None => influences
-                    .iter_mut()
-                    .for_each(|i| i.push((offset as u16, 1.0))),
             }
-            // Normals computed per part: parts stored in their own nodes' spaces may overlap.
-            let normals = normals.unwrap_or_else(|| {
-                computed_normals = true;
-                super::check::area_normals(&positions, &indices)
-            });
-            parts.push(Part {
-                positions,
-                normals,
-                uvs,
-                indices,
-                influences,
-                fallback: offset as u16,
-            });
         }
     }
-    if parts.is_empty() {
-        return Err(err(path, "has no mesh in its scene"));
+    if sets == 0 {
+        return Err(err(
+            path,
+            format!("{what} belongs to a skinned node but has no JOINTS_0/WEIGHTS_0"),
+        ));
     }
-    // Rigid mesh nodes add a joint each.
-    check_joint_count(path, joints.len())?;
-    let clips = read_clips(path, doc, &buffers, &mut warnings)?;
-    let skeleton = Skeleton {
-        nodes,
-        joints,
-        order,
-    };
-    let mut ch = super::assemble(
-        path.display().to_string(),
-        merge(parts, &mut warnings),
-        skeleton,
-        clips,
-        skinned,
-        warnings,
-    )?;
-    ch.normals_computed |= computed_normals;
-    Ok(ch)
+    Ok(influences)
 }
 
 /// Triangle list of a primitive's index list, or None for points and lines.
@@ -446,103 +504,6 @@ fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
         ));
     }
     (m, has_normal)
-}
-
-fn read_clips(
-    path: &Path,
-    doc: &gltf::Document,
-    buffers: &[gltf::buffer::Data],
-    warnings: &mut Vec<String>,
-) -> Result<Vec<Clip>> {
-    use gltf::animation::util::ReadOutputs;
-    let mut clips = Vec::new();
-    for a in doc.animations() {
-        let name = a
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("animation{}", a.index()));
-        let mut channels = Vec::new();
-        let mut duration = 0f32;
-        for c in a.channels() {
-            use gltf::animation::Property as P;
-            use DataType::{F32, I16, I8, U16, U8};
-            let label = format!("animation '{name}'");
-            let s = c.sampler();
-            check_accessor(path, &label, &s.input(), &[(Dimensions::Scalar, &[F32])])?;
-            let out: &[(Dimensions, &[DataType])] = match c.target().property() {
-                P::Translation | P::Scale => &[(Dimensions::Vec3, &[F32])],
-                P::Rotation => &[(Dimensions::Vec4, &[F32, I8, U8, I16, U16])],
-                P::MorphTargetWeights => &[(Dimensions::Scalar, &[F32, I8, U8, I16, U16])],
-            };
-            check_accessor(path, &label, &s.output(), out)?;
-            let reader = c.reader(|b| Some(&buffers[b.index()]));
-            let times: Vec<f32> = reader
-                .read_inputs()
-                .map(|i| i.collect())
-                .unwrap_or_default();
-            let (property, values): (Property, Vec<Vec4>) = match reader.read_outputs() {
-                Some(ReadOutputs::Translations(it)) => (
-                    Property::Translation,
-                    it.map(|v| Vec3::from(v).extend(0.0)).collect(),
-                ),
-                Some(ReadOutputs::Scales(it)) => (
-                    Property::Scale,
-                    it.map(|v| Vec3::from(v).extend(0.0)).collect(),
-                ),
-                Some(ReadOutputs::Rotations(it)) => {
-                    (Property::Rotation, it.into_f32().map(Vec4::from).collect())
-                }
-                Some(ReadOutputs::MorphTargetWeights(_)) => {
-                    warnings.push(format!(
-                        "animation '{name}': a morph-weight channel is ignored"
-                    ));
-                    continue;
-                }
-                None => {
-                    return Err(err(
-                        path,
-                        format!("animation '{name}': a channel's output cannot be read"),
-                    ))
-                }
-            };
-            let interp = match c.sampler().interpolation() {
-                gltf::animation::Interpolation::Step => Interp::Step,
-                gltf::animation::Interpolation::Linear => Interp::Linear,
-                gltf::animation::Interpolation::CubicSpline => Interp::CubicSpline,
-            };
-            let per_key = if interp == Interp::CubicSpline { 3 } else { 1 };
-            if times.is_empty() || values.len() != per_key * times.len() {
-                return Err(err(path, format!(
-                    "animation '{name}': a channel has {} keys and {} values ({per_key} per key expected)",
-                    times.len(),
-                    values.len()
-                )));
-            }
-            if times.iter().any(|t| !t.is_finite()) {
-                return Err(err(
-                    path,
-                    format!("animation '{name}': a key time is not finite"),
-                ));
-            }
-            if times.windows(2).any(|w| w[1] < w[0]) {
-                return Err(err(path, format!("animation '{name}': key times decrease")));
-            }
-            duration = duration.max(*times.last().unwrap());
-            channels.push(Channel {
-                node: c.target().node().index(),
-                property,
-                interp,
-                times,
-                values,
-            });
-        }
-        clips.push(Clip {
-            name,
-            duration,
-            channels,
-        });
-    }
-    Ok(clips)
 }
 
 /// Percent-decoding of a relative URI (spaces and the like in file names).

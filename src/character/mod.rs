@@ -4,6 +4,7 @@ pub mod anim;
 pub mod capsules;
 pub mod check;
 pub mod cpu;
+mod gltf_clips;
 pub mod gltf_load;
 pub mod inspect;
 pub mod model;

@@ -101,15 +101,29 @@ impl SphWork<'_> {
 }
 
 pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<RunResult> {
-    use crate::sph::run::{check, physics_stats, Stepper};
-    use crate::sph::SphSolver;
-    use crate::viewer::{MetaballViewer, PointsViewer, View};
-    let sw = &opts.switches;
-    let render = sw
+    use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
+    let render = opts
+        .switches
         .view
         .render
         .or(scene.look.render)
         .unwrap_or(RenderKind::Metaballs);
+    check_groups(&opts.switches, render, &scene)?;
+    let (scene, sw) = prepare(scene, &opts.switches)?;
+    let sw = &sw;
+    let frame_count = opts.frames.unwrap_or(scene.frames);
+    let ctx = open(sw)?;
+    let per_particle = bytes_per_particle(&scene.fluid);
+    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
+    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+    let mut work = SphWork::new(&ctx, opts, &scene, sw, render, neighbors, frame_count)?;
+    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
+    let how = (sw, render, neighbors);
+    work.finish(&ctx, opts, &scene, how, frame_count, timings)
+}
+
+/// Refuse switches that an SPH scene drawn this way would not use.
+fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) -> Result<()> {
     use crate::config::Group;
     let mut uses = vec![
         Group::Sort,
@@ -134,7 +148,13 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
     if !scene.system.is_empty() {
         uses.push(Group::Particles);
     }
-    sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)?;
+    sw.reject_unused(&format!("SPH scenes drawn as {}", render.as_str()), &uses)
+}
+
+/// The scene as it will play and the switches with its look applied: fluid overrides,
+/// the character's fit, the metaball radius from the spacing; validated and size-checked
+/// before any particle or buffer is made (the count is estimated, not built).
+fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::Scene, Switches)> {
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
@@ -151,27 +171,22 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
         let s0 = crate::sph::FluidParams::default().spacing();
         sw.metaball.radius = Some(DEFAULT_RADIUS * scene.fluid.spacing() / s0);
     }
-    let sw = &sw;
     crate::scene::particles::set_integrator_draw(
         &mut scene.system,
         sw.particle.integrator,
         sw.particle.draw,
     );
-    // Refused before any particle or buffer is made (the count is estimated, not built).
     scene.validate()?;
-    let per_particle = bytes_per_particle(&scene.fluid);
-    scene.check_size(MAX_PARTICLES, per_particle, 0)?;
+    scene.check_size(MAX_PARTICLES, bytes_per_particle(&scene.fluid), 0)?;
     let scene = match sw.common.particles {
         Some(n) => scene.with_particles(n),
         None => scene,
     };
-    let frame_count = opts.frames.unwrap_or(scene.frames);
-    let ctx = open(sw)?;
-    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
-    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
-    let mut solver = Guard::new(&ctx, SphSolver::new(&ctx, neighbors, sw.sorting.sort)?);
-    let parts = scene.particles(sw.common.seed);
-    let mut st = Guard::new(&ctx, solver.state(&ctx, &scene, &parts)?);
+    Ok((scene, sw))
+}
+
+/// The scene's camera, else one looking at the domain from the front and above.
+fn scene_camera(scene: &crate::scene::Scene, sw: &Switches) -> Camera {
     let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
@@ -189,145 +204,177 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
             )
         }
     };
-    let cam = camera_with_switches(cam, sw);
-    let targets = crate::scene::targets::SceneTargets::new(
-        &ctx, &scene, sw, &solver, &mut st, &parts.pos, SLOTS,
-    )?;
-    let targets = Guard::new(&ctx, targets);
-    let show = targets.show();
-    let view: Box<dyn View> = match render {
-        RenderKind::Metaballs => {
-            let tank = scene
-                .look
-                .tank
-                .unwrap_or(true)
-                .then_some([scene.domain.min, scene.domain.max]);
-            let overlay = !scene.system.is_empty();
-            Box::new(MetaballViewer::new(
-                &ctx, sw, cam, st.n, SLOTS, tank, show, overlay,
-            )?)
-        }
-        // Spheres of half the rest spacing.
-        RenderKind::Points => Box::new(PointsViewer::new(
-            &ctx,
-            sw,
-            &cam,
-            0.5 * scene.fluid.spacing(),
-            SLOTS,
-            show,
-        )?),
-    };
-    let view = Guard::new(&ctx, view);
-    let stepper = Guard::new(&ctx, Stepper::new(&ctx, &st, SLOTS)?);
-    let systems = match scene.system.is_empty() {
-        true => None,
-        false => Some(crate::run::particles::SceneSystems::new(
-            &ctx,
-            &scene.system,
-            stepper.frame_time as f32,
-            cam,
-            sw.frame.width(),
-            sw.frame.height(),
-            sw.common.seed,
-        )?),
-    };
-    let systems = Guard::new(&ctx, systems);
-    let every = sw.export.export_every.unwrap_or(1);
-    let export = sw
-        .export
-        .export
-        .map(|f| crate::export::ParticleExport::new(&ctx, f, every, &opts.out, &st, SLOTS))
-        .transpose()?;
-    let mut work = SphWork {
-        solver: solver.take(),
-        st: st.take(),
-        stepper: stepper.take(),
-        view: view.take(),
-        frames: Frames::new(&opts.out, opts.save_every, frame_count),
-        export,
-        targets: targets.take(),
-        systems: systems.take(),
-    };
-    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
-    let memory = ctx.memory_bytes();
-    let dump = match &timings {
-        Ok(_) => Some(work.st.read(&ctx)),
-        Err(_) => None,
-    };
-    let (steps, simulated_seconds) = (work.stepper.steps_taken, work.stepper.sim_time);
-    let density_error = work.stepper.error_stats(&work.st);
-    let steps_csv = work.stepper.write_csv(&opts.out.join("steps.csv"));
-    let render_stats = work.view.stats();
-    let character_stats = work.targets.character_stats();
-    let control_stats = work.targets.control_summary(&opts.out);
-    let emission_stats = match &timings {
-        Ok(_) => work
-            .targets
-            .emission_summary(&ctx, simulated_seconds, &opts.out),
-        Err(_) => Ok(None),
-    };
-    let particle_systems = match (&timings, &work.systems) {
-        (Ok(_), Some(s)) => s
-            .systems
-            .iter()
-            .map(|s| crate::run::particles::SystemStats::of(&ctx, s))
-            .collect::<Result<Vec<_>>>(),
-        _ => Ok(Vec::new()),
-    };
-    let sort = work.solver.search.sort;
-    let exports = work
-        .export
-        .as_ref()
-        .map(|e| e.files.clone())
-        .unwrap_or_default();
-    work.destroy(&ctx);
-    let timings = timings?;
-    let animation = work.frames.finish()?;
-    let stats = SphRunStats {
-        physics: physics_stats(
-            &dump.expect("state read")?,
-            &scene.domain,
-            scene.fluid.rest_density,
-        ),
-        steps,
-        simulated_seconds,
-        render: render_stats,
-        character: character_stats?,
-        control: control_stats?,
-        emission: emission_stats?,
-        particle_systems: particle_systems?,
-        density_error,
-    };
-    steps_csv?;
-    let config = RunConfig {
-        command: "run".into(),
-        scene: scene.name.clone(),
-        frames: frame_count,
-        save_every: opts.save_every,
-        particles: stats.physics.particles as u64,
-        neighbors: Some(neighbors),
-        sort: Some(sort),
-        render: Some(render),
-        fluid: Some(scene.fluid.clone()),
-        switches: sw.clone(),
-    };
-    let physics = stats.physics.clone();
-    let report = Report {
-        device: &ctx.info,
-        config,
-        timings: &timings,
-        memory,
-        stats: RunStats::Sph(Box::new(stats)),
-        validation: sw.common.validation.then(|| ctx.validation_counts()),
-        barriers: ctx.tracked_barriers(),
-    };
-    let summary = report.write(&opts.out)?;
-    check_validation(&ctx)?;
-    check(&physics)?;
-    Ok(RunResult {
-        summary,
-        pngs: work.frames.pngs,
-        animation,
-        exports,
-    })
+    camera_with_switches(cam, sw)
+}
+
+impl<'a> SphWork<'a> {
+    /// Solver, state, targets, view, stepper, particle systems and export of a scene.
+    fn new(
+        ctx: &Context,
+        opts: &'a RunOptions,
+        scene: &crate::scene::Scene,
+        sw: &Switches,
+        render: RenderKind,
+        neighbors: Neighbors,
+        frame_count: u64,
+    ) -> Result<Self> {
+        use crate::sph::run::Stepper;
+        use crate::sph::SphSolver;
+        use crate::viewer::{MetaballViewer, PointsViewer, View};
+        let mut solver = Guard::new(ctx, SphSolver::new(ctx, neighbors, sw.sorting.sort)?);
+        let parts = scene.particles(sw.common.seed);
+        let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
+        let cam = scene_camera(scene, sw);
+        let targets = crate::scene::targets::SceneTargets::new(
+            ctx, scene, sw, &solver, &mut st, &parts.pos, SLOTS,
+        )?;
+        let targets = Guard::new(ctx, targets);
+        let show = targets.show();
+        let view: Box<dyn View> = match render {
+            RenderKind::Metaballs => {
+                let tank = scene
+                    .look
+                    .tank
+                    .unwrap_or(true)
+                    .then_some([scene.domain.min, scene.domain.max]);
+                let overlay = !scene.system.is_empty();
+                Box::new(MetaballViewer::new(
+                    ctx, sw, cam, st.n, SLOTS, tank, show, overlay,
+                )?)
+            }
+            // Spheres of half the rest spacing.
+            RenderKind::Points => Box::new(PointsViewer::new(
+                ctx,
+                sw,
+                &cam,
+                0.5 * scene.fluid.spacing(),
+                SLOTS,
+                show,
+            )?),
+        };
+        let view = Guard::new(ctx, view);
+        let stepper = Guard::new(ctx, Stepper::new(ctx, &st, SLOTS)?);
+        let systems = match scene.system.is_empty() {
+            true => None,
+            false => Some(crate::run::particles::SceneSystems::new(
+                ctx,
+                &scene.system,
+                stepper.frame_time as f32,
+                cam,
+                sw.frame.width(),
+                sw.frame.height(),
+                sw.common.seed,
+            )?),
+        };
+        let systems = Guard::new(ctx, systems);
+        let every = sw.export.export_every.unwrap_or(1);
+        let export = sw
+            .export
+            .export
+            .map(|f| crate::export::ParticleExport::new(ctx, f, every, &opts.out, &st, SLOTS))
+            .transpose()?;
+        Ok(SphWork {
+            solver: solver.take(),
+            st: st.take(),
+            stepper: stepper.take(),
+            view: view.take(),
+            frames: Frames::new(&opts.out, opts.save_every, frame_count),
+            export,
+            targets: targets.take(),
+            systems: systems.take(),
+        })
+    }
+
+    /// After the frames: statistics read back, everything destroyed, the frames and
+    /// summary.json written, then the validation and physics checks.
+    fn finish(
+        mut self,
+        ctx: &Context,
+        opts: &RunOptions,
+        scene: &crate::scene::Scene,
+        (sw, render, neighbors): (&Switches, RenderKind, Neighbors),
+        frame_count: u64,
+        timings: Result<Vec<crate::gpu::FrameTiming>>,
+    ) -> Result<RunResult> {
+        use crate::sph::run::{check, physics_stats};
+        let memory = ctx.memory_bytes();
+        let ok = timings.is_ok();
+        let dump = ok.then(|| self.st.read(ctx));
+        let (steps, simulated_seconds) = (self.stepper.steps_taken, self.stepper.sim_time);
+        let density_error = self.stepper.error_stats(&self.st);
+        let steps_csv = self.stepper.write_csv(&opts.out.join("steps.csv"));
+        let render_stats = self.view.stats();
+        let character_stats = self.targets.character_stats();
+        let control_stats = self.targets.control_summary(&opts.out);
+        let emission_stats = match ok {
+            true => self
+                .targets
+                .emission_summary(ctx, simulated_seconds, &opts.out),
+            false => Ok(None),
+        };
+        let particle_systems = match (ok, &self.systems) {
+            (true, Some(s)) => s
+                .systems
+                .iter()
+                .map(|s| crate::run::particles::SystemStats::of(ctx, s))
+                .collect::<Result<Vec<_>>>(),
+            _ => Ok(Vec::new()),
+        };
+        let sort = self.solver.search.sort;
+        let exports = self
+            .export
+            .as_ref()
+            .map(|e| e.files.clone())
+            .unwrap_or_default();
+        self.destroy(ctx);
+        let timings = timings?;
+        let animation = self.frames.finish()?;
+        let stats = SphRunStats {
+            physics: physics_stats(
+                &dump.expect("state read")?,
+                &scene.domain,
+                scene.fluid.rest_density,
+            ),
+            steps,
+            simulated_seconds,
+            render: render_stats,
+            character: character_stats?,
+            control: control_stats?,
+            emission: emission_stats?,
+            particle_systems: particle_systems?,
+            density_error,
+        };
+        steps_csv?;
+        let config = RunConfig {
+            command: "run".into(),
+            scene: scene.name.clone(),
+            frames: frame_count,
+            save_every: opts.save_every,
+            particles: stats.physics.particles as u64,
+            neighbors: Some(neighbors),
+            sort: Some(sort),
+            render: Some(render),
+            fluid: Some(scene.fluid.clone()),
+            switches: sw.clone(),
+        };
+        let physics = stats.physics.clone();
+        let report = Report {
+            device: &ctx.info,
+            config,
+            timings: &timings,
+            memory,
+            stats: RunStats::Sph(Box::new(stats)),
+            validation: sw.common.validation.then(|| ctx.validation_counts()),
+            barriers: ctx.tracked_barriers(),
+        };
+        let summary = report.write(&opts.out)?;
+        check_validation(ctx)?;
+        check(&physics)?;
+        Ok(RunResult {
+            summary,
+            pngs: self.frames.pngs,
+            animation,
+            exports,
+        })
+    }
 }

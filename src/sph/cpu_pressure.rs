@@ -176,7 +176,7 @@ pub fn step(
         .iter()
         .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
         .collect();
-    let mut v: Vec<V3> = vel
+    let v: Vec<V3> = vel
         .iter()
         .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
         .collect();
@@ -194,174 +194,217 @@ pub fn step(
             .collect()
     };
     let a_np = |v: &[V3]| super::cpu::evaluate(&fnp, pos, &f32s(v)).acc;
+    let c = Common {
+        kk: &kk,
+        proto,
+        dt,
+        iterations,
+    };
     match f.solver {
         Solver::Wcsph => panic!("cpu_pressure covers the incompressible solvers"),
         Solver::Pcisph => {
             let a = a_np(&v);
-            let delta: Vec<f64> = (0..n)
-                .map(|i| 0.5 / (2.0 * dt * dt * kk.grad2(&x, i).max(1e-3 * proto)))
-                .collect();
-            let cap = 0.2 / (2.0 * dt * dt * proto);
-            let mut p = vec![0.0; n];
-            let mut ap = vec![[0.0; 3]; n];
-            for _ in 0..iterations {
-                let xs: Vec<V3> = (0..n)
-                    .map(|i| axpy(dt, axpy(dt, axpy(1.0, a[i], ap[i]), v[i]), x[i]))
-                    .collect();
-                for i in 0..n {
-                    let err = kk.density(&xs, i) / kk.rho0 - 1.0;
-                    p[i] = (p[i] + delta[i] * err).clamp(0.0, cap);
-                }
-                for i in 0..n {
-                    let mut s = [0.0; 3];
-                    for j in 0..n {
-                        if j != i {
-                            s = axpy(-(p[i] + p[j]), kk.vg(sub(xs[i], xs[j])), s);
-                        }
-                    }
-                    ap[i] = s;
-                }
-            }
-            let v: Vec<V3> = (0..n)
-                .map(|i| axpy(dt, axpy(1.0, a[i], ap[i]), v[i]))
-                .collect();
-            let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
-            (x, v)
+            pcisph(&c, x, v, &a)
         }
-        Solver::Dfsph => {
-            let solid: Vec<(f64, V3)> = x.iter().map(|xi| walls.solid(kk.h, *xi)).collect();
-            let alpha: Vec<f64> = (0..n)
-                .map(|i| {
-                    // The walls add to the gradient sum (not to the sum of squares).
-                    let (sg, s2) = kk.grad_sums(&x, i);
-                    let sg = axpy(1.0, solid[i].1, sg);
-                    let d = dot(sg, sg) + s2;
-                    if d > 1e-3 * proto {
-                        1.0 / d
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            let rate = |v: &[V3], i: usize| -> f64 {
-                dot(v[i], solid[i].1)
-                    + (0..n)
-                        .filter(|&j| j != i)
-                        .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
-                        .sum::<f64>()
-            };
-            let solve = |v: &mut Vec<V3>, divergence: bool| {
-                // The warm start's pass (no stiffness yet) answers velocities into walls.
-                for i in 0..n {
-                    v[i] = walls.response(x[i], dt, v[i]);
-                }
-                let source = |v: &[V3]| -> Vec<f64> {
-                    (0..n)
-                        .map(|i| {
-                            if divergence {
-                                rate(v, i).max(0.0)
-                            } else {
-                                (rho[i] / kk.rho0 + solid[i].0 + dt * rate(v, i) - 1.0).max(0.0)
-                            }
-                        })
-                        .collect()
-                };
-                let mut s = source(v);
-                let scale = if divergence { dt } else { dt * dt };
-                for _ in 0..iterations {
-                    let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
-                    let old = v.clone();
-                    for i in 0..n {
-                        let mut vi = axpy(-dt * k[i], solid[i].1, old[i]);
-                        for j in 0..n {
-                            if j != i {
-                                vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);
-                            }
-                        }
-                        v[i] = walls.response(x[i], dt, vi);
-                    }
-                    s = source(v);
-                }
-            };
-            solve(&mut v, true);
-            let a = a_np(&v);
-            for i in 0..n {
-                v[i] = walls.response(x[i], dt, axpy(dt, a[i], v[i]));
-            }
-            solve(&mut v, false);
-            let mut x: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
-            for i in 0..n {
-                walls.collide(&mut x[i], &mut v[i]);
-            }
-            (x, v)
-        }
+        Solver::Dfsph => dfsph(&c, walls, x, v, &rho, &a_np),
         Solver::Pbf => {
             let a = a_np(&v);
-            let mut xs: Vec<V3> = (0..n)
-                .map(|i| axpy(dt, axpy(dt, a[i], v[i]), x[i]))
-                .collect();
-            let dq = f.pbf.scorr_dq as f64 * kk.h;
-            let wdq = kk.w(dq * dq);
-            for _ in 0..iterations {
-                let lambda: Vec<f64> = (0..n)
-                    .map(|i| {
-                        let c = (kk.density(&xs, i) / kk.rho0 - 1.0).max(0.0);
-                        -c / (kk.grad2(&xs, i) + f.pbf.relaxation as f64 * proto)
-                    })
-                    .collect();
-                let dx: Vec<V3> = (0..n)
-                    .map(|i| {
-                        let mut s = [0.0; 3];
-                        for j in 0..n {
-                            let d = sub(xs[i], xs[j]);
-                            if j != i && dot(d, d) < kk.h * kk.h {
-                                let sc = -f.pbf.scorr_k as f64
-                                    * (kk.w(dot(d, d)) / wdq).powf(f.pbf.scorr_n as f64)
-                                    / proto;
-                                s = axpy(lambda[i] + lambda[j] + sc, kk.vg(d), s);
-                            }
-                        }
-                        s
-                    })
-                    .collect();
-                for i in 0..n {
-                    xs[i] = axpy(1.0, dx[i], xs[i]);
-                }
-            }
-            let mut v: Vec<V3> = (0..n)
-                .map(|i| axpy(-1.0, x[i], xs[i]).map(|c| c / dt))
-                .collect();
-            let x = xs;
-            let mut w = vec![[0.0; 3]; n];
-            let mut dv = vec![[0.0; 3]; n];
-            for i in 0..n {
-                for j in 0..n {
-                    let d = sub(x[i], x[j]);
-                    if j != i && dot(d, d) < kk.h * kk.h {
-                        let vji = sub(v[j], v[i]);
-                        w[i] = axpy(1.0, cross(kk.vg(d), vji), w[i]);
-                        dv[i] = axpy(kk.v * kk.w(dot(d, d)) * f.pbf.xsph as f64, vji, dv[i]);
-                    }
-                }
-            }
-            for i in 0..n {
-                let wl = dot(w[i], w[i]).sqrt();
-                let mut eta = [0.0; 3];
-                for j in 0..n {
-                    if j != i {
-                        let wj = dot(w[j], w[j]).sqrt();
-                        eta = axpy(wj - wl, kk.vg(sub(x[i], x[j])), eta);
-                    }
-                }
-                let el = dot(eta, eta).sqrt();
-                let fv = if el > 1e-6 / kk.h {
-                    cross(eta.map(|c| c / el), w[i]).map(|c| c * f.pbf.vorticity as f64)
-                } else {
-                    [0.0; 3]
-                };
-                v[i] = axpy(1.0, dv[i], axpy(dt, fv, v[i]));
-            }
-            (x, v)
+            pbf(&c, f, x, v, &a)
         }
     }
+}
+
+/// What every solver's step shares: kernels, the prototype's gradient sum, dt, iterations.
+struct Common<'a> {
+    kk: &'a K,
+    proto: f64,
+    dt: f64,
+    iterations: u32,
+}
+
+/// PCISPH: pressures predicted and corrected on the predicted positions.
+fn pcisph(c: &Common, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3>, Vec<V3>) {
+    let (kk, dt, n) = (c.kk, c.dt, x.len());
+    let delta: Vec<f64> = (0..n)
+        .map(|i| 0.5 / (2.0 * dt * dt * kk.grad2(&x, i).max(1e-3 * c.proto)))
+        .collect();
+    let cap = 0.2 / (2.0 * dt * dt * c.proto);
+    let mut p = vec![0.0; n];
+    let mut ap = vec![[0.0; 3]; n];
+    for _ in 0..c.iterations {
+        let xs: Vec<V3> = (0..n)
+            .map(|i| axpy(dt, axpy(dt, axpy(1.0, a[i], ap[i]), v[i]), x[i]))
+            .collect();
+        for i in 0..n {
+            let err = kk.density(&xs, i) / kk.rho0 - 1.0;
+            p[i] = (p[i] + delta[i] * err).clamp(0.0, cap);
+        }
+        for i in 0..n {
+            let mut s = [0.0; 3];
+            for j in 0..n {
+                if j != i {
+                    s = axpy(-(p[i] + p[j]), kk.vg(sub(xs[i], xs[j])), s);
+                }
+            }
+            ap[i] = s;
+        }
+    }
+    let v: Vec<V3> = (0..n)
+        .map(|i| axpy(dt, axpy(1.0, a[i], ap[i]), v[i]))
+        .collect();
+    let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+    (x, v)
+}
+
+/// DFSPH: the divergence solve, non-pressure forces, the density solve, then the move.
+fn dfsph(
+    c: &Common,
+    walls: &Walls,
+    x: Vec<V3>,
+    mut v: Vec<V3>,
+    rho: &[f64],
+    a_np: &dyn Fn(&[V3]) -> Vec<V3>,
+) -> (Vec<V3>, Vec<V3>) {
+    let (kk, dt, n) = (c.kk, c.dt, x.len());
+    let solid: Vec<(f64, V3)> = x.iter().map(|xi| walls.solid(kk.h, *xi)).collect();
+    let alpha: Vec<f64> = (0..n)
+        .map(|i| {
+            // The walls add to the gradient sum (not to the sum of squares).
+            let (sg, s2) = kk.grad_sums(&x, i);
+            let sg = axpy(1.0, solid[i].1, sg);
+            let d = dot(sg, sg) + s2;
+            if d > 1e-3 * c.proto {
+                1.0 / d
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let rate = |v: &[V3], i: usize| -> f64 {
+        dot(v[i], solid[i].1)
+            + (0..n)
+                .filter(|&j| j != i)
+                .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
+                .sum::<f64>()
+    };
+    let solve = |v: &mut Vec<V3>, divergence: bool| {
+        // The warm start's pass (no stiffness yet) answers velocities into walls.
+        for i in 0..n {
+            v[i] = walls.response(x[i], dt, v[i]);
+        }
+        let source = |v: &[V3]| -> Vec<f64> {
+            (0..n)
+                .map(|i| {
+                    if divergence {
+                        rate(v, i).max(0.0)
+                    } else {
+                        (rho[i] / kk.rho0 + solid[i].0 + dt * rate(v, i) - 1.0).max(0.0)
+                    }
+                })
+                .collect()
+        };
+        let mut s = source(v);
+        let scale = if divergence { dt } else { dt * dt };
+        for _ in 0..c.iterations {
+            let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
+            let old = v.clone();
+            for i in 0..n {
+                let mut vi = axpy(-dt * k[i], solid[i].1, old[i]);
+                for j in 0..n {
+                    if j != i {
+                        vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);
+                    }
+                }
+                v[i] = walls.response(x[i], dt, vi);
+            }
+            s = source(v);
+        }
+    };
+    solve(&mut v, true);
+    let a = a_np(&v);
+    for i in 0..n {
+        v[i] = walls.response(x[i], dt, axpy(dt, a[i], v[i]));
+    }
+    solve(&mut v, false);
+    let mut x: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+    for i in 0..n {
+        walls.collide(&mut x[i], &mut v[i]);
+    }
+    (x, v)
+}
+
+/// PBF: density constraints solved on predicted positions, then XSPH and vorticity.
+fn pbf(c: &Common, f: &FluidParams, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3>, Vec<V3>) {
+    let (kk, dt, n) = (c.kk, c.dt, x.len());
+    let mut xs: Vec<V3> = (0..n)
+        .map(|i| axpy(dt, axpy(dt, a[i], v[i]), x[i]))
+        .collect();
+    let dq = f.pbf.scorr_dq as f64 * kk.h;
+    let wdq = kk.w(dq * dq);
+    for _ in 0..c.iterations {
+        let lambda: Vec<f64> = (0..n)
+            .map(|i| {
+                let cst = (kk.density(&xs, i) / kk.rho0 - 1.0).max(0.0);
+                -cst / (kk.grad2(&xs, i) + f.pbf.relaxation as f64 * c.proto)
+            })
+            .collect();
+        let dx: Vec<V3> = (0..n)
+            .map(|i| {
+                let mut s = [0.0; 3];
+                for j in 0..n {
+                    let d = sub(xs[i], xs[j]);
+                    if j != i && dot(d, d) < kk.h * kk.h {
+                        let sc = -f.pbf.scorr_k as f64
+                            * (kk.w(dot(d, d)) / wdq).powf(f.pbf.scorr_n as f64)
+                            / c.proto;
+                        s = axpy(lambda[i] + lambda[j] + sc, kk.vg(d), s);
+                    }
+                }
+                s
+            })
+            .collect();
+        for i in 0..n {
+            xs[i] = axpy(1.0, dx[i], xs[i]);
+        }
+    }
+    let v: Vec<V3> = (0..n)
+        .map(|i| axpy(-1.0, x[i], xs[i]).map(|c| c / dt))
+        .collect();
+    let v = pbf_velocity(kk, f, dt, &xs, v);
+    (xs, v)
+}
+
+/// PBF's velocity update: XSPH viscosity and vorticity confinement.
+fn pbf_velocity(kk: &K, f: &FluidParams, dt: f64, x: &[V3], mut v: Vec<V3>) -> Vec<V3> {
+    let n = x.len();
+    let mut w = vec![[0.0; 3]; n];
+    let mut dv = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for j in 0..n {
+            let d = sub(x[i], x[j]);
+            if j != i && dot(d, d) < kk.h * kk.h {
+                let vji = sub(v[j], v[i]);
+                w[i] = axpy(1.0, cross(kk.vg(d), vji), w[i]);
+                dv[i] = axpy(kk.v * kk.w(dot(d, d)) * f.pbf.xsph as f64, vji, dv[i]);
+            }
+        }
+    }
+    for i in 0..n {
+        let wl = dot(w[i], w[i]).sqrt();
+        let mut eta = [0.0; 3];
+        for j in 0..n {
+            if j != i {
+                let wj = dot(w[j], w[j]).sqrt();
+                eta = axpy(wj - wl, kk.vg(sub(x[i], x[j])), eta);
+            }
+        }
+        let el = dot(eta, eta).sqrt();
+        let fv = if el > 1e-6 / kk.h {
+            cross(eta.map(|c| c / el), w[i]).map(|c| c * f.pbf.vorticity as f64)
+        } else {
+            [0.0; 3]
+        };
+        v[i] = axpy(1.0, dv[i], axpy(dt, fv, v[i]));
+    }
+    v
 }

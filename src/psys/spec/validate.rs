@@ -12,45 +12,83 @@ fn finite(v: &[f32]) -> bool {
 impl SystemSpec {
     /// Every value in range; the closed form only with forces that have one.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(Error::Param(format!("system '{}': {m}", self.name)));
         if self.capacity == 0 || self.capacity > 1 << 26 {
-            return bad(format!("capacity {} is not in 1..=67108864", self.capacity));
+            return self.bad(format!("capacity {} is not in 1..=67108864", self.capacity));
         }
+        self.check_emitter()?;
+        self.check_particle()?;
+        self.check_over_life()?;
+        self.check_forces_and_colliders()?;
+        self.check_death_and_events()?;
+        if self.emitter.burst > self.capacity {
+            return self.bad(format!(
+                "emitter: a burst of {} exceeds the capacity",
+                self.emitter.burst
+            ));
+        }
+        self.check_boids()?;
+        self.check_closed_form()?;
+        if !(self.point_px >= 1.0 && self.point_px <= 64.0) {
+            return self.bad("point_px must be in [1, 64]".into());
+        }
+        if self.draw() == SpriteMode::Points && matches!(self.sort, Some(s) if s != SortAlgo::None)
+        {
+            return self.bad("points are opaque and depth-tested: they take no sort".into());
+        }
+        Ok(())
+    }
+
+    /// The parameter error naming this system.
+    fn bad(&self, m: String) -> Result<()> {
+        Err(Error::Param(format!("system '{}': {}", self.name, m)))
+    }
+
+    /// The emission rate and the emitter shape.
+    fn check_emitter(&self) -> Result<()> {
         let e = &self.emitter;
         match (&e.rate, e.per_area) {
             (Some(r), None)
                 if r.mean >= 0.0 && r.variance >= 0.0 && finite(&[r.mean, r.variance]) => {}
             (None, Some(a)) if a > 0.0 && a.is_finite() => {}
-            (Some(_), Some(_)) => return bad("emitter: give rate or per_area, not both".into()),
+            (Some(_), Some(_)) => {
+                return self.bad("emitter: give rate or per_area, not both".into())
+            }
             (None, None) if e.burst > 0 => {}
             (None, None) => {
-                return bad("emitter: give rate = {mean, variance}, per_area or burst".into())
+                return self.bad("emitter: give rate = {mean, variance}, per_area or burst".into())
             }
-            _ => return bad("emitter: the rate must be finite and not negative".into()),
+            _ => return self.bad("emitter: the rate must be finite and not negative".into()),
         }
         if matches!(e.shape, Shape::Sphere | Shape::Disc) && !(e.radius > 0.0) {
-            return bad(format!("emitter: a {:?} needs a positive radius", e.shape).to_lowercase());
+            return self
+                .bad(format!("emitter: a {:?} needs a positive radius", e.shape).to_lowercase());
         }
         if e.shape == Shape::Disc && !(glam::Vec3::from(e.normal).length() > 1e-6) {
-            return bad("emitter: the disc normal is zero".into());
+            return self.bad("emitter: the disc normal is zero".into());
         }
         if e.shape == Shape::Box && e.half.iter().any(|h| !(*h >= 0.0)) {
-            return bad("emitter: box half extents must not be negative".into());
+            return self.bad("emitter: box half extents must not be negative".into());
         }
         if let Some([r, period]) = e.orbit {
             if !(r >= 0.0 && period > 0.0) {
-                return bad("emitter: orbit = [radius >= 0, period > 0]".into());
+                return self.bad("emitter: orbit = [radius >= 0, period > 0]".into());
             }
         }
+        Ok(())
+    }
+
+    /// The new particles' attributes, gravity, wind and damping.
+    fn check_particle(&self) -> Result<()> {
         let p = &self.particle;
         if !(p.life.mean > 0.0) || p.life.variance < 0.0 || p.life.variance >= p.life.mean {
-            return bad("particle.life: mean must be positive and variance in [0, mean)".into());
+            return self
+                .bad("particle.life: mean must be positive and variance in [0, mean)".into());
         }
         if !(0.0..=180.0).contains(&p.spread) {
-            return bad("particle.spread must be in [0, 180] degrees".into());
+            return self.bad("particle.spread must be in [0, 180] degrees".into());
         }
         if p.size.mean < 0.0 || p.size.variance < 0.0 {
-            return bad("particle.size: mean and variance must not be negative".into());
+            return self.bad("particle.size: mean and variance must not be negative".into());
         }
         let nums: Vec<f32> = [
             p.offset.mean,
@@ -67,11 +105,16 @@ impl SystemSpec {
         .copied()
         .collect();
         if !finite(&nums) || !self.damping.is_finite() || self.damping < 0.0 || self.wind[3] < 0.0 {
-            return bad(
+            return self.bad(
                 "attributes, gravity, wind and damping must be finite (damping and drag >= 0)"
                     .into(),
             );
         }
+        Ok(())
+    }
+
+    /// Key times over life rise within [0, 1].
+    fn check_over_life(&self) -> Result<()> {
         let o = &self.over_life;
         for (what, ts) in [
             ("size", o.size.iter().map(|k| k[0]).collect::<Vec<_>>()),
@@ -79,27 +122,34 @@ impl SystemSpec {
             ("opacity", o.opacity.iter().map(|k| k[0]).collect()),
         ] {
             if ts.len() > MAX_KEYS {
-                return bad(format!("over_life.{what}: at most {MAX_KEYS} keys"));
+                return self.bad(format!("over_life.{what}: at most {MAX_KEYS} keys"));
             }
             if ts.windows(2).any(|w| !(w[0] < w[1])) || ts.iter().any(|t| !(0.0..=1.0).contains(t))
             {
-                return bad(format!(
+                return self.bad(format!(
                     "over_life.{what}: key times must rise within [0, 1]"
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Force fields and colliders: counts and values.
+    fn check_forces_and_colliders(&self) -> Result<()> {
         if self.force.len() > MAX_FORCES || self.collider.len() > MAX_COLLIDERS {
-            return bad(format!(
+            return self.bad(format!(
                 "at most {MAX_FORCES} forces and {MAX_COLLIDERS} colliders"
             ));
         }
         for f in &self.force {
             if !f.strength.is_finite() || !(f.eps > 0.0) || !(f.scale > 0.0) {
-                return bad(format!(
-                    "force {:?}: strength finite, eps and scale positive",
-                    f.kind
-                )
-                .to_lowercase());
+                return self.bad(
+                    format!(
+                        "force {:?}: strength finite, eps and scale positive",
+                        f.kind
+                    )
+                    .to_lowercase(),
+                );
             }
         }
         for c in &self.collider {
@@ -111,45 +161,49 @@ impl SystemSpec {
                 ColliderKind::Character => true,
             };
             if !ok {
-                return bad(format!("collider {:?}: a plane needs a normal, a sphere or capsule a radius, a box min < max", c.kind).to_lowercase());
+                return self.bad(format!("collider {:?}: a plane needs a normal, a sphere or capsule a radius, a box min < max", c.kind).to_lowercase());
             }
             if !(0.0..=1.0).contains(&c.restitution) || !(0.0..=1.0).contains(&c.friction) {
-                return bad("collider: restitution and friction must be in [0, 1]".into());
+                return self.bad("collider: restitution and friction must be in [0, 1]".into());
             }
         }
+        Ok(())
+    }
+
+    /// Death by distance and the events that spawn children.
+    fn check_death_and_events(&self) -> Result<()> {
         if let Some(d) = self.death.max_distance {
             if !(d > 0.0) {
-                return bad("death.max_distance must be positive".into());
+                return self.bad("death.max_distance must be positive".into());
             }
         }
         for (k, ev) in self.event.iter().enumerate() {
             let c = ev.count;
             if !(c.mean >= 0.0 && c.variance >= 0.0 && c.mean + c.variance <= MAX_CHILDREN) {
-                return bad(format!(
+                return self.bad(format!(
                     "event on {:?}: count mean and variance >= 0, mean + variance <= {MAX_CHILDREN}",
                     ev.on
                 )
                 .to_lowercase());
             }
             if !ev.inherit.is_finite() {
-                return bad("event: inherit must be finite".into());
+                return self.bad("event: inherit must be finite".into());
             }
             if self.event[..k].iter().any(|o| o.on == ev.on) {
-                return bad(format!("two events on {:?}", ev.on).to_lowercase());
+                return self.bad(format!("two events on {:?}", ev.on).to_lowercase());
             }
             if ev.on == EventKind::Collision && self.collider.is_empty() {
-                return bad("an event on collision needs a [[system.collider]]".into());
+                return self.bad("an event on collision needs a [[system.collider]]".into());
             }
             if ev.on == EventKind::Death && ev.keep_parent {
-                return bad("keep_parent applies to collision events only".into());
+                return self.bad("keep_parent applies to collision events only".into());
             }
         }
-        if e.burst > self.capacity {
-            return bad(format!(
-                "emitter: a burst of {} exceeds the capacity",
-                e.burst
-            ));
-        }
+        Ok(())
+    }
+
+    /// Boids' radii, speeds, weights and bounds.
+    fn check_boids(&self) -> Result<()> {
         if let Some(b) = &self.boids {
             let pos = [
                 b.radius,
@@ -168,17 +222,23 @@ impl SystemSpec {
             if !pos.iter().all(|x| *x > 0.0 && x.is_finite())
                 || !weights.iter().all(|x| *x >= 0.0 && x.is_finite())
             {
-                return bad("boids: radii, max_speed, max_steer and look_ahead positive; weights and min_speed >= 0".into());
+                return self.bad("boids: radii, max_speed, max_steer and look_ahead positive; weights and min_speed >= 0".into());
             }
             if b.separation_radius > b.radius || b.min_speed > b.max_speed {
-                return bad("boids: separation_radius <= radius and min_speed <= max_speed".into());
+                return self
+                    .bad("boids: separation_radius <= radius and min_speed <= max_speed".into());
             }
             crate::primitives::neighbors::GridSpec::covering(b.bounds[0], b.bounds[1], b.radius)
                 .map_err(|e| Error::Param(format!("system '{}': boids bounds: {e}", self.name)))?;
             if !(0..3).all(|k| b.bounds[0][k] < b.bounds[1][k]) {
-                return bad("boids: bounds = [min, max] with min < max".into());
+                return self.bad("boids: bounds = [min, max] with min < max".into());
             }
         }
+        Ok(())
+    }
+
+    /// The closed form only without state: no forces, colliders, drag, events, boids.
+    fn check_closed_form(&self) -> Result<()> {
         if self.integrator() == Integrator::Closed {
             let stateful = |what: &str| {
                 Err(Error::Unsupported(format!(
@@ -204,13 +264,6 @@ impl SystemSpec {
             if self.death.max_distance.is_some() || self.death.out_of_view {
                 return stateful("death by distance or view (a state change)");
             }
-        }
-        if !(self.point_px >= 1.0 && self.point_px <= 64.0) {
-            return bad("point_px must be in [1, 64]".into());
-        }
-        if self.draw() == SpriteMode::Points && matches!(self.sort, Some(s) if s != SortAlgo::None)
-        {
-            return bad("points are opaque and depth-tested: they take no sort".into());
         }
         Ok(())
     }
