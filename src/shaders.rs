@@ -20,7 +20,7 @@ fn kv(k: &str, v: impl ToString) -> (String, String) {
 }
 
 pub fn variants() -> Vec<Variant> {
-    use crate::primitives::{bounds, counting, morton, neighbors, scan, sort};
+    use crate::primitives::{bounds, counting, morton, scan, sort};
     let mut v = vec![
         with::<bounds::BoundsIo>("primitives/bounds.comp", &[]),
         with::<morton::MortonIo>("primitives/morton.comp", &[]),
@@ -39,28 +39,7 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::render::mesh::MeshIo>("render/mesh.vert", &[]),
         with::<crate::render::mesh::MeshIo>("render/mesh.frag", &[]),
     ];
-    use crate::psys::gpu::{DrawIo, PsysIo};
-    for f in ["psys/emit.comp", "psys/args.comp", "psys/keys.comp"] {
-        v.push(with::<PsysIo>(f, &[]));
-    }
-    for sub in [false, true] {
-        let d: Vec<(String, String)> = crate::psys::Passes::update_defines(sub)
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect();
-        v.push(with::<PsysIo>("psys/update.comp", &d));
-    }
-    let grid = crate::primitives::neighbors::NeighborSearch::defines_for(
-        Neighbors::Grid,
-        SortAlgo::Counting,
-    );
-    let grid: Vec<(String, String)> = grid.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
-    v.push(with::<crate::psys::gpu::BoidsIo>("psys/boids.comp", &grid));
-    for mode in 0..3 {
-        for f in ["psys/draw.vert", "psys/draw.frag"] {
-            v.push(with::<DrawIo>(f, &[kv("MODE", mode)]));
-        }
-    }
+    particle_systems(&mut v);
     use crate::character::skin::{SkinIo, SkinPass};
     for method in [crate::config::Skinning::Lbs, crate::config::Skinning::Dqs] {
         for sets in [1, 2] {
@@ -84,6 +63,62 @@ pub fn variants() -> Vec<Variant> {
             v.push(with::<scan::ScanIo>(file, &d));
         }
     }
+    searches_sph_and_control(&mut v);
+    v.push(with::<crate::emission::emit::EmitIo>(
+        "emission/emit.comp",
+        &[],
+    ));
+    use crate::emission::uv::UvIo;
+    for f in [
+        "emission/uv.vert",
+        "emission/uv.frag",
+        "emission/uv_flags.comp",
+        "emission/uv_compact.comp",
+    ] {
+        v.push(with::<UvIo>(f, &[]));
+    }
+    use crate::control::rays::RaysIo;
+    for f in ["control/rays_count.comp", "control/rays_emit.comp"] {
+        v.push(with::<RaysIo>(f, &[]));
+    }
+    for pass in 0..2 {
+        let d = [kv("PASS", pass)];
+        v.push(with::<RaysIo>("control/rays.vert", &d));
+        v.push(with::<RaysIo>("control/rays.frag", &d));
+    }
+    metaballs(&mut v);
+    v
+}
+
+/// Particle systems: emit, update (with and without subgroups), boids, the draws.
+fn particle_systems(v: &mut Vec<Variant>) {
+    use crate::psys::gpu::{DrawIo, PsysIo};
+    for f in ["psys/emit.comp", "psys/args.comp", "psys/keys.comp"] {
+        v.push(with::<PsysIo>(f, &[]));
+    }
+    for sub in [false, true] {
+        let d: Vec<(String, String)> = crate::psys::Passes::update_defines(sub)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        v.push(with::<PsysIo>("psys/update.comp", &d));
+    }
+    let grid = crate::primitives::neighbors::NeighborSearch::defines_for(
+        Neighbors::Grid,
+        SortAlgo::Counting,
+    );
+    let grid: Vec<(String, String)> = grid.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+    v.push(with::<crate::psys::gpu::BoidsIo>("psys/boids.comp", &grid));
+    for mode in 0..3 {
+        for f in ["psys/draw.vert", "psys/draw.frag"] {
+            v.push(with::<DrawIo>(f, &[kv("MODE", mode)]));
+        }
+    }
+}
+
+/// Per neighbour search and sort: the search passes, SPH, every pressure solver's passes and the control passes per adaptive mode.
+fn searches_sph_and_control(v: &mut Vec<Variant>) {
+    use crate::primitives::neighbors;
     for nb in [Neighbors::Grid, Neighbors::Hash, Neighbors::Morton] {
         for sort in [SortAlgo::Counting, SortAlgo::OddEven, SortAlgo::Bitonic] {
             let d: Vec<(String, String)> = neighbors::NeighborSearch::defines_for(nb, sort)
@@ -137,28 +172,10 @@ pub fn variants() -> Vec<Variant> {
             }
         }
     }
-    v.push(with::<crate::emission::emit::EmitIo>(
-        "emission/emit.comp",
-        &[],
-    ));
-    use crate::emission::uv::UvIo;
-    for f in [
-        "emission/uv.vert",
-        "emission/uv.frag",
-        "emission/uv_flags.comp",
-        "emission/uv_compact.comp",
-    ] {
-        v.push(with::<UvIo>(f, &[]));
-    }
-    use crate::control::rays::RaysIo;
-    for f in ["control/rays_count.comp", "control/rays_emit.comp"] {
-        v.push(with::<RaysIo>(f, &[]));
-    }
-    for pass in 0..2 {
-        let d = [kv("PASS", pass)];
-        v.push(with::<RaysIo>("control/rays.vert", &d));
-        v.push(with::<RaysIo>("control/rays.frag", &d));
-    }
+}
+
+/// The metaball renderer per list, material, density function and sort.
+fn metaballs(v: &mut Vec<Variant>) {
     use crate::render::metaball::renderer::MetaballIo;
     for list in [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer] {
         for material in [
@@ -187,5 +204,4 @@ pub fn variants() -> Vec<Variant> {
             }
         }
     }
-    v
 }

@@ -123,236 +123,256 @@ pub const NAMES: &[&str] = &[
     "table2", "table3", "table4", "table5", "table6", "table7", "table8",
 ];
 
+/// The definition of a thesis table by name (`NAMES`).
 pub fn def(name: &str) -> Option<TableDef> {
-    let three = vec![NONE, ABUFFER, SBUFFER];
-    let four = vec![NONE, ABUFFER, SBUFFER, SBUFFER_SORTED];
     Some(match name {
-        "table2" => {
-            let m = |label: &str, mat, depth: Option<u32>, v: [(&'static str, &'static str); 3]| {
-                RowDef {
-                    label: label.into(),
-                    change: Change {
-                        material: Some(mat),
-                        depth,
-                        ..Change::default()
-                    },
-                    thesis: v.iter().map(|&(a, b)| t(a, b)).collect(),
-                    memory: ("8.7", "5.8"),
-                }
-            };
-            TableDef {
-                name: "table2",
-                title: "Table 2: materials x metaball lists",
-                notes: vec![
-                    "Transparent is `--material glass`, partially transparent `--material tinted`, both at recursion depth 2: the thesis does not give table 2's depth, and its 65 fps (K2, S-buffer) lies between its depth-2 and depth-3 rows of tables 6 and 7.",
-                ],
-                cols: three,
-                rows: vec![
-                    m("Phong", Material::Phong, None, [("9", "11"), ("45", "87"), ("52", "98")]),
-                    m("transparent", Material::Glass, Some(2), [("4", "5"), ("33", "47"), ("40", "65")]),
-                    m("partially transparent", Material::Tinted, Some(2), [("4", "5"), ("33", "47"), ("40", "65")]),
-                    m("gold", Material::Gold, None, [("9", "11"), ("51", "87"), ("54", "98")]),
-                    m("copper", Material::Copper, None, [("9", "11"), ("50", "87"), ("54", "98")]),
-                    m("aluminium", Material::Aluminium, None, [("8", "11"), ("50", "87"), ("54", "98")]),
-                ],
-                rises: vec![],
-                sheet_cols: 3,
-            }
+        "table2" => table2(),
+        "table3" => table3(),
+        "table4" => table4(),
+        "table5" => table5(),
+        "table6" => table6(),
+        "table7" => table7(),
+        "table8" => table8(),
+        _ => return None,
+    })
+}
+
+fn table2() -> TableDef {
+    let three = vec![NONE, ABUFFER, SBUFFER];
+    let m = |label: &str, mat, depth: Option<u32>, v: [(&'static str, &'static str); 3]| RowDef {
+        label: label.into(),
+        change: Change {
+            material: Some(mat),
+            depth,
+            ..Change::default()
+        },
+        thesis: v.iter().map(|&(a, b)| t(a, b)).collect(),
+        memory: ("8.7", "5.8"),
+    };
+    TableDef {
+            name: "table2",
+            title: "Table 2: materials x metaball lists",
+            notes: vec![
+                "Transparent is `--material glass`, partially transparent `--material tinted`, both at recursion depth 2: the thesis does not give table 2's depth, and its 65 fps (K2, S-buffer) lies between its depth-2 and depth-3 rows of tables 6 and 7.",
+            ],
+            cols: three,
+            rows: vec![
+                m("Phong", Material::Phong, None, [("9", "11"), ("45", "87"), ("52", "98")]),
+                m("transparent", Material::Glass, Some(2), [("4", "5"), ("33", "47"), ("40", "65")]),
+                m("partially transparent", Material::Tinted, Some(2), [("4", "5"), ("33", "47"), ("40", "65")]),
+                m("gold", Material::Gold, None, [("9", "11"), ("51", "87"), ("54", "98")]),
+                m("copper", Material::Copper, None, [("9", "11"), ("50", "87"), ("54", "98")]),
+                m("aluminium", Material::Aluminium, None, [("8", "11"), ("50", "87"), ("54", "98")]),
+            ],
+            rises: vec![],
+            sheet_cols: 3,
         }
-        "table3" => {
-            let d = |label: &str, f, v| RowDef {
-                label: label.into(),
+}
+
+fn table3() -> TableDef {
+    let three = vec![NONE, ABUFFER, SBUFFER];
+    let d = |label: &str, f, v| RowDef {
+        label: label.into(),
+        change: Change {
+            density: Some(f),
+            ..Change::default()
+        },
+        thesis: k2(v),
+        memory: ("9", "6"),
+    };
+    TableDef {
+        name: "table3",
+        title: "Table 3: density functions x metaball lists (Phong)",
+        notes: vec![
+            "The thesis's \"original\" is Blinn's Gaussian truncated at R (`--density blinn`).",
+        ],
+        cols: three,
+        rows: vec![
+            d("original (Blinn)", DensityFn::Blinn, ["11", "83", "95"]),
+            d("Wyvill", DensityFn::Wyvill, ["11", "87", "98"]),
+            d("Nishimura", DensityFn::Nishimura, ["10", "87", "97"]),
+            d("Murakami", DensityFn::Murakami, ["10", "88", "98"]),
+        ],
+        rises: vec![],
+        sheet_cols: 4,
+    }
+}
+
+fn table4() -> TableDef {
+    let three = vec![NONE, ABUFFER, SBUFFER];
+    let mut rows = Vec::new();
+    let radii = [
+        (0.03, "103-105", ("6.2", "4.6")),
+        (0.04, "98-101", ("12.7", "7.9")),
+        (0.05, "91-93", ("15.2", "9.1")),
+    ];
+    for &(r, s, mem) in &radii {
+        for tt in [1.5f32, 0.9, 0.2] {
+            rows.push(RowDef {
+                label: format!("R={r} T={tt}"),
                 change: Change {
-                    density: Some(f),
+                    radius: Some(r),
+                    threshold: Some(tt),
                     ..Change::default()
                 },
-                thesis: k2(v),
-                memory: ("9", "6"),
-            };
-            TableDef {
-                name: "table3",
-                title: "Table 3: density functions x metaball lists (Phong)",
-                notes: vec!["The thesis's \"original\" is Blinn's Gaussian truncated at R (`--density blinn`)."],
-                cols: three,
-                rows: vec![
-                    d("original (Blinn)", DensityFn::Blinn, ["11", "83", "95"]),
-                    d("Wyvill", DensityFn::Wyvill, ["11", "87", "98"]),
-                    d("Nishimura", DensityFn::Nishimura, ["10", "87", "97"]),
-                    d("Murakami", DensityFn::Murakami, ["10", "88", "98"]),
-                ],
-                rises: vec![],
-                sheet_cols: 4,
-            }
+                thesis: vec![t("", "11-12"), t("", ""), t("", s)],
+                memory: mem,
+            });
         }
-        "table4" => {
-            let mut rows = Vec::new();
-            let radii = [
-                (0.03, "103-105", ("6.2", "4.6")),
-                (0.04, "98-101", ("12.7", "7.9")),
-                (0.05, "91-93", ("15.2", "9.1")),
-            ];
-            for &(r, s, mem) in &radii {
-                for tt in [1.5f32, 0.9, 0.2] {
-                    rows.push(RowDef {
-                        label: format!("R={r} T={tt}"),
-                        change: Change {
-                            radius: Some(r),
-                            threshold: Some(tt),
-                            ..Change::default()
-                        },
-                        thesis: vec![t("", "11-12"), t("", ""), t("", s)],
-                        memory: mem,
-                    });
-                }
-            }
-            let by_t = (0..3)
-                .map(|ti| (0..3).map(|ri| ri * 3 + ti).collect())
-                .collect();
-            TableDef {
-                name: "table4",
-                title: "Table 4: threshold T x radius R (Wyvill, Phong)",
-                notes: vec![
-                    "The thesis prints one range per radius over the three thresholds (K2, S-buffer), A-buffer memory per radius, and none at 11-12 fps throughout; it gives no A-buffer frame rates.",
-                    "R is in metres beside our fluid's rest spacing of 0.0272 m (Kelager's water); the thesis's spacing is not given, so at R = 0.03 and T = 1.5 the field may stay below T and show little or nothing.",
-                ],
-                cols: three,
-                rows,
-                rises: vec![("cost rises with the radius R", by_t)],
-                sheet_cols: 3,
-            }
+    }
+    let by_t = (0..3)
+        .map(|ti| (0..3).map(|ri| ri * 3 + ti).collect())
+        .collect();
+    TableDef {
+            name: "table4",
+            title: "Table 4: threshold T x radius R (Wyvill, Phong)",
+            notes: vec![
+                "The thesis prints one range per radius over the three thresholds (K2, S-buffer), A-buffer memory per radius, and none at 11-12 fps throughout; it gives no A-buffer frame rates.",
+                "R is in metres beside our fluid's rest spacing of 0.0272 m (Kelager's water); the thesis's spacing is not given, so at R = 0.03 and T = 1.5 the field may stay below T and show little or nothing.",
+            ],
+            cols: three,
+            rows,
+            rises: vec![("cost rises with the radius R", by_t)],
+            sheet_cols: 3,
         }
-        "table5" => {
-            let rows = [
-                (0u32, ["14", "97", "101"]),
-                (2, ["13", "93", "98"]),
-                (4, ["9", "86", "99"]),
-            ]
-            .iter()
-            .map(|&(i, v)| RowDef {
-                label: format!("I={i}"),
+}
+
+fn table5() -> TableDef {
+    let three = vec![NONE, ABUFFER, SBUFFER];
+    let rows = [
+        (0u32, ["14", "97", "101"]),
+        (2, ["13", "93", "98"]),
+        (4, ["9", "86", "99"]),
+    ]
+    .iter()
+    .map(|&(i, v)| RowDef {
+        label: format!("I={i}"),
+        change: Change {
+            refine: Some(i),
+            ..Change::default()
+        },
+        thesis: k2(v),
+        memory: ("", ""),
+    })
+    .collect();
+    TableDef {
+        name: "table5",
+        title: "Table 5: binary refinement steps I (Phong)",
+        notes: vec![],
+        cols: three,
+        rows,
+        rises: vec![(
+            "cost rises with the refinement steps I",
+            vec![vec![0, 1, 2]],
+        )],
+        sheet_cols: 0,
+    }
+}
+
+fn table6() -> TableDef {
+    let four = vec![NONE, ABUFFER, SBUFFER, SBUFFER_SORTED];
+    let mut rows = Vec::new();
+    let data = [
+        (
+            1u32,
+            [["12", "92", "100"], ["10", "89", "98"], ["8", "86", "97"]],
+        ),
+        (3, [["3", "39", "57"], ["2", "38", "53"], ["2", "37", "52"]]),
+    ];
+    for (depth, per_i) in data {
+        for (k, i) in [0u32, 2, 4].into_iter().enumerate() {
+            let mut th = k2(per_i[k]);
+            th.push(Thesis::default());
+            rows.push(RowDef {
+                label: format!("depth {depth} I={i}"),
                 change: Change {
+                    material: Some(Material::Glass),
+                    depth: Some(depth),
                     refine: Some(i),
                     ..Change::default()
                 },
-                thesis: k2(v),
+                thesis: th,
                 memory: ("", ""),
-            })
-            .collect();
-            TableDef {
-                name: "table5",
-                title: "Table 5: binary refinement steps I (Phong)",
-                notes: vec![],
-                cols: three,
-                rows,
-                rises: vec![(
-                    "cost rises with the refinement steps I",
-                    vec![vec![0, 1, 2]],
-                )],
-                sheet_cols: 0,
-            }
+            });
         }
-        "table6" => {
-            let mut rows = Vec::new();
-            let data = [
-                (
-                    1u32,
-                    [["12", "92", "100"], ["10", "89", "98"], ["8", "86", "97"]],
-                ),
-                (3, [["3", "39", "57"], ["2", "38", "53"], ["2", "37", "52"]]),
-            ];
-            for (depth, per_i) in data {
-                for (k, i) in [0u32, 2, 4].into_iter().enumerate() {
-                    let mut th = k2(per_i[k]);
-                    th.push(Thesis::default());
-                    rows.push(RowDef {
-                        label: format!("depth {depth} I={i}"),
-                        change: Change {
-                            material: Some(Material::Glass),
-                            depth: Some(depth),
-                            refine: Some(i),
-                            ..Change::default()
-                        },
-                        thesis: th,
-                        memory: ("", ""),
-                    });
-                }
-            }
-            TableDef {
-                name: "table6",
-                title: "Table 6: transparent (glass), recursion depth 1 and 3 x refinement I",
-                notes: vec!["sbuffer-sorted is ours (S-buffer ranges sorted by view depth, each sample summing the metaballs within R of its depth); the thesis has no such column."],
-                cols: four,
-                rows,
-                rises: vec![
-                    ("cost rises with the refinement steps I", vec![vec![0, 1, 2], vec![3, 4, 5]]),
-                    ("cost rises with the recursion depth", vec![vec![0, 3], vec![1, 4], vec![2, 5]]),
-                ],
-                sheet_cols: 0,
-            }
+    }
+    TableDef {
+            name: "table6",
+            title: "Table 6: transparent (glass), recursion depth 1 and 3 x refinement I",
+            notes: vec!["sbuffer-sorted is ours (S-buffer ranges sorted by view depth, each sample summing the metaballs within R of its depth); the thesis has no such column."],
+            cols: four,
+            rows,
+            rises: vec![
+                ("cost rises with the refinement steps I", vec![vec![0, 1, 2], vec![3, 4, 5]]),
+                ("cost rises with the recursion depth", vec![vec![0, 3], vec![1, 4], vec![2, 5]]),
+            ],
+            sheet_cols: 0,
         }
-        "table7" => {
-            let rows = [
-                (1u32, ["12", "92", "101"]),
-                (2, ["5", "58", "72"]),
-                (3, ["3", "46", "60"]),
-            ]
-            .iter()
-            .map(|&(d, v)| {
-                let mut th = k2(v);
-                th.push(Thesis::default());
-                RowDef {
-                    label: format!("depth {d}"),
-                    change: Change {
-                        material: Some(Material::Tinted),
-                        depth: Some(d),
-                        refine: Some(0),
-                        ..Change::default()
-                    },
-                    thesis: th,
-                    memory: ("", ""),
-                }
-            })
-            .collect();
-            TableDef {
-                name: "table7",
-                title: "Table 7: partially transparent (tinted), recursion depth 1-3, I = 0",
-                notes: vec!["sbuffer-sorted is ours, as in table 6."],
-                cols: four,
-                rows,
-                rises: vec![("cost rises with the recursion depth", vec![vec![0, 1, 2]])],
-                sheet_cols: 0,
-            }
+}
+
+fn table7() -> TableDef {
+    let four = vec![NONE, ABUFFER, SBUFFER, SBUFFER_SORTED];
+    let rows = [
+        (1u32, ["12", "92", "101"]),
+        (2, ["5", "58", "72"]),
+        (3, ["3", "46", "60"]),
+    ]
+    .iter()
+    .map(|&(d, v)| {
+        let mut th = k2(v);
+        th.push(Thesis::default());
+        RowDef {
+            label: format!("depth {d}"),
+            change: Change {
+                material: Some(Material::Tinted),
+                depth: Some(d),
+                refine: Some(0),
+                ..Change::default()
+            },
+            thesis: th,
+            memory: ("", ""),
         }
-        "table8" => {
-            let rows = [
-                (0.5, ["22", "200", "213"], ("3.6", "3.3")),
-                (1.0, ["11", "95", "104"], ("8.2", "5.6")),
-                (2.0, ["6", "40", "42"], ("12", "7.5")),
-            ]
-            .iter()
-            .map(|&(f, v, mem)| RowDef {
-                label: format!("{}x", f),
-                change: Change {
-                    particles: Some(f),
-                    ..Change::default()
-                },
-                thesis: k2(v),
-                memory: mem,
-            })
-            .collect();
-            TableDef {
-                name: "table8",
-                title: "Table 8: particle count (Phong)",
-                notes: vec!["The same walker and camera filled with half, the same and twice the particles (the thesis's 1024, 2048, 4096): the spacing shrinks, the metaball radius stays."],
-                cols: three,
-                rows,
-                rises: vec![(
-                    "cost rises with the particle count N",
-                    vec![vec![0, 1, 2]],
-                )],
-                sheet_cols: 0,
-            }
-        }
-        _ => return None,
     })
+    .collect();
+    TableDef {
+        name: "table7",
+        title: "Table 7: partially transparent (tinted), recursion depth 1-3, I = 0",
+        notes: vec!["sbuffer-sorted is ours, as in table 6."],
+        cols: four,
+        rows,
+        rises: vec![("cost rises with the recursion depth", vec![vec![0, 1, 2]])],
+        sheet_cols: 0,
+    }
+}
+
+fn table8() -> TableDef {
+    let three = vec![NONE, ABUFFER, SBUFFER];
+    let rows = [
+        (0.5, ["22", "200", "213"], ("3.6", "3.3")),
+        (1.0, ["11", "95", "104"], ("8.2", "5.6")),
+        (2.0, ["6", "40", "42"], ("12", "7.5")),
+    ]
+    .iter()
+    .map(|&(f, v, mem)| RowDef {
+        label: format!("{}x", f),
+        change: Change {
+            particles: Some(f),
+            ..Change::default()
+        },
+        thesis: k2(v),
+        memory: mem,
+    })
+    .collect();
+    TableDef {
+            name: "table8",
+            title: "Table 8: particle count (Phong)",
+            notes: vec!["The same walker and camera filled with half, the same and twice the particles (the thesis's 1024, 2048, 4096): the spacing shrinks, the metaball radius stays."],
+            cols: three,
+            rows,
+            rises: vec![(
+                "cost rises with the particle count N",
+                vec![vec![0, 1, 2]],
+            )],
+            sheet_cols: 0,
+        }
 }
