@@ -104,25 +104,7 @@ pub const STABILITY_SECONDS: f64 = 10.0;
 /// in the domain, the settled pool's mean density within 5% of rho_0. Checkpoints every
 /// tenth of the run.
 pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
-    let mut scene = Scene::built_in("dam-break").expect("built-in");
-    let solver_kind = opts
-        .switches
-        .fluid_args
-        .solver
-        .unwrap_or(scene.fluid.solver);
-    // Frames of 20 ms: they bound a CFL step.
-    scene.fluid.substeps = 50;
-    scene.fluid = super::solvers::own(&scene.fluid, solver_kind);
-    scene.fluid = opts.switches.fluid_args.apply(&scene.fluid)?;
-    if let Some(n) = opts.switches.common.particles {
-        scene = scene.with_particles(n);
-    }
-    if !(opts.seconds > 0.0 && opts.seconds.is_finite()) {
-        return Err(Error::Param(format!(
-            "--seconds must be positive, got {}",
-            opts.seconds
-        )));
-    }
+    let (scene, solver_kind) = stability_scene(opts)?;
     let (strategy, sort) = strategies(
         opts,
         &[
@@ -204,22 +186,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         mean_density_within_5_percent: density_ok,
         unstable: unstable.clone(),
     };
-    std::fs::create_dir_all(&opts.out).map_err(|e| Error::Io {
-        path: opts.out.display().to_string(),
-        source: e,
-    })?;
-    let path = opts.out.join("stability.json");
-    std::fs::write(
-        &path,
-        serde_json::to_string_pretty(&summary).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            source: e.into(),
-        })? + "\n",
-    )
-    .map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        source: e,
-    })?;
+    let path = write_stability(&opts.out, &summary)?;
     if let Some(m) = unstable {
         return Err(Error::Unstable(format!(
             "{} after {:.2} simulated s (wrote {}): {m}",
@@ -230,12 +197,81 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     }
     let last = last.ok_or_else(|| Error::Param("stability: no checkpoint".into()))?;
     check(&last)?;
+    let row = stability_row(&summary, &timings, &last, solver_kind, ratio)?;
+    if !density_ok {
+        eprintln!(
+            "stability: the mean density ends {:.1}% from rho0 (limit 5%)",
+            (ratio - 1.0) * 100.0
+        );
+    }
+    Ok(vec![row])
+}
+
+/// The dam break with the solver's own stable setup and the switches applied.
+fn stability_scene(opts: &BenchOptions) -> Result<(Scene, crate::config::Solver)> {
+    let mut scene = Scene::built_in("dam-break").expect("built-in");
+    let solver_kind = opts
+        .switches
+        .fluid_args
+        .solver
+        .unwrap_or(scene.fluid.solver);
+    // Frames of 20 ms: they bound a CFL step.
+    scene.fluid.substeps = 50;
+    scene.fluid = super::solvers::own(&scene.fluid, solver_kind);
+    scene.fluid = opts.switches.fluid_args.apply(&scene.fluid)?;
+    if let Some(n) = opts.switches.common.particles {
+        scene = scene.with_particles(n);
+    }
+    if !(opts.seconds > 0.0 && opts.seconds.is_finite()) {
+        return Err(Error::Param(format!(
+            "--seconds must be positive, got {}",
+            opts.seconds
+        )));
+    }
+    Ok((scene, solver_kind))
+}
+
+/// stability.json in `out`.
+fn write_stability(
+    out: &std::path::Path,
+    summary: &StabilitySummary,
+) -> Result<std::path::PathBuf> {
+    std::fs::create_dir_all(&out).map_err(|e| Error::Io {
+        path: out.display().to_string(),
+        source: e,
+    })?;
+    let path = out.join("stability.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(summary).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            source: e.into(),
+        })? + "\n",
+    )
+    .map_err(|e| Error::Io {
+        path: path.display().to_string(),
+        source: e,
+    })?;
+    Ok(path)
+}
+
+/// The bench row of a stable run: GPU ms per frame, simulated time and the checks.
+fn stability_row(
+    summary: &StabilitySummary,
+    timings: &[crate::gpu::FrameTiming],
+    last: &crate::sph::run::PhysicsStats,
+    solver_kind: crate::config::Solver,
+    ratio: f64,
+) -> Result<Row> {
+    let (simulated, steps) = (summary.simulated_seconds, summary.steps);
+    let density_ok = summary.mean_density_within_5_percent;
+    let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
     let row = Row {
         variant: format!(
             "stability {} {}/{}",
             solver_kind.as_str(),
-            strategy.as_str(),
-            sort.as_str()
+            summary.neighbors.as_str(),
+            summary.sort.as_str()
         ),
         n: last.particles as u64,
         // GPU ms per frame of 20 ms.
@@ -267,11 +303,5 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             ),
         ],
     };
-    if !density_ok {
-        eprintln!(
-            "stability: the mean density ends {:.1}% from rho0 (limit 5%)",
-            (ratio - 1.0) * 100.0
-        );
-    }
-    Ok(vec![row])
+    Ok(row)
 }

@@ -282,7 +282,42 @@ fn thesis_ratio(def: &TableDef, r: usize, k: usize) -> Option<f64> {
 }
 
 fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> {
-    let scene = env.scene_ref()?;
+    let csv = table_csv(env, def, m);
+    let mut md = format!("# {}\n\n", def.title);
+    md.push_str(&setup_text(env, m)?);
+    for n in &def.notes {
+        md.push_str(&format!("- {n}\n"));
+    }
+    md.push_str(&table_md(def, m));
+    md.push_str(&detail_md(def, m));
+    let png = speedup_plot(env, def, m)?;
+    md.push_str(&format!(
+        "\n![speed-up over none per row]({}.png)\n",
+        def.name
+    ));
+    let mut files = vec![png];
+    if def.sheet_cols > 0 {
+        let sheet = env.out.join(format!("{}-frames.png", def.name));
+        crate::bench::plot::sheet(
+            &sheet,
+            &format!("{}: S-buffer frame per row", def.name),
+            &m.labels,
+            &m.images,
+            (env.width, env.height),
+            def.sheet_cols,
+        )?;
+        md.push_str(&format!("\n![the rows' frames]({}-frames.png)\n", def.name));
+        files.push(sheet);
+    }
+    let p = env.out.join(format!("{}.csv", def.name));
+    write(&p, &csv)?;
+    files.push(p);
+    files.push(super::finish_md(env, def.name, md, &verdicts(def, m))?);
+    Ok(files)
+}
+
+/// One CSV row per row and list: timings, list statistics and the thesis's numbers.
+fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
     let none = col_index(def, "none").expect("none");
     let mut csv = String::from(
         "table,row,list,particles,width,height,reps,median_ms,min_ms,max_ms,fps,speedup_vs_none,\
@@ -324,7 +359,13 @@ fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> 
             ));
         }
     }
-    let mut md = format!("# {}\n\n", def.title);
+    csv
+}
+
+/// The paragraph on the setup: scene, camera, timing.
+fn setup_text(env: &Env, m: &Measured) -> Result<String> {
+    let scene = env.scene_ref()?;
+    let mut md = String::new();
     md.push_str(&format!(
         "Setup (the thesis's, section 5): {} fluid particles at rest spacing {:.4} m filling \
          the built-in walker ({:.2} m tall, posed at t = {} s of its walk, lattice points \
@@ -353,9 +394,13 @@ fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> 
         env.warmup,
         env.budget_s,
     ));
-    for n in &def.notes {
-        md.push_str(&format!("- {n}\n"));
-    }
+    Ok(md)
+}
+
+/// The main table: frame rates against the thesis's, list memory, fragments.
+fn table_md(def: &TableDef, m: &Measured) -> String {
+    let none = col_index(def, "none").expect("none");
+    let mut md = String::new();
     md.push_str("\n| row |");
     for c in &def.cols {
         md.push_str(&format!(
@@ -399,6 +444,12 @@ fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> 
             cells[s].fragments
         ));
     }
+    md
+}
+
+/// Timing detail per cell and the loop-budget warning.
+fn detail_md(def: &TableDef, m: &Measured) -> String {
+    let mut md = String::new();
     md.push_str("\nTiming detail: median ms [min, max] over the repetitions (reps).\n\n| row |");
     for c in &def.cols {
         md.push_str(&format!(" {} |", c.name));
@@ -424,6 +475,12 @@ fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> 
              understate the cost.\n"
         ));
     }
+    md
+}
+
+/// The speed-up bars over `none`, ours beside the thesis's.
+fn speedup_plot(env: &Env, def: &TableDef, m: &Measured) -> Result<PathBuf> {
+    let none = col_index(def, "none").expect("none");
     let png = env.out.join(format!("{}.png", def.name));
     let mut series: Vec<(String, Vec<Option<f64>>)> = Vec::new();
     for (k, c) in def.cols.iter().enumerate().filter(|(k, _)| *k != none) {
@@ -449,27 +506,5 @@ fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> 
         &series,
         "frame rate / none's",
     )?;
-    md.push_str(&format!(
-        "\n![speed-up over none per row]({}.png)\n",
-        def.name
-    ));
-    let mut files = vec![png];
-    if def.sheet_cols > 0 {
-        let sheet = env.out.join(format!("{}-frames.png", def.name));
-        crate::bench::plot::sheet(
-            &sheet,
-            &format!("{}: S-buffer frame per row", def.name),
-            &m.labels,
-            &m.images,
-            (env.width, env.height),
-            def.sheet_cols,
-        )?;
-        md.push_str(&format!("\n![the rows' frames]({}-frames.png)\n", def.name));
-        files.push(sheet);
-    }
-    let p = env.out.join(format!("{}.csv", def.name));
-    write(&p, &csv)?;
-    files.push(p);
-    files.push(super::finish_md(env, def.name, md, &verdicts(def, m))?);
-    Ok(files)
+    Ok(png)
 }
