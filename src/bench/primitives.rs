@@ -280,14 +280,58 @@ fn pair_mismatches(rows: &[Row]) -> (usize, Vec<String>) {
     (checked, bad)
 }
 
+/// What a bench's rows say against its targets, one line each.
 pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
-    // The row of variant v whose N is nearest n (within 25%: scenes round particle counts).
-    let ms = |v: &str, n: u64| {
+    match what {
+        "solvers" => super::solvers::notes(rows),
+        "particles" => super::particles::notes(rows),
+        "emission" => emission_notes(rows),
+        "sort" => sort_notes(rows),
+        "neighbors" => neighbors_notes(rows),
+        "sph" => sph_notes(rows),
+        "render" => render_notes(rows),
+        "scan" => scan_notes(rows),
+        _ => Vec::new(),
+    }
+}
+
+/// The median ms of variant v's row whose N is nearest n (within 25%: scenes round
+/// particle counts).
+fn ms_near(rows: &[Row], v: &str, n: u64) -> Option<f64> {
+    rows.iter()
+        .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
+        .min_by_key(|r| r.n.abs_diff(n))
+        .map(|r| r.main.median)
+}
+
+fn emission_notes(rows: &[Row]) -> Vec<String> {
+    let ms = |v: &str, n: u64| ms_near(rows, v, n);
+    let mut out = Vec::new();
+    if let (Some(h), Some(g)) = (ms("hash/bitonic", 64 << 10), ms("grid/counting", 64 << 10)) {
+        out.push(format!(
+            "the counting grid's frame is {:.2}x faster than hash + bitonic at 64K (target: 2x)",
+            h / g
+        ));
+    }
+    let per = |v: &str, n: u64| {
         rows.iter()
             .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
             .min_by_key(|r| r.n.abs_diff(n))
-            .map(|r| r.main.median)
+            .map(|r| r.main.median / r.n as f64)
     };
+    for v in ["grid/counting", "hash/bitonic"] {
+        if let (Some(a), Some(b)) = (per(v, 8 << 10), per(v, 64 << 10)) {
+            out.push(format!(
+                "{v}: cost per particle at 64K is {:.2}x that at 8K (target for the grid: within 1.5x)",
+                b / a
+            ));
+        }
+    }
+    out
+}
+
+fn sort_notes(rows: &[Row]) -> Vec<String> {
+    let ms = |v: &str, n: u64| ms_near(rows, v, n);
     let growth = |v: &str| match (ms(v, 8 << 10), ms(v, 64 << 10)) {
         (Some(a), Some(b)) => Some(format!(
             "{v}: {:.1}x from 8K to 64K (8x the elements)",
@@ -296,147 +340,137 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
         _ => None,
     };
     let mut out = Vec::new();
-    match what {
-        "solvers" => out.extend(super::solvers::notes(rows)),
-        "emission" => {
-            if let (Some(h), Some(g)) =
-                (ms("hash/bitonic", 64 << 10), ms("grid/counting", 64 << 10))
-            {
+    if let (Some(o), Some(c)) = (ms("odd-even", 64 << 10), ms("counting", 64 << 10)) {
+        out.push(format!(
+            "counting sort is {:.1}x faster than odd-even merge sort at 64K (target: 20x)",
+            o / c
+        ));
+    }
+    if let (Some(b), Some(c)) = (ms("bitonic", 64 << 10), ms("counting", 64 << 10)) {
+        out.push(format!(
+            "counting sort is {:.1}x faster than bitonic sort at 64K",
+            b / c
+        ));
+    }
+    out.extend(
+        ["counting", "odd-even", "bitonic"]
+            .iter()
+            .filter_map(|v| growth(v)),
+    );
+    if out.iter().any(|l| l.starts_with("counting:")) {
+        out.push("target: counting grows at most 10x from 8K to 64K".into());
+    }
+    out
+}
+
+fn neighbors_notes(rows: &[Row]) -> Vec<String> {
+    let ms = |v: &str, n: u64| ms_near(rows, v, n);
+    let mut out = Vec::new();
+    let (checked, bad) = pair_mismatches(rows);
+    if checked > 0 && bad.is_empty() {
+        out.push(format!(
+            "every strategy found exactly grid/counting's neighbour pairs ({checked} rows checked)"
+        ));
+    }
+    out.extend(bad);
+    for v in [
+        "grid/counting",
+        "hash/bitonic",
+        "hash/odd-even",
+        "morton/odd-even",
+    ] {
+        if let (Some(a), Some(b)) = (ms(v, 8 << 10), ms(v, 1 << 20)) {
+            out.push(format!(
+                "{v}: cost per particle at 1M is {:.2}x that at 8K",
+                (b / (1 << 20) as f64) / (a / (8 << 10) as f64)
+            ));
+        }
+    }
+    if let (Some(g), Some(m)) = (
+        ms("grid/counting", 64 << 10),
+        ms("morton/odd-even", 64 << 10),
+    ) {
+        out.push(format!(
+            "grid/counting is {:.1}x faster than morton/odd-even at 64K",
+            m / g
+        ));
+    }
+    out
+}
+
+fn sph_notes(rows: &[Row]) -> Vec<String> {
+    let ms = |v: &str, n: u64| ms_near(rows, v, n);
+    let mut out = Vec::new();
+    if let (Some(g), Some(m)) = (
+        ms("grid/counting", 64 << 10),
+        ms("morton/odd-even", 64 << 10),
+    ) {
+        out.push(format!(
+            "grid/counting steps {:.1}x faster than morton/odd-even near 64K (target: 5x)",
+            m / g
+        ));
+    }
+    for v in ["grid/counting", "hash/bitonic", "morton/odd-even"] {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.variant == v).collect();
+        if let (Some(a), Some(b)) = (mine.first(), mine.last()) {
+            if a.n != b.n {
+                let per = |r: &Row| r.main.median / r.n as f64;
                 out.push(format!(
-                    "the counting grid's frame is {:.2}x faster than hash + bitonic at 64K (target: 2x)",
-                    h / g
+                    "{v}: cost per particle at {} is {:.2}x that at {} (grid target: within 2x)",
+                    b.n,
+                    per(b) / per(a),
+                    a.n
                 ));
-            }
-            let per = |v: &str, n: u64| {
-                rows.iter()
-                    .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
-                    .min_by_key(|r| r.n.abs_diff(n))
-                    .map(|r| r.main.median / r.n as f64)
-            };
-            for v in ["grid/counting", "hash/bitonic"] {
-                if let (Some(a), Some(b)) = (per(v, 8 << 10), per(v, 64 << 10)) {
-                    out.push(format!(
-                        "{v}: cost per particle at 64K is {:.2}x that at 8K (target for the grid: within 1.5x)",
-                        b / a
-                    ));
-                }
             }
         }
-        "particles" => out.extend(super::particles::notes(rows)),
-        "sort" => {
-            if let (Some(o), Some(c)) = (ms("odd-even", 64 << 10), ms("counting", 64 << 10)) {
-                out.push(format!(
-                    "counting sort is {:.1}x faster than odd-even merge sort at 64K (target: 20x)",
-                    o / c
-                ));
-            }
-            if let (Some(b), Some(c)) = (ms("bitonic", 64 << 10), ms("counting", 64 << 10)) {
-                out.push(format!(
-                    "counting sort is {:.1}x faster than bitonic sort at 64K",
-                    b / c
-                ));
-            }
-            out.extend(
-                ["counting", "odd-even", "bitonic"]
+    }
+    out
+}
+
+fn render_notes(rows: &[Row]) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in rows {
+        let cut = r.extra.iter().find(|(k, _)| k == "pixels past loop budget");
+        if let Some((_, v)) = cut.filter(|(_, v)| v != "0") {
+            out.push(format!("WARNING: {}: {v} pixels' rays were cut short by llvmpipe's loop budget, so this row understates the cost", r.variant));
+        }
+    }
+    let get = |v: &str| rows.iter().find(|r| r.variant == v);
+    for sv in ["sbuffer", "sbuffer-sorted"] {
+        if let (Some(s), Some(none)) = (get(sv), get("none")) {
+            out.push(format!(
+                "{sv}: {:.1}x the frame rate of none (target: 12x)",
+                none.main.median / s.main.median
+            ));
+        }
+        if let (Some(s), Some(a)) = (get(sv), get("abuffer")) {
+            out.push(format!(
+                "{sv}: {:.2}x the frame rate of abuffer (target: > 1)",
+                a.main.median / s.main.median
+            ));
+            let mb = |r: &Row| {
+                r.extra
                     .iter()
-                    .filter_map(|v| growth(v)),
-            );
-            if out.iter().any(|l| l.starts_with("counting:")) {
-                out.push("target: counting grows at most 10x from 8K to 64K".into());
-            }
-        }
-        "neighbors" => {
-            let (checked, bad) = pair_mismatches(rows);
-            if checked > 0 && bad.is_empty() {
-                out.push(format!("every strategy found exactly grid/counting's neighbour pairs ({checked} rows checked)"));
-            }
-            out.extend(bad);
-            for v in [
-                "grid/counting",
-                "hash/bitonic",
-                "hash/odd-even",
-                "morton/odd-even",
-            ] {
-                if let (Some(a), Some(b)) = (ms(v, 8 << 10), ms(v, 1 << 20)) {
-                    out.push(format!(
-                        "{v}: cost per particle at 1M is {:.2}x that at 8K",
-                        (b / (1 << 20) as f64) / (a / (8 << 10) as f64)
-                    ));
-                }
-            }
-            if let (Some(g), Some(m)) = (
-                ms("grid/counting", 64 << 10),
-                ms("morton/odd-even", 64 << 10),
-            ) {
+                    .find(|(k, _)| k == "list MB")
+                    .and_then(|(_, v)| v.parse::<f64>().ok())
+            };
+            if let (Some(ms), Some(ma)) = (mb(s), mb(a)) {
                 out.push(format!(
-                    "grid/counting is {:.1}x faster than morton/odd-even at 64K",
-                    m / g
+                    "{sv} memory is {:.2}x abuffer's (target: at most 0.7x)",
+                    ms / ma
                 ));
             }
         }
-        "sph" => {
-            if let (Some(g), Some(m)) = (
-                ms("grid/counting", 64 << 10),
-                ms("morton/odd-even", 64 << 10),
-            ) {
-                out.push(format!(
-                    "grid/counting steps {:.1}x faster than morton/odd-even near 64K (target: 5x)",
-                    m / g
-                ));
-            }
-            for v in ["grid/counting", "hash/bitonic", "morton/odd-even"] {
-                let mine: Vec<&Row> = rows.iter().filter(|r| r.variant == v).collect();
-                if let (Some(a), Some(b)) = (mine.first(), mine.last()) {
-                    if a.n != b.n {
-                        let per = |r: &Row| r.main.median / r.n as f64;
-                        out.push(format!("{v}: cost per particle at {} is {:.2}x that at {} (grid target: within 2x)", b.n, per(b) / per(a), a.n));
-                    }
-                }
-            }
+    }
+    out
+}
+
+fn scan_notes(rows: &[Row]) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in rows.iter().filter(|r| r.n == 16 << 20) {
+        if let Some((_, v)) = r.extra.iter().find(|(k, _)| k == "scan/copy bandwidth") {
+            out.push(format!("scan of 16M u32 reaches {v} of the copy bandwidth measured in the same frames (target: 30% lavapipe, 50% GPU)"));
         }
-        "render" => {
-            for r in rows {
-                let cut = r.extra.iter().find(|(k, _)| k == "pixels past loop budget");
-                if let Some((_, v)) = cut.filter(|(_, v)| v != "0") {
-                    out.push(format!("WARNING: {}: {v} pixels' rays were cut short by llvmpipe's loop budget, so this row understates the cost", r.variant));
-                }
-            }
-            let get = |v: &str| rows.iter().find(|r| r.variant == v);
-            for sv in ["sbuffer", "sbuffer-sorted"] {
-                if let (Some(s), Some(none)) = (get(sv), get("none")) {
-                    out.push(format!(
-                        "{sv}: {:.1}x the frame rate of none (target: 12x)",
-                        none.main.median / s.main.median
-                    ));
-                }
-                if let (Some(s), Some(a)) = (get(sv), get("abuffer")) {
-                    out.push(format!(
-                        "{sv}: {:.2}x the frame rate of abuffer (target: > 1)",
-                        a.main.median / s.main.median
-                    ));
-                    let mb = |r: &Row| {
-                        r.extra
-                            .iter()
-                            .find(|(k, _)| k == "list MB")
-                            .and_then(|(_, v)| v.parse::<f64>().ok())
-                    };
-                    if let (Some(ms), Some(ma)) = (mb(s), mb(a)) {
-                        out.push(format!(
-                            "{sv} memory is {:.2}x abuffer's (target: at most 0.7x)",
-                            ms / ma
-                        ));
-                    }
-                }
-            }
-        }
-        "scan" => {
-            for r in rows.iter().filter(|r| r.n == 16 << 20) {
-                if let Some((_, v)) = r.extra.iter().find(|(k, _)| k == "scan/copy bandwidth") {
-                    out.push(format!("scan of 16M u32 reaches {v} of the copy bandwidth measured in the same frames (target: 30% lavapipe, 50% GPU)"));
-                }
-            }
-        }
-        _ => {}
     }
     out
 }

@@ -341,79 +341,24 @@ pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Findin
     ];
     let lists = [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer];
     let total = strategies.len() * sph_counts.len() + lists.len() * render_factors.len();
-    let mut steps = Steps::new("scaling", total as u64, env.switches.common.quiet);
-    let mut rows: Vec<(String, Row)> = Vec::new();
-    let mut stops: Vec<String> = Vec::new();
+    let mut sw = Sweep {
+        steps: Steps::new("scaling", total as u64, env.switches.common.quiet),
+        rows: Vec::new(),
+        stops: Vec::new(),
+        cap_ms,
+    };
     let mut opts = env.bench_options("sph", "scaling");
-    let limit = crate::sph::solver::MAX_PARTICLES
-        .min(ctx.info.device_local_bytes / 2 / crate::sph::solver::BYTES_PER_PARTICLE);
     for (strategy, sort) in strategies {
-        opts.switches.search.neighbors = Some(strategy);
-        opts.switches.sorting.sort = Some(sort);
-        let mut stopped = false;
-        for &n in &sph_counts {
-            steps.start(&format!("sph {} N = {n}", strategy.as_str()));
-            if !stopped && n as u64 > limit {
-                stops.push(format!(
-                    "sph {}: N = {n} exceeds what the device holds ({limit})",
-                    strategy.as_str()
-                ));
-                stopped = true;
-            }
-            if !stopped {
-                opts.counts = vec![n];
-                let r = crate::bench::sph::steps(ctx, &opts)?;
-                for row in r {
-                    if row.main.median > cap_ms {
-                        stops.push(format!(
-                            "sph {}: stopped after N = {} ({:.0} ms a step, over the {cap_ms:.0} ms cap)",
-                            row.variant, row.n, row.main.median
-                        ));
-                        stopped = true;
-                    }
-                    rows.push(("sph".into(), row));
-                }
-            }
-            steps.tick();
-        }
+        scaling_sph(ctx, &mut opts, (strategy, sort), &sph_counts, &mut sw)?;
     }
     // Render: the thesis scene's walker and camera filled with more and more particles.
-    let base_n = env.particles;
-    let seed = env.switches.common.seed;
     let cam = env.scene(ctx)?.camera;
     let ropts = env.bench_options("render", "scaling");
     for list in lists {
-        let mut stopped = false;
-        for &f in &render_factors {
-            let n = (base_n as f64 * f).round() as usize;
-            steps.start(&format!("render {} N = {n}", list.as_str()));
-            if !stopped {
-                match render_row(ctx, env, &ropts, list, n, seed, &cam) {
-                    Ok(row) => {
-                        if row.main.median > cap_ms {
-                            stops.push(format!(
-                                "render {}: stopped after N = {n} ({:.0} ms a frame, over the {cap_ms:.0} ms cap)",
-                                list.as_str(),
-                                row.main.median
-                            ));
-                            stopped = true;
-                        }
-                        rows.push(("render".into(), row));
-                    }
-                    Err(Error::Memory(m)) => {
-                        stops.push(format!(
-                            "render {}: N = {n} does not fit: {m}",
-                            list.as_str()
-                        ));
-                        stopped = true;
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-            steps.tick();
-        }
+        scaling_render(ctx, env, &ropts, list, &render_factors, &cam, &mut sw)?;
     }
-    steps.finish();
+    sw.steps.finish();
+    let (rows, stops) = (sw.rows, sw.stops);
     let sph: Vec<&Row> = rows
         .iter()
         .filter(|(k, _)| k == "sph")
@@ -424,32 +369,7 @@ pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Findin
         .filter(|(k, _)| k == "render")
         .map(|(_, r)| r)
         .collect();
-    let mut found = grid_findings(&sph, "grid/counting", "hash/bitonic", "SPH step");
-    let mut fails = Vec::new();
-    for list in lists {
-        let ms: Vec<f64> = render
-            .iter()
-            .filter(|r| r.variant == list.as_str())
-            .map(|r| r.main.median)
-            .collect();
-        if !ms.windows(2).all(|w| w[1] > w[0]) {
-            fails.push(list.as_str());
-        }
-    }
-    found.push(Finding::new(
-        "cost rises with the particle count N",
-        Verdict::of(fails.is_empty()),
-        format!(
-            "render frame time over N = {}..{} rises for {} of 3 lists{}",
-            render.first().map(|r| r.n).unwrap_or(0),
-            render.iter().map(|r| r.n).max().unwrap_or(0),
-            3 - fails.len(),
-            match fails.is_empty() {
-                true => String::new(),
-                false => format!(" (not for {})", fails.join(", ")),
-            }
-        ),
-    ));
+    let found = scaling_findings(&sph, &render, &lists);
     let p_csv = env.out.join("scaling.csv");
     write(&p_csv, &csv(&rows))?;
     let png = env.out.join("scaling.png");
@@ -486,6 +406,132 @@ pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Findin
     md.push_str("\n![cost per particle against N](scaling.png)\n");
     let p_md = super::finish_md(env, "scaling", md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
+}
+
+/// The scaling sweep's state: progress, rows by kind, why series stopped, the time cap.
+struct Sweep {
+    steps: Steps,
+    rows: Vec<(String, Row)>,
+    stops: Vec<String>,
+    cap_ms: f64,
+}
+
+/// One neighbour strategy's SPH series, stopped at the device's size or the time cap.
+fn scaling_sph(
+    ctx: &Context,
+    opts: &mut crate::bench::BenchOptions,
+    (strategy, sort): (Neighbors, SortAlgo),
+    sph_counts: &[u32],
+    sw: &mut Sweep,
+) -> Result<()> {
+    let limit = crate::sph::solver::MAX_PARTICLES
+        .min(ctx.info.device_local_bytes / 2 / crate::sph::solver::BYTES_PER_PARTICLE);
+    let cap = sw.cap_ms;
+    opts.switches.search.neighbors = Some(strategy);
+    opts.switches.sorting.sort = Some(sort);
+    let mut stopped = false;
+    for &n in sph_counts {
+        sw.steps
+            .start(&format!("sph {} N = {n}", strategy.as_str()));
+        if !stopped && n as u64 > limit {
+            sw.stops.push(format!(
+                "sph {}: N = {n} exceeds what the device holds ({limit})",
+                strategy.as_str()
+            ));
+            stopped = true;
+        }
+        if !stopped {
+            opts.counts = vec![n];
+            let r = crate::bench::sph::steps(ctx, &opts)?;
+            for row in r {
+                if row.main.median > sw.cap_ms {
+                    sw.stops.push(format!(
+                        "sph {}: stopped after N = {} ({:.0} ms a step, over the {cap:.0} ms cap)",
+                        row.variant, row.n, row.main.median
+                    ));
+                    stopped = true;
+                }
+                sw.rows.push(("sph".into(), row));
+            }
+        }
+        sw.steps.tick();
+    }
+    Ok(())
+}
+
+/// One list's render series: the thesis scene's walker and camera with more particles.
+fn scaling_render(
+    ctx: &Context,
+    env: &mut Env,
+    ropts: &crate::bench::BenchOptions,
+    list: ListKind,
+    render_factors: &[f64],
+    cam: &crate::render::Camera,
+    sw: &mut Sweep,
+) -> Result<()> {
+    let (base_n, seed) = (env.particles, env.switches.common.seed);
+    let cap = sw.cap_ms;
+    let mut stopped = false;
+    for &f in render_factors {
+        let n = (base_n as f64 * f).round() as usize;
+        sw.steps.start(&format!("render {} N = {n}", list.as_str()));
+        if !stopped {
+            match render_row(ctx, env, &ropts, list, n, seed, &cam) {
+                Ok(row) => {
+                    if row.main.median > sw.cap_ms {
+                        sw.stops.push(format!(
+                            "render {}: stopped after N = {n} ({:.0} ms a frame, over the {cap:.0} ms cap)",
+                            list.as_str(),
+                            row.main.median
+                        ));
+                        stopped = true;
+                    }
+                    sw.rows.push(("render".into(), row));
+                }
+                Err(Error::Memory(m)) => {
+                    sw.stops.push(format!(
+                        "render {}: N = {n} does not fit: {m}",
+                        list.as_str()
+                    ));
+                    stopped = true;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        sw.steps.tick();
+    }
+    Ok(())
+}
+
+/// Findings of the scaling sweep: grid against hash, and render cost rising with N.
+fn scaling_findings(sph: &[&Row], render: &[&Row], lists: &[ListKind]) -> Vec<Finding> {
+    let mut found = grid_findings(&sph, "grid/counting", "hash/bitonic", "SPH step");
+    let mut fails = Vec::new();
+    for list in lists {
+        let ms: Vec<f64> = render
+            .iter()
+            .filter(|r| r.variant == list.as_str())
+            .map(|r| r.main.median)
+            .collect();
+        if !ms.windows(2).all(|w| w[1] > w[0]) {
+            fails.push(list.as_str());
+        }
+    }
+    found.push(Finding::new(
+        "cost rises with the particle count N",
+        Verdict::of(fails.is_empty()),
+        format!(
+            "render frame time over N = {}..{} rises for {} of 3 lists{}",
+            render.first().map(|r| r.n).unwrap_or(0),
+            render.iter().map(|r| r.n).max().unwrap_or(0),
+            3 - fails.len(),
+            match fails.is_empty() {
+                true => String::new(),
+                false => format!(" (not for {})", fails.join(", ")),
+            }
+        ),
+    ));
+    found
 }
 
 /// One render configuration of the scaling sweep: the thesis walker with `n` particles.
