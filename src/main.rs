@@ -260,6 +260,7 @@ impl SphBench {
 
 impl BenchWhat {
     /// The benchmark's name and its switches (groups it does not take at their defaults).
+    /// Long because it is a table: one arm per benchmark naming the groups it takes.
     fn into_parts(
         self,
     ) -> (
@@ -427,65 +428,20 @@ fn real_main() -> Result<()> {
             out,
             save_every,
             switches,
-        } => {
-            let r = run(&RunOptions {
-                scene,
-                frames,
-                out: out.clone(),
-                save_every,
-                switches,
-            })?;
-            fluidform::run::print_summary(&r.summary);
-            // One closing line: where the files went.
-            let anim = r
-                .animation
-                .as_ref()
-                .map(|p| format!(", {}", p.display()))
-                .unwrap_or_default();
-            let exports = match r.exports.len() {
-                0 => String::new(),
-                k => format!(", {k} particle files and particles.csv"),
-            };
-            let control = match &r.summary.stats {
-                fluidform::run::RunStats::Sph(s) if s.control.is_some() => ", control.csv",
-                _ => "",
-            };
-            println!(
-                "wrote {} frame PNGs{anim}{exports}{control}, timings.csv and summary.json to {}",
-                r.pngs.len(),
-                out.display()
-            );
-            Ok(())
-        }
+        } => run_command(RunOptions {
+            scene,
+            frames,
+            out,
+            save_every,
+            switches,
+        }),
         Command::Bench {
             what,
             out,
             frames,
             warmup,
             budget_s,
-        } => {
-            let seconds = match &what {
-                BenchWhat::Stability { seconds, .. } => *seconds,
-                _ => fluidform::bench::sph::STABILITY_SECONDS,
-            };
-            let (what, switches, character, vertices, velocities) = what.into_parts();
-            let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
-                what: what.to_string(),
-                out: out.clone(),
-                frames,
-                warmup,
-                budget_s,
-                switches,
-                character,
-                vertices,
-                velocities,
-                counts: Vec::new(),
-                seconds,
-            })?;
-            print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
-            eprintln!("{} configurations; wrote {}", rows.len(), out.display());
-            Ok(())
-        }
+        } => bench_command(what, out, (frames, warmup, budget_s)),
         Command::Plot {
             csv,
             out,
@@ -539,6 +495,62 @@ fn real_main() -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `run`: play the scene, print its summary and where the files went.
+fn run_command(opts: RunOptions) -> Result<()> {
+    let out = opts.out.clone();
+    let r = run(&opts)?;
+    fluidform::run::print_summary(&r.summary);
+    // One closing line: where the files went.
+    let anim = r
+        .animation
+        .as_ref()
+        .map(|p| format!(", {}", p.display()))
+        .unwrap_or_default();
+    let exports = match r.exports.len() {
+        0 => String::new(),
+        k => format!(", {k} particle files and particles.csv"),
+    };
+    let control = match &r.summary.stats {
+        fluidform::run::RunStats::Sph(s) if s.control.is_some() => ", control.csv",
+        _ => "",
+    };
+    println!(
+        "wrote {} frame PNGs{anim}{exports}{control}, timings.csv and summary.json to {}",
+        r.pngs.len(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// `bench`: run one benchmark and print its table.
+fn bench_command(
+    what: BenchWhat,
+    out: PathBuf,
+    (frames, warmup, budget_s): (u64, u64, f64),
+) -> Result<()> {
+    let seconds = match &what {
+        BenchWhat::Stability { seconds, .. } => *seconds,
+        _ => fluidform::bench::sph::STABILITY_SECONDS,
+    };
+    let (what, switches, character, vertices, velocities) = what.into_parts();
+    let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
+        what: what.to_string(),
+        out: out.clone(),
+        frames,
+        warmup,
+        budget_s,
+        switches,
+        character,
+        vertices,
+        velocities,
+        counts: Vec::new(),
+        seconds,
+    })?;
+    print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
+    eprintln!("{} configurations; wrote {}", rows.len(), out.display());
+    Ok(())
 }
 
 fn devices(json: bool) -> Result<()> {
