@@ -123,37 +123,12 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
                 }
                 Err(e) => return Err(e),
             };
-            let t = &o.summary["stats"]["control"]["targets"][0];
-            let w = &t["fidelity"];
-            let m = |k: &str| (cell(&w[k]["mean"], 3), cell(&w[k]["min"], 3));
-            let p = &o.summary["pass_ms"];
-            let share = match (
-                p["sph/control"]["median"].as_f64(),
-                p["sph"]["median"].as_f64(),
-            ) {
-                (Some(c), Some(s)) if s > 0.0 => format!("{:.2}", c / s),
-                _ => "-".into(),
-            };
-            let t90 = cell(&t["time_to_90"], 2);
-            let n = o.rows.len();
-            let cells = [
-                label.to_string(),
-                preset.as_str().to_string(),
-                n.to_string(),
-                format!("{} ({})", m("fill").0, m("fill").1),
-                format!("{} ({})", m("iou").0, m("iou").1),
-                cell(&w["spray"]["mean"], 4),
-                cell(&w["surface_p95"]["mean"], 2),
-                m("density_in_shape").0,
-                cell(&w["speed_excess"]["mean"], 2),
-                t90,
-                share,
-            ];
+            let cells = row_cells(label, preset, &o);
             md.push_str(&format!("| {} |\n", cells.join(" | ")));
             // (The csv splits mean and min.)
             let mut c = cells.to_vec();
-            c[3] = format!("{},{}", m("fill").0, m("fill").1);
-            c[4] = format!("{},{}", m("iou").0, m("iou").1);
+            c[3] = c[3].replace(" (", ",").replace(')', "");
+            c[4] = c[4].replace(" (", ",").replace(')', "");
             csv.push_str(&format!("{}\n", c.join(",")));
             let series = |f: fn(&ControlRow) -> f64| {
                 o.rows.iter().map(|r| (r.time, f(r))).collect::<Vec<_>>()
@@ -197,6 +172,37 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let p_md = super::finish_md(env, "fidelity", md, &[])?;
     files.extend([p_csv, p_md, fill_png, iou_png]);
     Ok((files, Vec::new()))
+}
+
+/// A run's row: metrics (mean, min in brackets), time to 90% and the control's share.
+fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> [String; 11] {
+    let t = &o.summary["stats"]["control"]["targets"][0];
+    let w = &t["fidelity"];
+    let m = |k: &str| (cell(&w[k]["mean"], 3), cell(&w[k]["min"], 3));
+    let p = &o.summary["pass_ms"];
+    let share = match (
+        p["sph/control"]["median"].as_f64(),
+        p["sph"]["median"].as_f64(),
+    ) {
+        (Some(c), Some(s)) if s > 0.0 => format!("{:.2}", c / s),
+        _ => "-".into(),
+    };
+    let t90 = cell(&t["time_to_90"], 2);
+    let n = o.rows.len();
+    let cells = [
+        label.to_string(),
+        preset.as_str().to_string(),
+        n.to_string(),
+        format!("{} ({})", m("fill").0, m("fill").1),
+        format!("{} ({})", m("iou").0, m("iou").1),
+        cell(&w["spray"]["mean"], 4),
+        cell(&w["surface_p95"]["mean"], 2),
+        m("density_in_shape").0,
+        cell(&w["speed_excess"]["mean"], 2),
+        t90,
+        share,
+    ];
+    cells
 }
 
 /// `a` and `b` side by side in one PNG (a on the left), each at its own size.
