@@ -88,44 +88,8 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
         .map(|i| families[i as usize].timestamp_valid_bits)
         .unwrap_or(0);
 
-    let mut missing = Vec::new();
-    if props.api_version < vk::API_VERSION_1_3 {
-        missing.push(format!(
-            "Vulkan 1.3 (has {})",
-            version_string(props.api_version)
-        ));
-    }
-    if queue_family.is_none() {
-        missing.push("a graphics+compute queue with timestamps (timestampValidBits > 0)".into());
-    }
-    if props.limits.timestamp_period <= 0.0 {
-        missing.push("timestampPeriod > 0".into());
-    }
-    for (ok, name) in [
-        (
-            f.fragment_stores_and_atomics == vk::TRUE,
-            "fragmentStoresAndAtomics",
-        ),
-        (f13.synchronization2 == vk::TRUE, "synchronization2"),
-        (f13.dynamic_rendering == vk::TRUE, "dynamicRendering"),
-        (f12.host_query_reset == vk::TRUE, "hostQueryReset"),
-        (
-            has_ext(ash::khr::push_descriptor::NAME),
-            "VK_KHR_push_descriptor",
-        ),
-        (
-            props.limits.max_compute_work_group_invocations >= 256,
-            "maxComputeWorkGroupInvocations >= 256",
-        ),
-        (
-            props.limits.max_compute_shared_memory_size >= 16384,
-            "maxComputeSharedMemorySize >= 16384",
-        ),
-    ] {
-        if !ok {
-            missing.push(name.to_string());
-        }
-    }
+    let push_descriptor = has_ext(ash::khr::push_descriptor::NAME);
+    let missing = missing_features(&props, &f, &f12, &f13, push_descriptor, queue_family);
     let kind = match props.device_type {
         vk::PhysicalDeviceType::DISCRETE_GPU => ("discrete", 0),
         vk::PhysicalDeviceType::INTEGRATED_GPU => ("integrated", 1),
@@ -185,6 +149,53 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
         },
         type_rank: kind.1,
     }
+}
+
+/// What fluidform needs that the device lacks, by the names the spec gives them.
+fn missing_features(
+    props: &vk::PhysicalDeviceProperties,
+    f: &vk::PhysicalDeviceFeatures,
+    f12: &vk::PhysicalDeviceVulkan12Features,
+    f13: &vk::PhysicalDeviceVulkan13Features,
+    push_descriptor: bool,
+    queue_family: Option<u32>,
+) -> Vec<String> {
+    let mut missing = Vec::new();
+    if props.api_version < vk::API_VERSION_1_3 {
+        missing.push(format!(
+            "Vulkan 1.3 (has {})",
+            version_string(props.api_version)
+        ));
+    }
+    if queue_family.is_none() {
+        missing.push("a graphics+compute queue with timestamps (timestampValidBits > 0)".into());
+    }
+    if props.limits.timestamp_period <= 0.0 {
+        missing.push("timestampPeriod > 0".into());
+    }
+    for (ok, name) in [
+        (
+            f.fragment_stores_and_atomics == vk::TRUE,
+            "fragmentStoresAndAtomics",
+        ),
+        (f13.synchronization2 == vk::TRUE, "synchronization2"),
+        (f13.dynamic_rendering == vk::TRUE, "dynamicRendering"),
+        (f12.host_query_reset == vk::TRUE, "hostQueryReset"),
+        (push_descriptor, "VK_KHR_push_descriptor"),
+        (
+            props.limits.max_compute_work_group_invocations >= 256,
+            "maxComputeWorkGroupInvocations >= 256",
+        ),
+        (
+            props.limits.max_compute_shared_memory_size >= 16384,
+            "maxComputeSharedMemorySize >= 16384",
+        ),
+    ] {
+        if !ok {
+            missing.push(name.to_string());
+        }
+    }
+    missing
 }
 
 fn enumerate(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, DeviceInfo)>> {
