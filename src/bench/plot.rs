@@ -145,103 +145,123 @@ pub fn sweep_dated(
     let caption = format!("{title}: {device}, {date}");
     let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
-    if several_n {
-        let per = |r: &Row| r.main.median * 1e6 / r.n.max(1) as f64;
-        let (nmin, nmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
-            (a.min(r.n as f64), b.max(r.n as f64))
-        });
-        let (cmin, cmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
-            (a.min(per(r)), b.max(per(r)))
-        });
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&caption, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(72)
-            .build_cartesian_2d(
-                (nmin / 1.3..nmax * 1.3).log_scale(),
-                // Whole decades: a log axis labels only its decades' ticks.
-                (10f64.powf((cmin / 1.5).log10().floor())..10f64.powf((cmax * 1.5).log10().ceil()))
-                    .log_scale(),
-            )
-            .map_err(|e| err(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc("N (elements)")
-            .y_desc(format!("{scope} ns per element"))
-            .x_label_formatter(&|x| format!("{x:.0}"))
-            .y_label_formatter(&|y| {
-                if *y >= 10.0 {
-                    format!("{y:.0}")
-                } else {
-                    format!("{y:.2}")
-                }
-            })
-            .draw()
-            .map_err(|e| err(path, e))?;
-        for (i, v) in variants.iter().enumerate() {
-            let c = PALETTE[i % PALETTE.len()];
-            let pts: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.variant == *v)
-                .map(|r| (r.n as f64, per(r)))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-                .map_err(|e| err(path, e))?
-                .label(*v)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
-            chart
-                .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))
-                .map_err(|e| err(path, e))?;
-        }
-        legend(&mut chart, path, None)?;
-    } else {
-        let ymax = rows.iter().map(|r| r.main.max).fold(0.0f64, f64::max);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&caption, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(72)
-            .build_cartesian_2d(0.0..rows.len() as f64, 0.0..ymax * 1.15)
-            .map_err(|e| err(path, e))?;
-        let labels: Vec<String> = rows
-            .iter()
-            .map(|r| format!("{} (N {})", r.variant, r.n))
-            .collect();
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(rows.len() * 2 + 1)
-            .x_label_formatter(&|x| {
-                let i = (*x - 0.5).round();
-                if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
-                    labels[i as usize].clone()
-                } else {
-                    String::new()
-                }
-            })
-            .y_desc(format!("{scope} ms (median, bar: min..max)"))
-            .draw()
-            .map_err(|e| err(path, e))?;
-        for (i, r) in rows.iter().enumerate() {
-            let c = PALETTE[i % PALETTE.len()];
-            let x = i as f64;
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(x + 0.15, 0.0), (x + 0.85, r.main.median)],
-                    c.filled(),
-                )))
-                .map_err(|e| err(path, e))?;
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(x + 0.5, r.main.min), (x + 0.5, r.main.max)],
-                    BLACK.stroke_width(2),
-                )))
-                .map_err(|e| err(path, e))?;
-        }
+    match several_n {
+        true => per_element_lines(&root, path, &caption, scope, &variants, rows)?,
+        false => bars(&root, path, &caption, scope, rows)?,
     }
     root.present().map_err(|e| err(path, e))
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// Cost per element against N on log axes, one line per variant.
+fn per_element_lines(
+    root: &Area,
+    path: &Path,
+    caption: &str,
+    scope: &str,
+    variants: &[&str],
+    rows: &[Row],
+) -> Result<()> {
+    let per = |r: &Row| r.main.median * 1e6 / r.n.max(1) as f64;
+    let (nmin, nmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
+        (a.min(r.n as f64), b.max(r.n as f64))
+    });
+    let (cmin, cmax) = rows.iter().fold((f64::MAX, 0.0f64), |(a, b), r| {
+        (a.min(per(r)), b.max(per(r)))
+    });
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(
+            (nmin / 1.3..nmax * 1.3).log_scale(),
+            // Whole decades: a log axis labels only its decades' ticks.
+            (10f64.powf((cmin / 1.5).log10().floor())..10f64.powf((cmax * 1.5).log10().ceil()))
+                .log_scale(),
+        )
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("N (elements)")
+        .y_desc(format!("{scope} ns per element"))
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| {
+            if *y >= 10.0 {
+                format!("{y:.0}")
+            } else {
+                format!("{y:.2}")
+            }
+        })
+        .draw()
+        .map_err(|e| err(path, e))?;
+    for (i, v) in variants.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        let pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.variant == *v)
+            .map(|r| (r.n as f64, per(r)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+            .map_err(|e| err(path, e))?
+            .label(*v)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
+        chart
+            .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))
+            .map_err(|e| err(path, e))?;
+    }
+    legend(&mut chart, path, None)?;
+    Ok(())
+}
+
+/// One bar per row (a single N each): the median, a line from min to max.
+fn bars(root: &Area, path: &Path, caption: &str, scope: &str, rows: &[Row]) -> Result<()> {
+    let ymax = rows.iter().map(|r| r.main.max).fold(0.0f64, f64::max);
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..rows.len() as f64, 0.0..ymax * 1.15)
+        .map_err(|e| err(path, e))?;
+    let labels: Vec<String> = rows
+        .iter()
+        .map(|r| format!("{} (N {})", r.variant, r.n))
+        .collect();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(rows.len() * 2 + 1)
+        .x_label_formatter(&|x| {
+            let i = (*x - 0.5).round();
+            if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+                labels[i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .y_desc(format!("{scope} ms (median, bar: min..max)"))
+        .draw()
+        .map_err(|e| err(path, e))?;
+    for (i, r) in rows.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        let x = i as f64;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(x + 0.15, 0.0), (x + 0.85, r.main.median)],
+                c.filled(),
+            )))
+            .map_err(|e| err(path, e))?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x + 0.5, r.main.min), (x + 0.5, r.main.max)],
+                BLACK.stroke_width(2),
+            )))
+            .map_err(|e| err(path, e))?;
+    }
+    Ok(())
 }
 
 /// Coverage over scene time, one line per variant (`series`: name, (time, coverage)).
