@@ -2,6 +2,7 @@
 //! Each writes `<out>/<name>.csv`, `<name>.md` and `<name>.png` with the paper's numbers
 //! beside ours, and its verdicts on the papers' findings into `<name>.findings.json`, from
 //! which `findings.md` is rebuilt (so single experiments and `all` leave the same file).
+pub mod adaptive;
 pub mod fidelity;
 pub mod findings;
 pub mod measure;
@@ -337,7 +338,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>>
         let t = Instant::now();
         let (written, found) = match name {
             "fig9" => sweeps::fig9(ctx, env)?,
-            "adaptive" => sweeps::adaptive(env)?,
+            "adaptive" => adaptive::adaptive(env)?,
             "scaling" => sweeps::scaling(ctx, env)?,
             "fidelity" => fidelity::fidelity(env)?,
             table => {
