@@ -148,11 +148,43 @@ pub struct ControlForce {
     pub m: u32,
 }
 
+/// How many control particles the force holds (the rays' capacity or the mesh's
+/// vertices), after the settings' checks.
+fn control_count(
+    mesh: &Mesh,
+    settings: &ControlSettings,
+    rays: Option<(f32, u32)>,
+) -> Result<usize> {
+    settings.validate()?;
+    let m = match rays {
+        Some((_, capacity)) => capacity as usize,
+        None => mesh.vertices(),
+    };
+    if m == 0 {
+        return Err(Error::Param("no control particles".into()));
+    }
+    if rays.is_some() && (settings.velocity > 0.0 || settings.damping > 0.0) {
+        return Err(Error::Param(
+            "--control-velocity and --control-damping need control particles that persist between frames: --placement rays re-places them every frame (use vertices or random, or set both to 0)".into(),
+        ));
+    }
+    // The control grid: the grid strategy with the counting sort (cell counts).
+    let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
+    if !NeighborSearch::defines_for(kind, sort).contains(&("NB_CELL_COUNTS", "1".into())) {
+        return Err(Error::Param(
+            "the control grid expects cell counts from the counting sort".into(),
+        ));
+    }
+    Ok(m)
+}
+
 impl ControlForce {
     /// For control particles at rest positions `mesh.positions`, bound by its joints and
     /// weights (normals unused), skinned by `joints` joints, for fluid searched by
     /// `solver`, in the domain [lo, hi], skinned by `skinning`. With `rays` (spacing,
     /// capacity), `mesh` is the target's surface, skinned and re-placed by rays every frame.
+    /// Long because each pipeline and buffer is made under its own guard and moved into
+    /// the force at the end (a failure part-way frees what was made).
     pub fn new(
         ctx: &Context,
         solver: &crate::sph::SphSolver,
@@ -162,26 +194,8 @@ impl ControlForce {
         domain: ([f32; 3], [f32; 3]),
         (rays, skinning): (Option<(f32, u32)>, crate::kinds::Skinning),
     ) -> Result<Self> {
-        settings.validate()?;
-        let m = match rays {
-            Some((_, capacity)) => capacity as usize,
-            None => mesh.vertices(),
-        };
-        if m == 0 {
-            return Err(Error::Param("no control particles".into()));
-        }
-        if rays.is_some() && (settings.velocity > 0.0 || settings.damping > 0.0) {
-            return Err(Error::Param(
-                "--control-velocity and --control-damping need control particles that persist between frames: --placement rays re-places them every frame (use vertices or random, or set both to 0)".into(),
-            ));
-        }
-        // The control grid: the grid strategy with the counting sort (cell counts).
+        let m = control_count(mesh, &settings, rays)?;
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
-        if !NeighborSearch::defines_for(kind, sort).contains(&("NB_CELL_COUNTS", "1".into())) {
-            return Err(Error::Param(
-                "the control grid expects cell counts from the counting sort".into(),
-            ));
-        }
         // The passes walk the fluid's grid with the fluid search's defines.
         let eos = crate::sph::params::Eos::defines();
         let mut defines = solver.search.defines();

@@ -104,8 +104,47 @@ impl StateDump {
     }
 }
 
+/// The device draws the system's points and holds its buffers.
+fn check_fits(ctx: &Context, spec: &SystemSpec) -> Result<()> {
+    let max_px = ctx.info.max_point_size;
+    if spec.draw() == SpriteMode::Points && spec.point_px > max_px {
+        return Err(Error::Unsupported(format!(
+            "system '{}': points of {} px, but the device draws points of at most {max_px} px",
+            spec.name, spec.point_px
+        )));
+    }
+    let cap = spec.capacity as u64;
+    let bytes = cap * 16;
+    let need = bytes * 4
+        + cap * 4 * 5
+        + cap * spec.event.len() as u64 * EVENT_BYTES
+        + if spec.sort() == SortAlgo::Counting {
+            cap * 12 + DEPTH_CELLS as u64 * 12
+        } else {
+            0
+        }
+        // Boids: steering, and the grid's keys, permutation, sorted positions, one
+        // neighbour count and list entry per slot, counting-sort scratch and cell ranges.
+        + match &spec.boids {
+            Some(b) => cap * 68 + (b.grid().cells() + 1) * 12,
+            None => 0,
+        };
+    if need > ctx.info.device_local_bytes {
+        return Err(Error::Param(format!(
+            "system '{}': {} slots need {} MB, more than the device's {} MB",
+            spec.name,
+            cap,
+            need >> 20,
+            ctx.info.device_local_bytes >> 20
+        )));
+    }
+    Ok(())
+}
+
 impl ParticleSystem {
-    /// Slots for `spec` (validated by the caller), every slot free.
+    /// Slots for `spec` (validated by the caller), every slot free. Long because every
+    /// buffer is made under its own guard and moved into the system at the end (a failure
+    /// part-way frees what was made), then given its first contents.
     pub fn new(
         ctx: &Context,
         passes: &Passes,
@@ -114,38 +153,9 @@ impl ParticleSystem {
         seed: u64,
     ) -> Result<Self> {
         spec.validate()?;
-        let max_px = ctx.info.max_point_size;
-        if spec.draw() == SpriteMode::Points && spec.point_px > max_px {
-            return Err(Error::Unsupported(format!(
-                "system '{}': points of {} px, but the device draws points of at most {max_px} px",
-                spec.name, spec.point_px
-            )));
-        }
+        check_fits(ctx, spec)?;
         let cap = spec.capacity as u64;
         let bytes = cap * 16;
-        let need = bytes * 4
-            + cap * 4 * 5
-            + cap * spec.event.len() as u64 * EVENT_BYTES
-            + if spec.sort() == SortAlgo::Counting {
-                cap * 12 + DEPTH_CELLS as u64 * 12
-            } else {
-                0
-            }
-            // Boids: steering, and the grid's keys, permutation, sorted positions, one
-            // neighbour count and list entry per slot, counting-sort scratch and cell ranges.
-            + match &spec.boids {
-                Some(b) => cap * 68 + (b.grid().cells() + 1) * 12,
-                None => 0,
-            };
-        if need > ctx.info.device_local_bytes {
-            return Err(Error::Param(format!(
-                "system '{}': {} slots need {} MB, more than the device's {} MB",
-                spec.name,
-                cap,
-                need >> 20,
-                ctx.info.device_local_bytes >> 20
-            )));
-        }
         let name = &spec.name;
         let buf = |what: &str, size: u64| {
             ctx.storage_buffer(&format!("{name} {what}"), size)

@@ -144,43 +144,7 @@ impl SceneTargets {
             false => Timeline::new(&scene.name, &scene.timeline, &names)?,
         };
         if let Some(desc) = &scene.emission {
-            // validate() made sure of the [character]: the first character.
-            let (kind, settings, size) = desc.resolve(sw)?;
-            let ch = &out.live[0].character.ch;
-            let caps = capsules::of(ch);
-            if desc.collide && caps.len() + out.colliders.len() > MAX_COLLIDERS {
-                return Err(crate::Error::Param(format!(
-                    "scene {}: {} character capsules and {} colliders exceed {MAX_COLLIDERS}",
-                    scene.name,
-                    caps.len(),
-                    out.colliders.len()
-                )));
-            }
-            let layout = match kind {
-                crate::config::EmitterKind::Vertices => None,
-                _ if !ch.mesh.uvs.is_empty() => Some(UvLayout::from_mesh(&ch.mesh, size)?),
-                _ => Some(UvLayout::from_capsules(&ch.mesh, &caps, size)?),
-            };
-            let metrics = Guard::new(ctx, EmissionMetrics::new(ctx, slots)?);
-            let source = EmitSource::new(ctx, kind, layout, &ch.mesh.positions, size)?;
-            let emitter = Emitter::new(
-                ctx,
-                st,
-                initial,
-                source,
-                (settings, desc.recycle),
-                sw.common.seed,
-            )?;
-            if desc.collide {
-                out.capsules = caps;
-            }
-            out.emission = Some(SceneEmission {
-                emitter,
-                metrics: metrics.take(),
-                character: 0,
-                slots: desc.slots,
-                primed: false,
-            });
+            out.add_emission(ctx, scene, desc, sw, st, initial, slots)?;
         }
         let mut t = out.take();
         t.fading = vec![None; t.controlled.len()];
@@ -190,6 +154,59 @@ impl SceneTargets {
                 .set_attached(t.timeline.attached(k), t.timeline.strength(k));
         }
         Ok(t)
+    }
+
+    /// The scene's emitter on its first character, with the character's capsules as
+    /// colliders when it collides.
+    #[allow(clippy::too_many_arguments)]
+    fn add_emission(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        desc: &crate::scene::emission::EmissionDesc,
+        sw: &Switches,
+        st: &mut SphState,
+        initial: &[[f32; 4]],
+        slots: usize,
+    ) -> Result<()> {
+        // validate() made sure of the [character]: the first character.
+        let (kind, settings, size) = desc.resolve(sw)?;
+        let ch = &self.live[0].character.ch;
+        let caps = capsules::of(ch);
+        if desc.collide && caps.len() + self.colliders.len() > MAX_COLLIDERS {
+            return Err(crate::Error::Param(format!(
+                "scene {}: {} character capsules and {} colliders exceed {MAX_COLLIDERS}",
+                scene.name,
+                caps.len(),
+                self.colliders.len()
+            )));
+        }
+        let layout = match kind {
+            crate::config::EmitterKind::Vertices => None,
+            _ if !ch.mesh.uvs.is_empty() => Some(UvLayout::from_mesh(&ch.mesh, size)?),
+            _ => Some(UvLayout::from_capsules(&ch.mesh, &caps, size)?),
+        };
+        let metrics = Guard::new(ctx, EmissionMetrics::new(ctx, slots)?);
+        let source = EmitSource::new(ctx, kind, layout, &ch.mesh.positions, size)?;
+        let emitter = Emitter::new(
+            ctx,
+            st,
+            initial,
+            source,
+            (settings, desc.recycle),
+            sw.common.seed,
+        )?;
+        if desc.collide {
+            self.capsules = caps;
+        }
+        self.emission = Some(SceneEmission {
+            emitter,
+            metrics: metrics.take(),
+            character: 0,
+            slots: desc.slots,
+            primed: false,
+        });
+        Ok(())
     }
 
     pub fn is_empty(&self) -> bool {
