@@ -82,42 +82,60 @@ pub struct Context {
     pub(crate) trackers: Mutex<super::track::Trackers>,
 }
 
+/// The debug-utils instance functions (when the loader has them) and, with validation,
+/// a messenger counting the layer's errors and warnings into `messages`. On failure the
+/// instance is destroyed.
+fn create_messenger(
+    entry: &ash::Entry,
+    instance: &ash::Instance,
+    has_debug: bool,
+    validation: bool,
+    messages: &MessageCounts,
+) -> Result<(
+    Option<ash::ext::debug_utils::Instance>,
+    vk::DebugUtilsMessengerEXT,
+)> {
+    let mut debug_instance = None;
+    let mut messenger = vk::DebugUtilsMessengerEXT::null();
+    if has_debug {
+        let di = ash::ext::debug_utils::Instance::new(entry, instance);
+        if validation {
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(messages as *const MessageCounts as *mut c_void);
+            match unsafe { di.create_debug_utils_messenger(&info, None) } {
+                Ok(m) => messenger = m,
+                Err(e) => {
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(Error::Vulkan {
+                        context: "create debug messenger".into(),
+                        result: e,
+                    });
+                }
+            }
+        }
+        debug_instance = Some(di);
+    }
+    Ok((debug_instance, messenger))
+}
+
 impl Context {
     /// Open the chosen device headless: the one constructor for tests, benches and the CLI.
     pub fn new(opts: &ContextOptions) -> Result<Self> {
         let entry = load_entry()?;
         let (instance, has_debug) = create_instance(&entry, opts.validation)?;
         let messages = Box::<MessageCounts>::default();
-        let mut debug_instance = None;
-        let mut messenger = vk::DebugUtilsMessengerEXT::null();
-        if has_debug {
-            let di = ash::ext::debug_utils::Instance::new(&entry, &instance);
-            if opts.validation {
-                let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-                    .message_severity(
-                        vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                            | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-                    )
-                    .message_type(
-                        vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                            | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                            | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-                    )
-                    .pfn_user_callback(Some(debug_callback))
-                    .user_data(&*messages as *const MessageCounts as *mut c_void);
-                match unsafe { di.create_debug_utils_messenger(&info, None) } {
-                    Ok(m) => messenger = m,
-                    Err(e) => {
-                        unsafe { instance.destroy_instance(None) };
-                        return Err(Error::Vulkan {
-                            context: "create debug messenger".into(),
-                            result: e,
-                        });
-                    }
-                }
-            }
-            debug_instance = Some(di);
-        }
+        let (debug_instance, messenger) =
+            create_messenger(&entry, &instance, has_debug, opts.validation, &messages)?;
         let cleanup = |di: &Option<ash::ext::debug_utils::Instance>| unsafe {
             if let Some(di) = di {
                 if messenger != vk::DebugUtilsMessengerEXT::null() {
