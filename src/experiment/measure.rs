@@ -203,6 +203,15 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
             }
         ),
     ));
+    found.push(memory_finding(m, s, a));
+    for (claim, groups) in &def.rises {
+        found.push(rise_finding(def, m, claim, groups));
+    }
+    found
+}
+
+/// The S-buffer's lists smaller than the A-buffer's in every row.
+fn memory_finding(m: &Measured, s: usize, a: usize) -> Finding {
     let mem_bad: Vec<&String> = m
         .cells
         .iter()
@@ -215,7 +224,7 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
         .iter()
         .map(|c| c[s].list_bytes as f64 / c[a].list_bytes.max(1) as f64)
         .collect();
-    found.push(Finding::new(
+    Finding::new(
         findings::MEMORY,
         Verdict::of(mem_bad.is_empty()),
         format!(
@@ -235,44 +244,50 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
                 ),
             }
         ),
-    ));
-    for (claim, groups) in &def.rises {
-        let mut fails = Vec::new();
-        let mut checks = 0;
-        for g in groups {
-            for (k, col) in def.cols.iter().enumerate() {
-                let ms: Vec<f64> = g.iter().map(|&r| m.cells[r][k].stat.median).collect();
-                checks += 1;
-                if !ms.windows(2).all(|w| w[1] > w[0]) {
-                    fails.push(format!(
-                        "{} over {}: {} ms",
-                        col.name,
-                        g.iter()
-                            .map(|&r| m.labels[r].as_str())
-                            .collect::<Vec<_>>()
-                            .join(" < "),
-                        ms.iter()
-                            .map(|v| format!("{v:.2}"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ));
-                }
+    )
+}
+
+/// A claim that times rise along groups of rows, checked for every list.
+fn rise_finding(
+    def: &TableDef,
+    m: &Measured,
+    claim: &'static str,
+    groups: &[Vec<usize>],
+) -> Finding {
+    let mut fails = Vec::new();
+    let mut checks = 0;
+    for g in groups {
+        for (k, col) in def.cols.iter().enumerate() {
+            let ms: Vec<f64> = g.iter().map(|&r| m.cells[r][k].stat.median).collect();
+            checks += 1;
+            if !ms.windows(2).all(|w| w[1] > w[0]) {
+                fails.push(format!(
+                    "{} over {}: {} ms",
+                    col.name,
+                    g.iter()
+                        .map(|&r| m.labels[r].as_str())
+                        .collect::<Vec<_>>()
+                        .join(" < "),
+                    ms.iter()
+                        .map(|v| format!("{v:.2}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
             }
         }
-        found.push(Finding::new(
-            claim,
-            Verdict::of(fails.is_empty()),
-            format!(
-                "{} of {checks} series (per list) rise{}",
-                checks - fails.len(),
-                match fails.is_empty() {
-                    true => String::new(),
-                    false => format!("; not in: {}", fails.join("; ")),
-                }
-            ),
-        ));
     }
-    found
+    Finding::new(
+        claim,
+        Verdict::of(fails.is_empty()),
+        format!(
+            "{} of {checks} series (per list) rise{}",
+            checks - fails.len(),
+            match fails.is_empty() {
+                true => String::new(),
+                false => format!("; not in: {}", fails.join("; ")),
+            }
+        ),
+    )
 }
 
 fn thesis_ratio(def: &TableDef, r: usize, k: usize) -> Option<f64> {
