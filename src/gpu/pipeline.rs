@@ -393,6 +393,80 @@ pub struct GraphicsPipeline<I: Interface> {
     interface: PhantomData<I>,
 }
 
+/// The graphics pipeline of `d`'s states (dynamic rendering, dynamic viewport and
+/// scissor) over the two shader modules.
+fn fixed_function(
+    ctx: &Context,
+    d: &GraphicsDesc,
+    (vsm, fsm): (vk::ShaderModule, vk::ShaderModule),
+    layout: vk::PipelineLayout,
+) -> std::result::Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)> {
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(vsm)
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(fsm)
+            .name(c"main"),
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+    let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(d.topology);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let ms = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(d.depth_format.is_some())
+        .depth_write_enable(d.depth_format.is_some() && !d.blend)
+        .depth_compare_op(vk::CompareOp::LESS);
+    let attachment = [vk::PipelineColorBlendAttachmentState::default()
+        .blend_enable(d.blend)
+        .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+        .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+        .color_blend_op(vk::BlendOp::ADD)
+        .src_alpha_blend_factor(vk::BlendFactor::ONE)
+        .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+        .alpha_blend_op(vk::BlendOp::ADD)
+        .color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend =
+        vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() {
+            &attachment[..]
+        } else {
+            &[]
+        });
+    let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
+    let formats: Vec<vk::Format> = d.color_format.into_iter().collect();
+    let mut rendering =
+        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
+    if let Some(df) = d.depth_format {
+        rendering = rendering.depth_attachment_format(df);
+    }
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&ia)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&ms)
+        .depth_stencil_state(&depth)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering);
+    unsafe {
+        ctx.device
+            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+    }
+}
+
 impl<I: Interface> GraphicsPipeline<I> {
     pub fn new(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
         let defines = all_defines::<I>(d.defines);
@@ -412,71 +486,7 @@ impl<I: Interface> GraphicsPipeline<I> {
                 return Err(e);
             }
         };
-        let stages = [
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vsm)
-                .name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(fsm)
-                .name(c"main"),
-        ];
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(d.topology);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
-            .line_width(1.0);
-        let ms = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(d.depth_format.is_some())
-            .depth_write_enable(d.depth_format.is_some() && !d.blend)
-            .depth_compare_op(vk::CompareOp::LESS);
-        let attachment = [vk::PipelineColorBlendAttachmentState::default()
-            .blend_enable(d.blend)
-            .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
-            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ONE)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-            .alpha_blend_op(vk::BlendOp::ADD)
-            .color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(
-            if d.color_format.is_some() {
-                &attachment[..]
-            } else {
-                &[]
-            },
-        );
-        let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
-        let formats: Vec<vk::Format> = d.color_format.into_iter().collect();
-        let mut rendering =
-            vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
-        if let Some(df) = d.depth_format {
-            rendering = rendering.depth_attachment_format(df);
-        }
-        let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&ia)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&ms)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .push_next(&mut rendering);
-        let r = unsafe {
-            ctx.device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
+        let r = fixed_function(ctx, d, (vsm, fsm), layout);
         unsafe {
             ctx.device.destroy_shader_module(vsm, None);
             ctx.device.destroy_shader_module(fsm, None);
