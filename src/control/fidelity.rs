@@ -80,6 +80,49 @@ impl Grid {
     }
 }
 
+/// Voxel counts over a box: the target's interior, how much of it the fluid fills, and
+/// fluid occupancy outside it.
+struct Voxels {
+    interior: usize,
+    filled: usize,
+    occupied_out: usize,
+    interior_set: HashSet<IVec3>,
+}
+
+/// `dims` voxels of side `s` from `lo`, each classified by its centre.
+fn voxels(
+    inside: &InsideTest,
+    occupied: impl Fn(Vec3) -> bool,
+    lo: Vec3,
+    dims: IVec3,
+    s: f32,
+) -> Voxels {
+    let (mut interior, mut filled, mut occupied_out) = (0usize, 0usize, 0usize);
+    let mut interior_set = HashSet::new();
+    for z in 0..dims.z {
+        for y in 0..dims.y {
+            for x in 0..dims.x {
+                let v = IVec3::new(x, y, z);
+                let c = lo + (v.as_vec3() + 0.5) * s;
+                let occupied = occupied(c);
+                if inside.inside(c) {
+                    interior += 1;
+                    interior_set.insert(v);
+                    filled += occupied as usize;
+                } else {
+                    occupied_out += occupied as usize;
+                }
+            }
+        }
+    }
+    Voxels {
+        interior,
+        filled,
+        occupied_out,
+        interior_set,
+    }
+}
+
 /// The metrics of `frame` against the target `mesh` (positions, triangles), whose skin
 /// points move at most `skin_speed` m/s.
 pub fn measure(frame: &Frame, mesh: (&[Vec3], &[u32]), skin_speed: f32, f: &Fluid) -> Fidelity {
@@ -103,24 +146,13 @@ pub fn measure(frame: &Frame, mesh: (&[Vec3], &[u32]), skin_speed: f32, f: &Flui
     let in_box = |p: Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
     // Voxels of the grown box: target interior and fluid occupancy.
     let dims = ((hi - lo) / s).ceil().as_ivec3().max(IVec3::ONE);
-    let (mut interior, mut filled, mut occupied_out) = (0usize, 0usize, 0usize);
-    let mut interior_set = HashSet::new();
-    for z in 0..dims.z {
-        for y in 0..dims.y {
-            for x in 0..dims.x {
-                let v = IVec3::new(x, y, z);
-                let c = lo + (v.as_vec3() + 0.5) * s;
-                let occupied = density(c) >= 0.5 * f.rest_density;
-                if inside.inside(c) {
-                    interior += 1;
-                    interior_set.insert(v);
-                    filled += occupied as usize;
-                } else {
-                    occupied_out += occupied as usize;
-                }
-            }
-        }
-    }
+    let occupied = |c: Vec3| density(c) >= 0.5 * f.rest_density;
+    let Voxels {
+        interior,
+        filled,
+        occupied_out,
+        interior_set,
+    } = voxels(&inside, occupied, lo, dims, s);
     let fill = filled as f64 / interior.max(1) as f64;
     let iou = filled as f64 / (interior + occupied_out).max(1) as f64;
     // Neighbour counts within h over every live particle (spray counts all the fluid).

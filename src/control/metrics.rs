@@ -264,8 +264,14 @@ impl ControlMetrics {
                 .fold(0.0, f64::max),
             control_particles: live,
         };
+        self.stats.control_particles = live;
+        self.push(row, time);
+        Ok(self.rows.last().unwrap())
+    }
+
+    /// Keep `row` (at scene time `time`) and fold it into the run's statistics.
+    fn push(&mut self, row: ControlRow, time: f64) {
         let st = &mut self.stats;
-        st.control_particles = live;
         if st.time_to_90.is_none() && row.fill >= 0.9 {
             st.time_to_90 = Some(time);
         }
@@ -283,7 +289,6 @@ impl ControlMetrics {
         st.mean_coverage = (st.mean_coverage * k + row.coverage) / (k + 1.0);
         st.last = Some(row.clone());
         self.rows.push(row);
-        Ok(self.rows.last().unwrap())
     }
 
     /// The fidelity window: the frames from scene time `from` on (None: the second half

@@ -59,36 +59,44 @@ pub struct UvSurface {
     parts: Vec<([f32; 4], u32, u32)>,
 }
 
+/// A mesh with triangles and an atlas of `size` texels the device can address.
+fn check_size(ctx: &Context, layout: &UvLayout, size: [u32; 2]) -> Result<()> {
+    if layout.triangles() == 0 {
+        return Err(Error::Param("the emitting mesh has no triangles".into()));
+    }
+    if size.iter().any(|s| *s == 0 || *s > MAX_SIZE) {
+        return Err(Error::Param(format!(
+            "UV texture size {}x{} is outside 1..={MAX_SIZE}",
+            size[0], size[1]
+        )));
+    }
+    let texels = size[0] as u64 * size[1] as u64;
+    if texels * 16 > ctx.max_storage_range() {
+        return Err(Error::Memory(format!(
+            "a {}x{} UV atlas needs {} bytes per position buffer, more than one storage binding may address on this device ({}); lower --uv-size",
+            size[0],
+            size[1],
+            texels * 16,
+            ctx.max_storage_range()
+        )));
+    }
+    Ok(())
+}
+
 impl UvSurface {
     pub const NAME: &'static str = "uv";
 
     /// For `layout` at `size` texels (the layout packed for that size); lists the texels
-    /// covered with the mesh at `rest` (its vertex positions).
+    /// covered with the mesh at `rest` (its vertex positions). Long because each pass and
+    /// buffer is made under its own guard, then the texels are listed once.
     pub fn new(
         ctx: &Context,
         layout: &UvLayout,
         rest: &[glam::Vec3],
         size: [u32; 2],
     ) -> Result<Self> {
-        if layout.triangles() == 0 {
-            return Err(Error::Param("the emitting mesh has no triangles".into()));
-        }
-        if size.iter().any(|s| *s == 0 || *s > MAX_SIZE) {
-            return Err(Error::Param(format!(
-                "UV texture size {}x{} is outside 1..={MAX_SIZE}",
-                size[0], size[1]
-            )));
-        }
+        check_size(ctx, layout, size)?;
         let texels = size[0] as u64 * size[1] as u64;
-        if texels * 16 > ctx.max_storage_range() {
-            return Err(Error::Memory(format!(
-                "a {}x{} UV atlas needs {} bytes per position buffer, more than one storage binding may address on this device ({}); lower --uv-size",
-                size[0],
-                size[1],
-                texels * 16,
-                ctx.max_storage_range()
-            )));
-        }
         let desc = GraphicsDesc {
             name: "uv",
             vertex: "emission/uv.vert",

@@ -105,6 +105,7 @@ fn v3(a: [f32; 3], w: f32) -> V4 {
 
 impl SystemParams {
     /// The block for `spec` (validated); `type_id` tells systems apart in the shaders.
+    /// Long because it fills the GPU block field by field, in the block's order.
     pub fn new(spec: &SystemSpec, type_id: u32) -> Self {
         let mut p = Self::zeroed();
         let e = &spec.emitter;

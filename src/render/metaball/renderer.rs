@@ -177,7 +177,8 @@ impl MetaballRenderer {
     }
 
     /// `record` without the readbacks: the picture in `b.pixels` (and `b.scene_depth` with
-    /// the opaque layer), for layers drawn over it before `record_readback`.
+    /// the opaque layer), for layers drawn over it before `record_readback`. Long because
+    /// it is the frame's pass order with the barriers its draws need between passes.
     #[allow(clippy::too_many_arguments)]
     pub fn record_picture(
         &self,
