@@ -125,34 +125,19 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut frames = FrameLoop::new(ctx, crate::session::SLOTS)?;
     let mut checkpoints: Vec<Checkpoint> = Vec::new();
     let started = std::time::Instant::now();
-    let result = (|| -> Result<()> {
-        let mut played = 0;
-        for chunk in 1..=10u64 {
-            let count = total * chunk / 10 - played;
-            if count == 0 {
-                continue;
-            }
-            let mut work = super::solvers::Play {
-                solver: &solver,
-                st: &mut st,
-                stepper: &mut stepper,
-            };
-            frames.run(ctx, count, &mut work)?;
-            played += count;
-            let d = st.read(ctx)?;
-            let s = Checkpoint {
-                step: stepper.steps_taken,
-                time: stepper.sim_time,
-                physics: physics_stats(&d, &scene.domain, scene.fluid.rest_density),
-            };
-            eprintln!(
-                "stability {}: {:.2} s, step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",
-                solver_kind.as_str(), s.time, s.step, s.physics.density_mean_over_rest, s.physics.max_speed, s.physics.nan, s.physics.outside_domain
-            );
-            checkpoints.push(s);
-        }
-        Ok(())
-    })();
+    let mut work = super::solvers::Play {
+        solver: &solver,
+        st: &mut st,
+        stepper: &mut stepper,
+    };
+    let result = play_checkpoints(
+        ctx,
+        &mut frames,
+        &mut work,
+        (&scene, solver_kind),
+        total,
+        &mut checkpoints,
+    );
     let timings = std::mem::take(&mut frames.profiler.results);
     frames.destroy(ctx);
     let (steps, simulated) = (stepper.steps_taken, stepper.sim_time);
@@ -205,6 +190,38 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         );
     }
     Ok(vec![row])
+}
+
+/// Play `total` frames in ten chunks, a physics checkpoint after each.
+fn play_checkpoints(
+    ctx: &Context,
+    frames: &mut FrameLoop,
+    work: &mut super::solvers::Play,
+    (scene, solver_kind): (&Scene, crate::config::Solver),
+    total: u64,
+    checkpoints: &mut Vec<Checkpoint>,
+) -> Result<()> {
+    let mut played = 0;
+    for chunk in 1..=10u64 {
+        let count = total * chunk / 10 - played;
+        if count == 0 {
+            continue;
+        }
+        frames.run(ctx, count, work)?;
+        played += count;
+        let d = work.st.read(ctx)?;
+        let s = Checkpoint {
+            step: work.stepper.steps_taken,
+            time: work.stepper.sim_time,
+            physics: physics_stats(&d, &scene.domain, scene.fluid.rest_density),
+        };
+        eprintln!(
+            "stability {}: {:.2} s, step {:>6}: mean density / rho0 {:.4}, max speed {:.3} m/s, NaN {}, outside {}",
+            solver_kind.as_str(), s.time, s.step, s.physics.density_mean_over_rest, s.physics.max_speed, s.physics.nan, s.physics.outside_domain
+        );
+        checkpoints.push(s);
+    }
+    Ok(())
 }
 
 /// The dam break with the solver's own stable setup and the switches applied.

@@ -153,25 +153,40 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
         }
     }
     steps.finish();
+    let plots = plots(env, &mut md, (&fill_series, &iou_series), &pictures)?;
+    let p_csv = env.out.join("fidelity.csv");
+    write(&p_csv, &csv)?;
+    let p_md = super::finish_md(env, "fidelity", md, &[])?;
+    files.push(p_csv);
+    files.push(p_md);
+    files.extend(plots);
+    Ok((files, Vec::new()))
+}
+
+type Series = Vec<(String, Vec<(f64, f64)>)>;
+
+/// Fill and IoU over time for every run, and the frames side by side, into `md`.
+fn plots(
+    env: &Env,
+    md: &mut String,
+    (fill_series, iou_series): (&Series, &Series),
+    pictures: &[(&str, PathBuf)],
+) -> Result<[PathBuf; 2]> {
     let device = env.meta.device.clone();
     let fill_png = env.out.join("fidelity.png");
     let y = "fill (interior voxels with rho >= 0.5 rho0)";
-    crate::bench::plot::over_time(&fill_png, "fill over time", y, &device, &fill_series)?;
+    crate::bench::plot::over_time(&fill_png, "fill over time", y, &device, fill_series)?;
     let iou_png = env.out.join("fidelity-iou.png");
     let y = "IoU near the target";
-    crate::bench::plot::over_time(&iou_png, "IoU over time", y, &device, &iou_series)?;
+    crate::bench::plot::over_time(&iou_png, "IoU over time", y, &device, iou_series)?;
     md.push_str("\n![fill over time](fidelity.png)\n\n![IoU over time](fidelity-iou.png)\n\n");
-    for (label, png) in &pictures {
+    for (label, png) in pictures {
         let f = png.file_name().and_then(|f| f.to_str()).unwrap_or_default();
         md.push_str(&format!(
             "{label}, the last saved frame: thesis (left), fidelity (right)\n\n![{label}]({f})\n\n"
         ));
     }
-    let p_csv = env.out.join("fidelity.csv");
-    write(&p_csv, &csv)?;
-    let p_md = super::finish_md(env, "fidelity", md, &[])?;
-    files.extend([p_csv, p_md, fill_png, iou_png]);
-    Ok((files, Vec::new()))
+    Ok([fill_png, iou_png])
 }
 
 /// A run's row: metrics (mean, min in brackets), time to 90% and the control's share.
