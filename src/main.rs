@@ -402,6 +402,7 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// One arm per command (long because it is the dispatch table; each arm is short).
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command.unwrap_or(Command::Run {

@@ -290,12 +290,8 @@ fn csv_field(v: &str) -> String {
     }
 }
 
-fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {
-    let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
-        path: p.display().to_string(),
-        source: e,
-    };
-    std::fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
+/// The rows as CSV and as a markdown table, a column for every pass and extra any row has.
+fn sweep_tables(rows: &[Row]) -> (String, String) {
     let mut pass_names: Vec<String> = Vec::new();
     let mut extra_names: Vec<String> = Vec::new();
     for r in rows {
@@ -359,6 +355,16 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String
         csv.push('\n');
         md.push('\n');
     }
+    (csv, md)
+}
+
+fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {
+    let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
+        path: p.display().to_string(),
+        source: e,
+    };
+    std::fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
+    let (csv, mut md) = sweep_tables(rows);
     md.push_str(&format!(
         "\nDevice: {} ({}, {}, Vulkan {}). Up to {} timed repetitions after {} warm-up, fewer \
          (reps column) where they would exceed {} s; medians of GPU timestamp scopes.\n\n",

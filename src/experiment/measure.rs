@@ -59,6 +59,8 @@ pub fn table(ctx: &Context, env: &mut Env, def: TableDef) -> Result<(Vec<PathBuf
     Ok((files, found))
 }
 
+/// Every cell of the table, row by row. Long because a row's centre buffer must be freed
+/// on every path, so its lists' measurements sit inside one closure.
 fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     let seed = env.switches.common.seed;
     let base_centers = env.scene(ctx)?.centers.clone();

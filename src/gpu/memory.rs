@@ -238,6 +238,8 @@ impl Context {
         self.readback(src, 0, src.size as usize / std::mem::size_of::<T>())
     }
 
+    /// Long because each step (image, memory, bind, view) releases what the earlier steps
+    /// made when it fails.
     pub fn create_image(
         &self,
         name: &str,
