@@ -76,6 +76,93 @@ fn poly6(r2: f64, h: f64) -> f64 {
     315.0 / (64.0 * std::f64::consts::PI * h.powi(9)) * (h * h - r2).powi(3)
 }
 
+/// The adaptive control pressure's factor at control density ratio `fr` (thesis eq. 7).
+fn adaptive_factor(settings: &ControlSettings, fr: f64) -> f64 {
+    match settings.adaptive {
+        Adaptive::Off => 1.0,
+        Adaptive::On if fr < settings.low as f64 => settings.up as f64,
+        Adaptive::On if fr > settings.high as f64 => settings.down as f64,
+        Adaptive::On => 1.0,
+        Adaptive::Smooth => {
+            settings.up as f64
+                * ((settings.high as f64 - fr) / (settings.high - settings.low) as f64)
+                    .clamp(0.0, 1.0)
+        }
+    }
+}
+
+type Field = std::collections::HashMap<glam::I64Vec3, (glam::DVec3, f64)>;
+
+/// The reference attraction and damping field at the control grid's cells (and the
+/// grid's cells per side), from control particles at `positions` with densities `rho_ref`.
+fn reference_field(
+    positions: &[glam::Vec3],
+    rho_ref: &[f64],
+    settings: &ControlSettings,
+    rho0: f64,
+) -> (Field, i64) {
+    // The attraction and damping field at the control grid's cell centres (cell h_c from
+    // the domain's corner), each cell's control particles taken together at their
+    // deficit-weighted centre; the control particles stand still (their first pose is
+    // also their previous one), so the character's velocity there is zero.
+    let (reach, hc) = (settings.reach as f64, settings.radius as f64);
+    let dims = ((0.5 / hc).ceil()) as i64;
+    let key = |p: glam::DVec3| {
+        (p / hc)
+            .floor()
+            .as_i64vec3()
+            .clamp(glam::I64Vec3::ZERO, glam::I64Vec3::splat(dims - 1))
+    };
+    let mut cells: std::collections::HashMap<glam::I64Vec3, (glam::DVec3, f64, glam::DVec3, f64)> =
+        Default::default();
+    for (c, &rho_j) in positions.iter().zip(rho_ref) {
+        let e = cells.entry(key(c.as_dvec3())).or_default();
+        let d = (1.0 - rho_j / rho0).max(0.0);
+        e.0 += d * c.as_dvec3();
+        e.1 += d;
+        e.2 += c.as_dvec3();
+        e.3 += 1.0;
+    }
+    let k = (reach / hc).ceil() as i64;
+    let mut field = std::collections::HashMap::new();
+    for z in 0..dims {
+        for y in 0..dims {
+            for x in 0..dims {
+                let c0 = glam::I64Vec3::new(x, y, z);
+                let xc = (c0.as_dvec3() + 0.5) * hc;
+                let (mut pull, mut wall, mut wdef) = (glam::DVec3::ZERO, 0.0, 0.0);
+                for (cell, (dc, dsum, csum, n)) in &cells {
+                    if (*cell - c0).abs().max_element() > k {
+                        continue;
+                    }
+                    if *dsum > 0.0 {
+                        let d = *dc / *dsum - xc;
+                        let r = d.length();
+                        if r < reach {
+                            let w = (1.0 - r / reach).powi(2) * dsum;
+                            if r > 1e-6 {
+                                pull += w / r * d;
+                            }
+                            wdef += w;
+                        }
+                    }
+                    let r = (*csum / *n - xc).length();
+                    if r < reach {
+                        wall += (1.0 - r / reach).powi(2) * n;
+                    }
+                }
+                let a = if wdef > 0.0 {
+                    settings.attraction as f64 * pull / f64::max(wdef, 1.0)
+                } else {
+                    glam::DVec3::ZERO
+                };
+                field.insert(c0, (a, if wall > 0.0 { 1.0 } else { 0.0 }));
+            }
+        }
+    }
+    (field, dims)
+}
+
 /// Largest relative error of the control acceleration, and of the control densities.
 fn compare(settings: ControlSettings) -> (f64, f64) {
     let ctx = common::ctx();
@@ -157,79 +244,8 @@ fn compare(settings: ControlSettings) -> (f64, f64) {
         want.iter().any(|&r| r > 0.3 * rho0),
         "some control particles sit in fluid"
     );
-    let factor = |r: f64| {
-        let fr = r / rho0;
-        match settings.adaptive {
-            Adaptive::Off => 1.0,
-            Adaptive::On if fr < settings.low as f64 => settings.up as f64,
-            Adaptive::On if fr > settings.high as f64 => settings.down as f64,
-            Adaptive::On => 1.0,
-            Adaptive::Smooth => {
-                settings.up as f64
-                    * ((settings.high as f64 - fr) / (settings.high - settings.low) as f64)
-                        .clamp(0.0, 1.0)
-            }
-        }
-    };
-    // The attraction and damping field at the control grid's cell centres (cell h_c from
-    // the domain's corner), each cell's control particles taken together at their
-    // deficit-weighted centre; the control particles stand still (their first pose is
-    // also their previous one), so the character's velocity there is zero.
-    let reach = settings.reach as f64;
-    let dims = ((0.5 / hc).ceil()) as i64;
-    let key = |p: glam::DVec3| {
-        (p / hc)
-            .floor()
-            .as_i64vec3()
-            .clamp(glam::I64Vec3::ZERO, glam::I64Vec3::splat(dims - 1))
-    };
-    let mut cells: std::collections::HashMap<glam::I64Vec3, (glam::DVec3, f64, glam::DVec3, f64)> =
-        Default::default();
-    for (c, &rho_j) in mesh.positions.iter().zip(&rho_ref) {
-        let e = cells.entry(key(c.as_dvec3())).or_default();
-        let d = (1.0 - rho_j / rho0).max(0.0);
-        e.0 += d * c.as_dvec3();
-        e.1 += d;
-        e.2 += c.as_dvec3();
-        e.3 += 1.0;
-    }
-    let k = (reach / hc).ceil() as i64;
-    let mut field = std::collections::HashMap::new();
-    for z in 0..dims {
-        for y in 0..dims {
-            for x in 0..dims {
-                let c0 = glam::I64Vec3::new(x, y, z);
-                let xc = (c0.as_dvec3() + 0.5) * hc;
-                let (mut pull, mut wall, mut wdef) = (glam::DVec3::ZERO, 0.0, 0.0);
-                for (cell, (dc, dsum, csum, n)) in &cells {
-                    if (*cell - c0).abs().max_element() > k {
-                        continue;
-                    }
-                    if *dsum > 0.0 {
-                        let d = *dc / *dsum - xc;
-                        let r = d.length();
-                        if r < reach {
-                            let w = (1.0 - r / reach).powi(2) * dsum;
-                            if r > 1e-6 {
-                                pull += w / r * d;
-                            }
-                            wdef += w;
-                        }
-                    }
-                    let r = (*csum / *n - xc).length();
-                    if r < reach {
-                        wall += (1.0 - r / reach).powi(2) * n;
-                    }
-                }
-                let a = if wdef > 0.0 {
-                    settings.attraction as f64 * pull / f64::max(wdef, 1.0)
-                } else {
-                    glam::DVec3::ZERO
-                };
-                field.insert(c0, (a, if wall > 0.0 { 1.0 } else { 0.0 }));
-            }
-        }
-    }
+    let (field, dims) = reference_field(&mesh.positions, &rho_ref, &settings, rho0);
+    let factor = |r: f64| adaptive_factor(&settings, r / rho0);
     let spiky = -45.0 / (std::f64::consts::PI * hc.powi(6));
     let (mut err, mut scale, mut touched) = (0.0f64, 0.0f64, 0);
     let mut rows = Vec::new();
