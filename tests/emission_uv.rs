@@ -191,8 +191,6 @@ fn emitted_particles_start_on_the_surface_with_its_velocity() {
     let ctx = common::ctx();
     let ch = character::load(&asset("CesiumMan.glb")).unwrap();
     let rest = &ch.mesh.positions;
-    let (lo, hi) = character::check::bounds(rest);
-    let diag = (hi - lo).length();
     let n = 4096u32;
     let frame_dt = 1.0f32 / 30.0;
     let size = [128, 128];
@@ -279,14 +277,7 @@ fn emitted_particles_start_on_the_surface_with_its_velocity() {
         let v: Vec<[f32; 4]> = ctx.read_all(&vel).unwrap();
         let vh: Vec<[f32; 4]> = ctx.read_all(&vhalf).unwrap();
         let want_v = offset / frame_dt;
-        for &i in &born {
-            let vi = Vec3::from_slice(&v[i][..3]);
-            assert!(
-                (vi - want_v).length() <= 1e-3 * want_v.length().max(1.0),
-                "slot {i}: velocity {vi} vs {want_v}"
-            );
-            assert_eq!(v[i], vh[i], "half-step velocity starts equal");
-        }
+        births_move_with_the_surface(&born, &v, &vh, want_v);
         let stats: Vec<u32> = ctx.read_all(&emit.stats).unwrap();
         assert_eq!(stats[0], 3000, "births this frame");
         let mean_speed = stats[1] as f32 * 0.01 / 3000.0;
@@ -298,38 +289,7 @@ fn emitted_particles_start_on_the_surface_with_its_velocity() {
         let hist: Vec<u32> = ctx.read_all(&emit.hist).unwrap();
         assert_eq!(hist.iter().sum::<u32>(), 3000, "every birth binned");
         if offset == Vec3::ZERO {
-            // On the surface: as near a triangle as float rounding allows, and near the
-            // triangle the histogram binned it under.
-            let idx = &ch.mesh.indices;
-            for &i in born.iter().step_by(7) {
-                let q = Vec3::from_slice(&p[i][..3]);
-                let d = idx
-                    .chunks(3)
-                    .map(|t| {
-                        common::tri_distance(
-                            q,
-                            rest[t[0] as usize],
-                            rest[t[1] as usize],
-                            rest[t[2] as usize],
-                        )
-                    })
-                    .fold(f32::INFINITY, f32::min);
-                assert!(d < 1e-4 * diag, "slot {i} at {q}: {d} m off the surface");
-            }
-            // Births spread over the texels at least as well as uniform picks: those hit
-            // V (1 - (1 - 1/V)^3000) distinct texels of V on average (the hash of the slot
-            // index collides a little less, which spreads births more evenly).
-            let distinct: HashSet<[u32; 3]> = born
-                .iter()
-                .map(|i| [p[*i][0].to_bits(), p[*i][1].to_bits(), p[*i][2].to_bits()])
-                .collect();
-            let v = uv.valid_count as f64;
-            let expected = v * (1.0 - (1.0 - 1.0 / v).powi(3000));
-            assert!(
-                distinct.len() as f64 > 0.95 * expected,
-                "{} distinct birth texels, {expected:.0} expected of {v} texels",
-                distinct.len()
-            );
+            births_on_the_rest_surface(&born, &p, rest, &ch.mesh.indices, uv.valid_count);
         }
         // The next step: the rest are born, the born age; nothing lost or duplicated.
         let (counts, l2, _) = step(params(2, 10_000, 2.0));
@@ -361,4 +321,61 @@ fn emitted_particles_start_on_the_surface_with_its_velocity() {
         }
     }
     common::finish(&ctx);
+}
+
+/// Sampled births lie on the rest surface (triangles `indices` over `rest`) and spread
+/// over the `valid_count` texels at least as well as uniform picks.
+fn births_on_the_rest_surface(
+    born: &[usize],
+    p: &[[f32; 4]],
+    rest: &[Vec3],
+    indices: &[u32],
+    valid_count: u32,
+) {
+    // On the surface: as near a triangle as float rounding allows, and near the
+    // triangle the histogram binned it under.
+    let idx = indices;
+    let (lo, hi) = character::check::bounds(rest);
+    let diag = (hi - lo).length();
+    for &i in born.iter().step_by(7) {
+        let q = Vec3::from_slice(&p[i][..3]);
+        let d = idx
+            .chunks(3)
+            .map(|t| {
+                common::tri_distance(
+                    q,
+                    rest[t[0] as usize],
+                    rest[t[1] as usize],
+                    rest[t[2] as usize],
+                )
+            })
+            .fold(f32::INFINITY, f32::min);
+        assert!(d < 1e-4 * diag, "slot {i} at {q}: {d} m off the surface");
+    }
+    // Births spread over the texels at least as well as uniform picks: those hit
+    // V (1 - (1 - 1/V)^3000) distinct texels of V on average (the hash of the slot
+    // index collides a little less, which spreads births more evenly).
+    let distinct: HashSet<[u32; 3]> = born
+        .iter()
+        .map(|i| [p[*i][0].to_bits(), p[*i][1].to_bits(), p[*i][2].to_bits()])
+        .collect();
+    let v = valid_count as f64;
+    let expected = v * (1.0 - (1.0 - 1.0 / v).powi(3000));
+    assert!(
+        distinct.len() as f64 > 0.95 * expected,
+        "{} distinct birth texels, {expected:.0} expected of {v} texels",
+        distinct.len()
+    );
+}
+
+/// Every birth starts with the surface's velocity `want_v`, its half-step velocity equal.
+fn births_move_with_the_surface(born: &[usize], v: &[[f32; 4]], vh: &[[f32; 4]], want_v: Vec3) {
+    for &i in born {
+        let vi = Vec3::from_slice(&v[i][..3]);
+        assert!(
+            (vi - want_v).length() <= 1e-3 * want_v.length().max(1.0),
+            "slot {i}: velocity {vi} vs {want_v}"
+        );
+        assert_eq!(v[i], vh[i], "half-step velocity starts equal");
+    }
 }
