@@ -32,6 +32,96 @@ fn num(row: &HashMap<String, String>, k: &str) -> f64 {
         .unwrap_or_else(|_| panic!("{k} = {:?} is not a number", row[k]))
 }
 
+/// A thesis table's CSV (one row per row and list, the thesis's numbers beside ours)
+/// and markdown.
+fn thesis_table_files(dir: &std::path::Path, name: &str) {
+    let fragments_per_metaball = 490.0 * (128.0 * 128.0) / (512.0 * 512.0);
+    let def = tables::def(name).unwrap();
+    let (head, rows) = read_csv(&dir.join(format!("{name}.csv")));
+    for col in [
+        "row",
+        "list",
+        "reps",
+        "median_ms",
+        "min_ms",
+        "max_ms",
+        "fps",
+        "speedup_vs_none",
+        "list_mb",
+        "fragments",
+        "thesis_k1_fps",
+        "thesis_k2_fps",
+        "thesis_memory_mb",
+    ] {
+        assert!(head.iter().any(|h| h == col), "{name}.csv lacks {col}");
+    }
+    assert_eq!(rows.len(), def.rows.len() * def.cols.len(), "{name}");
+    for r in &rows {
+        let (lo, med, hi) = (num(r, "min_ms"), num(r, "median_ms"), num(r, "max_ms"));
+        assert!(0.0 < lo && lo <= med && med <= hi, "{name} {r:?}");
+        assert!((num(r, "fps") - 1000.0 / med).abs() < 1e-2 * num(r, "fps"));
+        assert!(num(r, "reps") >= 1.0);
+        let none = rows
+            .iter()
+            .find(|x| x["row"] == r["row"] && x["list"] == "none")
+            .unwrap();
+        let ratio = num(r, "fps") / num(none, "fps");
+        assert!((num(r, "speedup_vs_none") - ratio).abs() < 1e-2 * ratio);
+        match r["list"].as_str() {
+            "none" => assert_eq!(num(r, "list_mb"), 0.0),
+            _ => assert!(num(r, "list_mb") > 0.0 && num(r, "fragments") > 0.0),
+        }
+        if r["list"] == "sbuffer" {
+            assert!(!r["thesis_k2_fps"].is_empty(), "{name} {r:?}");
+        }
+    }
+    // The camera is framed to the thesis's fragments per metaball (within 3%) for
+    // every table at the base particle count and radius.
+    if name == "table2" {
+        for r in rows.iter().filter(|r| r["list"] == "sbuffer") {
+            let f = num(r, "fragments") / num(r, "particles");
+            assert!(
+                (f / fragments_per_metaball - 1.0).abs() < 0.03,
+                "{f} fragments per metaball"
+            );
+            assert!(!r["thesis_k1_fps"].is_empty());
+        }
+    }
+    let md = std::fs::read_to_string(dir.join(format!("{name}.md"))).unwrap();
+    assert!(md.contains("thesis K1 / K2"), "{name}.md");
+    for row in &def.rows {
+        if row.change.particles.is_none() {
+            assert!(md.contains(&format!("| {} |", row.label)), "{name}.md");
+        }
+    }
+}
+
+/// The sweeps' CSVs: fig9's variants, adaptive's modes, scaling's kinds.
+fn sweep_files(dir: &std::path::Path) {
+    let (_, fig9) = read_csv(&dir.join("fig9.csv"));
+    for v in ["grid/counting", "hash/bitonic"] {
+        assert_eq!(fig9.iter().filter(|r| r["variant"] == v).count(), 2, "{v}");
+    }
+    let (_, adaptive) = read_csv(&dir.join("adaptive.csv"));
+    let modes: Vec<&str> = adaptive.iter().map(|r| r["mode"].as_str()).collect();
+    assert_eq!(modes, ["adaptive-off", "adaptive-on"]);
+    for r in &adaptive {
+        let c = num(r, "mean_coverage");
+        assert!((0.0..=1.0).contains(&c) && num(r, "control_particles") > 100.0);
+    }
+    let (_, scaling) = read_csv(&dir.join("scaling.csv"));
+    for kind in ["sph", "render"] {
+        assert!(
+            scaling.iter().filter(|r| r["kind"] == kind).count() >= 4,
+            "{kind}"
+        );
+    }
+    for r in &scaling {
+        let per = num(r, "median_ms") * 1e6 / num(r, "n");
+        assert!((num(r, "ns_per_particle") - per).abs() <= 1e-2 * per + 1e-3);
+    }
+}
+
 #[test]
 fn quick_experiments_write_every_file_and_column() {
     let dir = std::env::temp_dir().join(format!("fluidform-experiment-{}", std::process::id()));
@@ -60,96 +150,15 @@ fn quick_experiments_write_every_file_and_column() {
             md.contains("Device: ") && md.contains("built from commit ") && md.contains("--quick")
         );
     }
-    // Thesis tables: one CSV row per (row, list), the thesis's numbers beside ours.
-    let fragments_per_metaball = 490.0 * (128.0 * 128.0) / (512.0 * 512.0);
     for name in tables::NAMES {
-        let def = tables::def(name).unwrap();
-        let (head, rows) = read_csv(&dir.join(format!("{name}.csv")));
-        for col in [
-            "row",
-            "list",
-            "reps",
-            "median_ms",
-            "min_ms",
-            "max_ms",
-            "fps",
-            "speedup_vs_none",
-            "list_mb",
-            "fragments",
-            "thesis_k1_fps",
-            "thesis_k2_fps",
-            "thesis_memory_mb",
-        ] {
-            assert!(head.iter().any(|h| h == col), "{name}.csv lacks {col}");
-        }
-        assert_eq!(rows.len(), def.rows.len() * def.cols.len(), "{name}");
-        for r in &rows {
-            let (lo, med, hi) = (num(r, "min_ms"), num(r, "median_ms"), num(r, "max_ms"));
-            assert!(0.0 < lo && lo <= med && med <= hi, "{name} {r:?}");
-            assert!((num(r, "fps") - 1000.0 / med).abs() < 1e-2 * num(r, "fps"));
-            assert!(num(r, "reps") >= 1.0);
-            let none = rows
-                .iter()
-                .find(|x| x["row"] == r["row"] && x["list"] == "none")
-                .unwrap();
-            let ratio = num(r, "fps") / num(none, "fps");
-            assert!((num(r, "speedup_vs_none") - ratio).abs() < 1e-2 * ratio);
-            match r["list"].as_str() {
-                "none" => assert_eq!(num(r, "list_mb"), 0.0),
-                _ => assert!(num(r, "list_mb") > 0.0 && num(r, "fragments") > 0.0),
-            }
-            if r["list"] == "sbuffer" {
-                assert!(!r["thesis_k2_fps"].is_empty(), "{name} {r:?}");
-            }
-        }
-        // The camera is framed to the thesis's fragments per metaball (within 3%) for
-        // every table at the base particle count and radius.
-        if *name == "table2" {
-            for r in rows.iter().filter(|r| r["list"] == "sbuffer") {
-                let f = num(r, "fragments") / num(r, "particles");
-                assert!(
-                    (f / fragments_per_metaball - 1.0).abs() < 0.03,
-                    "{f} fragments per metaball"
-                );
-                assert!(!r["thesis_k1_fps"].is_empty());
-            }
-        }
-        let md = std::fs::read_to_string(dir.join(format!("{name}.md"))).unwrap();
-        assert!(md.contains("thesis K1 / K2"), "{name}.md");
-        for row in &def.rows {
-            if row.change.particles.is_none() {
-                assert!(md.contains(&format!("| {} |", row.label)), "{name}.md");
-            }
-        }
+        thesis_table_files(&dir, name);
     }
     for name in ["table2", "table3", "table4"] {
         let p = dir.join(format!("{name}-frames.png"));
         let img = image::open(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
         assert!(img.width() > 256 && img.height() > 128);
     }
-    // The sweeps.
-    let (_, fig9) = read_csv(&dir.join("fig9.csv"));
-    for v in ["grid/counting", "hash/bitonic"] {
-        assert_eq!(fig9.iter().filter(|r| r["variant"] == v).count(), 2, "{v}");
-    }
-    let (_, adaptive) = read_csv(&dir.join("adaptive.csv"));
-    let modes: Vec<&str> = adaptive.iter().map(|r| r["mode"].as_str()).collect();
-    assert_eq!(modes, ["adaptive-off", "adaptive-on"]);
-    for r in &adaptive {
-        let c = num(r, "mean_coverage");
-        assert!((0.0..=1.0).contains(&c) && num(r, "control_particles") > 100.0);
-    }
-    let (_, scaling) = read_csv(&dir.join("scaling.csv"));
-    for kind in ["sph", "render"] {
-        assert!(
-            scaling.iter().filter(|r| r["kind"] == kind).count() >= 4,
-            "{kind}"
-        );
-    }
-    for r in &scaling {
-        let per = num(r, "median_ms") * 1e6 / num(r, "n");
-        assert!((num(r, "ns_per_particle") - per).abs() <= 1e-2 * per + 1e-3);
-    }
+    sweep_files(&dir);
     // Every claim of the papers gets a verdict.
     let f = std::fs::read_to_string(dir.join("findings.md")).unwrap();
     for claim in [
