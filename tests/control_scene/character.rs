@@ -3,7 +3,7 @@
 use super::*;
 
 #[test]
-fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
+fn the_character_scene_runs_with_each_placement() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("c");
     let out_s = out.to_str().unwrap();
@@ -62,6 +62,11 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
             .count(),
         4
     );
+}
+
+#[test]
+fn the_character_scene_scales_with_particles() {
+    let dir = tempfile::tempdir().unwrap();
     // --particles scales the scene, the character with it.
     let big = dir.path().join("big");
     let o = fluidform(&[
@@ -82,6 +87,13 @@ fn the_character_scene_runs_and_bad_control_input_fails_clearly() {
     let s = summary(&big);
     let h = s["stats"]["character"]["height"].as_f64().unwrap();
     assert!(h > 1.3 && h < 1.7, "the walker grew with the scene: {h} m");
+}
+
+#[test]
+fn bad_control_input_fails_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    let out_s = out.to_str().unwrap();
     let fails: [(&[&str], &str); 7] = [
         (
             &["--scene", "character", "--adaptive-thresholds", "1.3,1.2"],
