@@ -18,11 +18,8 @@ fn child(name: &str, capacity: u32, life: f32) -> SystemSpec {
     s
 }
 
-#[test]
-fn type_changes_conserve_the_budget() {
-    let ctx = common::ctx();
-    let passes = Passes::new(&ctx).unwrap();
-    let cam = cam();
+/// Rain that turns into splashes on the ground, splashes that burst into mist at death.
+fn rain_splash_mist() -> [SystemSpec; 3] {
     let ground = ColliderSpec::ground(0.0, 0.3, 0.2);
     let mut rain = ballistic(Integrator::Euler, 2048);
     rain.name = "rain".into();
@@ -71,7 +68,53 @@ fn type_changes_conserve_the_budget() {
     for s in [&mut splash, &mut rain] {
         s.validate().unwrap();
     }
-    let specs = [rain, splash, mist];
+    [rain, splash, mist]
+}
+
+/// Every system's lists partition its slots and its counters balance; the type changes
+/// create and lose nothing.
+fn budget_is_conserved(systems: &[ParticleSystem], d: &[fluidform::psys::system::StateDump]) {
+    for (s, d) in systems.iter().zip(d) {
+        partitions(&d.alive, &d.dead, s.capacity)
+            .unwrap_or_else(|e| panic!("{}: {e}", s.spec.name));
+        let c = d.counters;
+        assert_eq!(
+            (c.births + c.spawned) as u64 - c.deaths(),
+            d.alive.len() as u64,
+            "{}: births + children - deaths = alive ({c:?})",
+            s.spec.name
+        );
+        assert_eq!(c.events_dropped, 0, "{}", s.spec.name);
+    }
+    let (r, sp, m) = (d[0].counters, d[1].counters, d[2].counters);
+    // Every drop that left the rain arrived as a splash or was refused for want of a
+    // slot: the type change creates and loses nothing.
+    assert_eq!(
+        r.died_life + r.died_collision,
+        0,
+        "drops die only by changing"
+    );
+    assert_eq!(r.changed, sp.spawned + sp.spawn_refused);
+    assert_eq!(sp.births + m.births, 0, "children come from events alone");
+    // Each splash that died of age spawned 0..=3 mist children.
+    let asked = (m.spawned + m.spawn_refused) as u64;
+    assert!(
+        asked <= 3 * sp.died_life as u64,
+        "{asked} > 3 x {}",
+        sp.died_life
+    );
+    // Children are born where their parent hit the ground: never below it.
+    for &slot in &d[1].alive {
+        assert!(d[1].pos[slot as usize][1] >= -1e-5);
+    }
+}
+
+#[test]
+fn type_changes_conserve_the_budget() {
+    let ctx = common::ctx();
+    let passes = Passes::new(&ctx).unwrap();
+    let cam = cam();
+    let specs = rain_splash_mist();
     let mut systems: Vec<ParticleSystem> = specs
         .iter()
         .enumerate()
@@ -95,39 +138,7 @@ fn type_changes_conserve_the_budget() {
         })
         .unwrap();
         let d: Vec<_> = systems.iter().map(|s| s.read(&ctx).unwrap()).collect();
-        for (s, d) in systems.iter().zip(&d) {
-            partitions(&d.alive, &d.dead, s.capacity)
-                .unwrap_or_else(|e| panic!("{}: {e}", s.spec.name));
-            let c = d.counters;
-            assert_eq!(
-                (c.births + c.spawned) as u64 - c.deaths(),
-                d.alive.len() as u64,
-                "{}: births + children - deaths = alive ({c:?})",
-                s.spec.name
-            );
-            assert_eq!(c.events_dropped, 0, "{}", s.spec.name);
-        }
-        let (r, sp, m) = (d[0].counters, d[1].counters, d[2].counters);
-        // Every drop that left the rain arrived as a splash or was refused for want of a
-        // slot: the type change creates and loses nothing.
-        assert_eq!(
-            r.died_life + r.died_collision,
-            0,
-            "drops die only by changing"
-        );
-        assert_eq!(r.changed, sp.spawned + sp.spawn_refused);
-        assert_eq!(sp.births + m.births, 0, "children come from events alone");
-        // Each splash that died of age spawned 0..=3 mist children.
-        let asked = (m.spawned + m.spawn_refused) as u64;
-        assert!(
-            asked <= 3 * sp.died_life as u64,
-            "{asked} > 3 x {}",
-            sp.died_life
-        );
-        // Children are born where their parent hit the ground: never below it.
-        for &slot in &d[1].alive {
-            assert!(d[1].pos[slot as usize][1] >= -1e-5);
-        }
+        budget_is_conserved(&systems, &d);
     }
     let sp = systems[1].read_counters(&ctx).unwrap();
     let m = systems[2].read_counters(&ctx).unwrap();
