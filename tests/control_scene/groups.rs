@@ -58,16 +58,7 @@ fn group_only_control(solver: &[&str]) {
     let b = play(&held, &d.join("held"), frames, &ex);
     let again = play(&free, &d.join("again"), frames, &ex);
     // The steps and the iterations of each solve are the same (they are fixed here).
-    let steps = |name: &str| -> Vec<String> {
-        std::fs::read_to_string(d.join(name).join("steps.csv"))
-            .unwrap()
-            .lines()
-            .map(|l| {
-                let c: Vec<&str> = l.split(',').collect();
-                format!("{} {} {}", c[3], c[4], c[7])
-            })
-            .collect()
-    };
+    let steps = |name: &str| step_lines(&d.join(name));
     assert_eq!(steps("free"), steps("held"), "steps or iterations differ");
     let read = |r: &fluidform::run::RunResult| -> Vec<(u32, [f32; 3])> {
         let p = r.exports.last().expect("an export").clone();
@@ -105,19 +96,6 @@ fn group_only_control(solver: &[&str]) {
     // that to centimetres for a few particles (seen: 4 mm with DFSPH here, 18 cm with
     // PCISPH on CI). What control must not change is group 1 as a body: its centroid and
     // spread stay within a tenth of a spacing of the free run's.
-    let body = |v: &[[f32; 3]]| {
-        let n = v.len() as f64;
-        let c: Vec<f64> = (0..3)
-            .map(|k| v.iter().map(|x| x[k] as f64).sum::<f64>() / n)
-            .collect();
-        let spread = (v
-            .iter()
-            .map(|x| (0..3).map(|k| (x[k] as f64 - c[k]).powi(2)).sum::<f64>())
-            .sum::<f64>()
-            / n)
-            .sqrt();
-        (c, spread)
-    };
     let tol = 0.1 * spacing as f64;
     let ((ca, sa), (cb, sb), (cc, sc)) = (body(&fa), body(&fb), body(&fc));
     let shift = |u: &[f64], v: &[f64]| (0..3).map(|k| (u[k] - v[k]).abs()).fold(0.0, f64::max);
@@ -152,4 +130,31 @@ fn group_only_control(solver: &[&str]) {
         g0(&pb),
         g0(&pa)
     );
+}
+
+/// Centroid and RMS spread of a body of points.
+fn body(v: &[[f32; 3]]) -> (Vec<f64>, f64) {
+    let n = v.len() as f64;
+    let c: Vec<f64> = (0..3)
+        .map(|k| v.iter().map(|x| x[k] as f64).sum::<f64>() / n)
+        .collect();
+    let spread = (v
+        .iter()
+        .map(|x| (0..3).map(|k| (x[k] as f64 - c[k]).powi(2)).sum::<f64>())
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    (c, spread)
+}
+
+/// Each step's time step and iteration counts from a run's steps.csv.
+fn step_lines(run: &Path) -> Vec<String> {
+    std::fs::read_to_string(run.join("steps.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            format!("{} {} {}", c[3], c[4], c[7])
+        })
+        .collect()
 }
