@@ -58,6 +58,64 @@ fn step_density_errors_match_the_cpu() {
     common::finish(&ctx);
 }
 
+/// The incompressible solvers, from the switch or the file: iterations per step in
+/// steps.csv and summary.json (at least min_iterations, 2), dfsph's divergence solve.
+fn incompressible_solvers_report_iterations(dir: &std::path::Path, cfl: &str) {
+    let pbf = dir.join("pbf.toml");
+    std::fs::write(
+        &pbf,
+        std::fs::read_to_string(cfl)
+            .unwrap()
+            .replace("cfl = 0.4", "cfl = 0.4\nsolver = \"pbf\""),
+    )
+    .unwrap();
+    for (name, scene, extra) in [
+        ("pcisph", cfl, vec!["--solver", "pcisph"]),
+        ("dfsph", cfl, vec!["--solver", "dfsph"]),
+        ("pbf", pbf.to_str().unwrap(), vec![]),
+    ] {
+        let out = dir.join(name);
+        let mut args = vec![
+            "run",
+            "--scene",
+            scene,
+            "--render",
+            "points",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--quiet",
+            "--frames",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = common::fluidform(&args);
+        assert!(o.status.success(), "{name}: {}", common::text(&o));
+        let sum = common::summary(&out);
+        assert_eq!(sum["config"]["fluid"]["solver"], name);
+        let err = &sum["stats"]["density_error"];
+        assert!(
+            err["iterations_mean"].as_f64().unwrap() >= 2.0,
+            "{name}: {err}"
+        );
+        let dfsph = name == "dfsph";
+        assert_eq!(
+            err["divergence_iterations_mean"].as_f64().unwrap() >= 2.0,
+            dfsph,
+            "{err}"
+        );
+        let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+        for row in csv.lines().skip(1) {
+            let c: Vec<&str> = row.split(',').collect();
+            assert!(c[4].parse::<u32>().unwrap() >= 2, "{name}: {row}");
+            assert_eq!(c[7].parse::<u32>().unwrap() >= 2, dfsph, "{name}: {row}");
+        }
+    }
+}
+
 #[test]
 fn solver_switch_and_per_step_density_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -99,61 +157,7 @@ fn solver_switch_and_per_step_density_errors() {
         (frame0 - 0.01).abs() < 1e-6,
         "frame 0 steps sum to {frame0}"
     );
-    // The incompressible solvers, from the switch or the file: iterations per step in
-    // steps.csv and summary.json (at least min_iterations, 2), dfsph's divergence solve.
-    let pbf = dir.path().join("pbf.toml");
-    std::fs::write(
-        &pbf,
-        std::fs::read_to_string(&cfl)
-            .unwrap()
-            .replace("cfl = 0.4", "cfl = 0.4\nsolver = \"pbf\""),
-    )
-    .unwrap();
-    for (name, scene, extra) in [
-        ("pcisph", cfl.as_str(), vec!["--solver", "pcisph"]),
-        ("dfsph", cfl.as_str(), vec!["--solver", "dfsph"]),
-        ("pbf", pbf.to_str().unwrap(), vec![]),
-    ] {
-        let out = dir.path().join(name);
-        let mut args = vec![
-            "run",
-            "--scene",
-            scene,
-            "--render",
-            "points",
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--quiet",
-            "--frames",
-            "3",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = common::fluidform(&args);
-        assert!(o.status.success(), "{name}: {}", common::text(&o));
-        let sum = common::summary(&out);
-        assert_eq!(sum["config"]["fluid"]["solver"], name);
-        let err = &sum["stats"]["density_error"];
-        assert!(
-            err["iterations_mean"].as_f64().unwrap() >= 2.0,
-            "{name}: {err}"
-        );
-        let dfsph = name == "dfsph";
-        assert_eq!(
-            err["divergence_iterations_mean"].as_f64().unwrap() >= 2.0,
-            dfsph,
-            "{err}"
-        );
-        let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
-        for row in csv.lines().skip(1) {
-            let c: Vec<&str> = row.split(',').collect();
-            assert!(c[4].parse::<u32>().unwrap() >= 2, "{name}: {row}");
-            assert_eq!(c[7].parse::<u32>().unwrap() >= 2, dfsph, "{name}: {row}");
-        }
-    }
+    incompressible_solvers_report_iterations(dir.path(), &cfl);
     for args in [
         vec![
             "run",
