@@ -314,6 +314,14 @@ fn particle_scenes_run_with_every_integrator_sort_and_draw() {
         );
         assert!(out.join("frame_0003.png").exists());
     }
+}
+
+/// A malformed scene file, a closed form with state, a switch the scene does not take,
+/// a sort of opaque points: one clear error each, no panic.
+#[test]
+fn bad_particle_scenes_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = format!("{}/tests/scenes/sparks.toml", env!("CARGO_MANIFEST_DIR"));
     let bad = dir.path().join("bad.toml");
     std::fs::write(
         &bad,
