@@ -164,6 +164,8 @@ fn reference_field(
 }
 
 /// Largest relative error of the control acceleration, and of the control densities.
+/// Long because it is one GPU run and its f64 restatement side by side (the field and the
+/// adaptive factor are apart).
 fn compare(settings: ControlSettings) -> (f64, f64) {
     let ctx = common::ctx();
     let sc = scene();

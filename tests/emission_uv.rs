@@ -185,6 +185,8 @@ fn uv_positions_match_a_cpu_rasterisation() {
 /// the surface's velocity times the transfer rate (a rigid translation), lives in
 /// (0, limit / 2); across steps every slot accounted for (alive count = live slots), due
 /// slots without budget die (pos.w = -1), permanent slots never age.
+/// Long because its three steps share one emit pass and its buffers; the checks of the
+/// births are apart.
 #[test]
 fn emitted_particles_start_on_the_surface_with_its_velocity() {
     use fluidform::emission::emit::{EmitGpuParams, EmitInput, EmitPass};

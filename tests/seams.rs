@@ -286,7 +286,8 @@ fn failed_construction_leaks_nothing() {
 }
 
 /// Rust mirrors of GPU structs against the offsets the GLSL compiler gave each member: every
-/// `#[repr(C)]` struct in src (a test below counts them).
+/// `#[repr(C)]` struct in src (a test below counts them). Long because it is a table: one
+/// entry per struct.
 #[test]
 fn gpu_struct_mirrors_match_glsl_field_offsets() {
     use fluidform::gpu::interface::member_offsets;

@@ -145,6 +145,7 @@ fn missing_device_is_a_clear_error() {
     );
 }
 
+/// Long because it is a table of (command line, the error it must print).
 #[test]
 fn unimplemented_switches_and_bad_values_fail_clearly() {
     let dir = tempfile::tempdir().unwrap();
