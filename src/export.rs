@@ -4,7 +4,7 @@
 //! recorded into the frame's own commands, so each file holds exactly that frame's state.
 use crate::config::ExportFormat;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, Guard, MemoryLocation};
+use crate::gpu::{Buffer, Context, Guard, MemoryLocation};
 use crate::sph::SphState;
 use ash::vk;
 use std::io::Write;
@@ -138,7 +138,7 @@ impl ParticleExport {
         ctx.copy(cmd, st.vel(), 0, &c.vel, 0, n * 16);
         ctx.copy(cmd, st.rho_p(), 0, &c.rho_p, 0, n * 8);
         ctx.copy(cmd, st.attr(), 0, &c.attr, 0, n * 16);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // copies -> the host
+        ctx.host_reads(cmd, &[&c.pos, &c.vel, &c.rho_p, &c.attr]);
     }
 
     /// After the slot's fence: write the frame's file and its particles.csv row.

@@ -5,7 +5,7 @@
 //! the fluid and the mesh. Both write one PNG per saved frame.
 use crate::config::{ShowMesh, Switches};
 use crate::error::Result;
-use crate::gpu::{sync, Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
+use crate::gpu::{Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
 use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FrameStats, MetaballBuffers, MetaballRenderer, MetaballSettings};
 use crate::render::{points::PointsPush, Camera, PointsView};
@@ -16,6 +16,9 @@ use serde::{Deserialize, Serialize};
 /// the opaque ones write depth; the blended ones only test it, drawn after everything
 /// opaque (the fluid included).
 pub trait Overlay {
+    /// Declare the draws of the next rendering scope (before it begins): the opaque ones,
+    /// or the blended ones.
+    fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, opaque: bool);
     fn draw_opaque(&self, ctx: &Context, cmd: vk::CommandBuffer);
     fn draw_blended(&self, ctx: &Context, cmd: vk::CommandBuffer);
     fn has_blended(&self) -> bool;
@@ -140,6 +143,16 @@ impl View for PointsViewer {
         save: bool,
     ) -> Result<()> {
         prof.begin(ctx, cmd, PointsView::NAME);
+        if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
+            v.prepare(ctx, cmd, m);
+        }
+        if n > 0 {
+            self.view.prepare(ctx, cmd, pos, attr);
+        }
+        if let Some(o) = layers.overlay {
+            o.prepare(ctx, cmd, true);
+            o.prepare(ctx, cmd, false);
+        }
         self.target
             .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
         if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
@@ -272,6 +285,7 @@ impl MetaballViewer {
             })?;
             scopes.begin(ctx, cmd, "overlay");
             target.load_layers(ctx, cmd, (&b.pixels, 0), (&b.scene_depth, 0));
+            o.prepare(ctx, cmd, false);
             target.begin_rendering_loaded(ctx, cmd);
             o.draw_blended(ctx, cmd);
             target.end_rendering(ctx, cmd);
@@ -298,11 +312,25 @@ impl View for MetaballViewer {
     ) -> Result<()> {
         if let Some(target) = &self.target {
             prof.begin(ctx, cmd, MeshView::NAME);
+            let mesh = match &self.mesh {
+                Some(view) => Some((
+                    view,
+                    layers.mesh.ok_or_else(|| {
+                        crate::Error::Param(
+                            "a metaball view made to draw a mesh was given none".into(),
+                        )
+                    })?,
+                )),
+                None => None,
+            };
+            if let Some((view, m)) = mesh {
+                view.prepare(ctx, cmd, m);
+            }
+            if let Some(o) = layers.overlay {
+                o.prepare(ctx, cmd, true);
+            }
             target.begin_rendering(ctx, cmd, [0.0; 4]);
-            if let Some(view) = &self.mesh {
-                let m = layers.mesh.ok_or_else(|| {
-                    crate::Error::Param("a metaball view made to draw a mesh was given none".into())
-                })?;
+            if let Some((view, m)) = mesh {
                 view.draw(ctx, cmd, m);
             }
             if let Some(o) = layers.overlay {
@@ -314,12 +342,6 @@ impl View for MetaballViewer {
             prof.end(ctx, cmd);
         }
         ctx.copy(cmd, pos, 0, &self.centers[slot], 0, n as u64 * 16);
-        // This slot's centers (and the opaque layer) -> the renderer's passes.
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::GRAPHICS_READ,
-        );
         prof.begin(ctx, cmd, "render");
         let r = self.renderer.record_picture(
             ctx,

@@ -78,6 +78,71 @@ fn a_hand_barrier_that_covers_the_hazard_leaves_nothing_to_place() {
 }
 
 /// Uses come from what a shader does, not from how it declares a block.
+fn fragment(i: u64, r: bool, w: bool) -> BufferUse {
+    let (a, b) = (
+        vk::AccessFlags2::SHADER_STORAGE_READ,
+        vk::AccessFlags2::SHADER_STORAGE_WRITE,
+    );
+    BufferUse::at(
+        buf(i),
+        vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        (r, a),
+        (w, b),
+    )
+}
+
+#[test]
+fn declared_draws_get_their_barrier_before_the_scope_and_undeclared_ones_count() {
+    let mut t = Tracker::default();
+    // A dispatch writes 1; a draw reads 1 and writes 2 (its uses declared before the scope).
+    t.before(&[write(1)], true);
+    let draw = [fragment(1, true, false), fragment(2, false, true)];
+    let (from, to) = t.declare(&draw).expect("compute write -> fragment read");
+    assert!(from.access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
+    assert!(to.stage.contains(vk::PipelineStageFlags2::FRAGMENT_SHADER));
+    // Inside the scope the draw finds its uses declared: no hazard, nothing unplaced.
+    assert!(t.before(&draw, false).is_none());
+    t.end_scope();
+    assert_eq!((t.placed, t.unplaced), (1, 0));
+    // After the scope: a dispatch reading 2 waits for the fragment write.
+    let (from, _) = t
+        .before(&[read(2)], true)
+        .expect("fragment write -> compute read");
+    assert!(from
+        .stage
+        .contains(vk::PipelineStageFlags2::FRAGMENT_SHADER));
+    // A draw that was not declared: its hazard is counted, no barrier placed.
+    t.before(&[write(3)], true);
+    assert!(t.before(&[fragment(3, true, false)], false).is_some());
+    t.end_scope();
+    assert_eq!((t.placed, t.unplaced), (2, 1));
+    // Declarations end with their scope: the next scope's draw of 1 is checked again.
+    t.before(&[write(1)], true);
+    assert!(t.before(&[fragment(1, true, false)], false).is_some());
+    assert_eq!(t.unplaced, 2);
+}
+
+#[test]
+fn host_reads_wait_for_the_writes_they_read() {
+    let mut t = Tracker::default();
+    t.before(&[BufferUse::transfer(buf(1), true)], true);
+    let (from, to) = t
+        .host_read(&[BufferUse::host(buf(1))])
+        .expect("copy -> host");
+    assert!(from.access.contains(vk::AccessFlags2::TRANSFER_WRITE));
+    assert!(to.access.contains(vk::AccessFlags2::HOST_READ));
+    assert!(to.stage.contains(vk::PipelineStageFlags2::HOST));
+    // Read again: already visible to the host.
+    assert!(t.host_read(&[BufferUse::host(buf(1))]).is_none());
+    // A buffer this command buffer never touched: its writes came earlier, so every
+    // device write is made visible to the host.
+    let (from, _) = t
+        .host_read(&[BufferUse::host(buf(9))])
+        .expect("unknown -> a barrier");
+    assert!(from.access.contains(vk::AccessFlags2::SHADER_STORAGE_WRITE));
+    assert!(from.access.contains(vk::AccessFlags2::TRANSFER_WRITE));
+}
+
 #[test]
 fn buffer_uses_follow_loads_stores_and_atomics() {
     let c = fluidform::gpu::shader::ShaderCompiler::new().unwrap();

@@ -55,6 +55,9 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// Coverage over time: (scene time, coverage).
+type Coverage = Vec<(f64, f64)>;
+
 /// One run of the scene with adaptive mode `mode` and velocity gain `k`: its row, the
 /// device's name and the coverage over time.
 fn one_run(
@@ -63,7 +66,7 @@ fn one_run(
     variant: &str,
     mode: Adaptive,
     k: f32,
-) -> Result<(Row, String, Vec<(f64, f64)>)> {
+) -> Result<(Row, String, Coverage)> {
     let mut s = opts.switches.clone();
     s.control.adaptive = Some(mode);
     s.control.control_velocity = Some(k);

@@ -145,6 +145,7 @@ pub fn particles(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     k += 1;
                     record_simulation(ctx, cmd, prof, &passes, std::slice::from_mut(&mut *s), &f)?;
                     prof.begin(ctx, cmd, Passes::DRAW);
+                    s.prepare_draw(ctx, cmd, &passes, &f);
                     target.begin_rendering(ctx, cmd, [0.0, 0.0, 0.0, 1.0]);
                     s.record_draw(ctx, cmd, &passes, &f);
                     target.end_rendering(ctx, cmd);

@@ -253,7 +253,7 @@ fn write_stability(
     out: &std::path::Path,
     summary: &StabilitySummary,
 ) -> Result<std::path::PathBuf> {
-    std::fs::create_dir_all(&out).map_err(|e| Error::Io {
+    std::fs::create_dir_all(out).map_err(|e| Error::Io {
         path: out.display().to_string(),
         source: e,
     })?;

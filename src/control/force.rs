@@ -10,7 +10,7 @@ use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
@@ -378,7 +378,6 @@ impl ControlForce {
         // placement's (re-placed particles have no previous pose: both are the new set).
         let (pos, prev) = match &g.rays {
             Some(r) => {
-                ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ); // surface -> raster
                 scopes.end(ctx, cmd);
                 r.record(
                     ctx,

@@ -8,7 +8,7 @@ use super::fidelity::{self, Fidelity};
 use super::force::{ControlForce, ALL_GROUPS};
 use super::inside::InsideTest;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, MemoryLocation};
+use crate::gpu::{Buffer, Context, MemoryLocation};
 use crate::sph::SphState;
 use ash::vk;
 use glam::Vec3;
@@ -175,7 +175,7 @@ impl ControlMetrics {
         ctx.copy(cmd, st.rho_p(), 0, &s.rho, 0, self.n as u64 * 8);
         ctx.copy(cmd, st.attr(), 0, &s.attr, 0, self.n as u64 * 16);
         force.record_copy_readback(ctx, cmd, &s.crho, &s.counts)?;
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ);
+        ctx.host_reads(cmd, &[&s.pos, &s.vel, &s.rho, &s.attr, &s.crho, &s.counts]);
         Ok(())
     }
 

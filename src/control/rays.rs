@@ -10,8 +10,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::{
-    sync, Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
-    Scopes,
+    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
 };
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch, ScanVariant};
 use ash::vk;
@@ -198,44 +197,24 @@ impl RaysPlacer {
             stats: &self.stats,
         };
         scopes.begin(ctx, cmd, Self::NAME);
-        // The last frame's readers of these buffers -> the resets.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::GRAPHICS_READ | sync::TRANSFER_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.fill(cmd, &self.offsets, 0);
         ctx.fill(cmd, &self.out, self.park.to_bits());
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::GRAPHICS_READ | sync::COMPUTE_READ,
-        );
         let [w, h, _] = self.grid.dims;
         let draw = |p: &GraphicsPipeline<RaysIo>| {
+            p.prepare(ctx, cmd, &bufs);
             begin_empty_rendering(ctx, cmd, w, h);
             p.bind(ctx, cmd, &bufs, &push);
             ctx.draw(cmd, 3 * triangles, 1);
             ctx.end_rendering(cmd);
         };
         draw(&self.count);
-        ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::COMPUTE_READ); // counts -> scan
         let scan = |b: &Buffer| {
             self.scan
                 .record(ctx, cmd, b, b, px + 1, ScanKind::Exclusive, &self.scratch)
         };
         scan(&self.offsets)?;
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::GRAPHICS_READ | sync::TRANSFER_READ,
-        );
         ctx.copy(cmd, &self.offsets, px * 4, &self.stats, STATS_FRAGMENTS, 4);
-        // The total's copy -> the fill pass's atomics on the same buffer (no barrier may
-        // be placed inside the draw's rendering scope).
-        ctx.barrier(cmd, sync::TRANSFER_READ, sync::GRAPHICS_READ);
         draw(&self.fill);
-        ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::COMPUTE_READ); // lists -> sort
         self.sort_count.dispatch(ctx, cmd, &bufs, &push, px);
         scan(&self.emit_buf)?;
         self.emit.dispatch(ctx, cmd, &bufs, &push, px);

@@ -9,8 +9,8 @@ use super::layout::UvLayout;
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::{
-    sync, Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
-    Labels, Scopes,
+    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
+    Scopes,
 };
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch, ScanVariant};
 use ash::vk;
@@ -162,14 +162,7 @@ impl UvSurface {
         ctx.upload(&mut verts, 0, &v4)?;
         ctx.one_shot(|cmd| -> Result<()> {
             ctx.fill(cmd, &s.owner, u32::MAX);
-            // Cleared owners -> the claiming atomics (a read and a write).
-            ctx.barrier(
-                cmd,
-                sync::TRANSFER_WRITE,
-                sync::GRAPHICS_READ | sync::FRAGMENT_WRITE,
-            );
             s.raster_into(ctx, cmd, &verts, &s.pos[0], 1); // claim the owners
-            ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::GRAPHICS_READ);
             s.record(ctx, cmd, &mut Labels, &verts)?;
             s.record_compact(ctx, cmd)
         })??;
@@ -201,9 +194,8 @@ impl UvSurface {
         }
     }
 
-    /// Rasterise the skinned mesh (`verts`: its vertices' positions, written and made
-    /// visible to vertex shaders by the caller) into the next position buffer, which
-    /// becomes the current one.
+    /// Rasterise the skinned mesh (`verts`: its vertices' positions) into the next
+    /// position buffer, which becomes the current one.
     pub fn record(
         &mut self,
         ctx: &Context,
@@ -213,24 +205,8 @@ impl UvSurface {
     ) -> Result<()> {
         let next = 1 - self.current;
         scopes.begin(ctx, cmd, Self::NAME);
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::GRAPHICS_READ | sync::TRANSFER_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.fill(cmd, &self.pos[next], 0);
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::GRAPHICS_READ | sync::FRAGMENT_WRITE,
-        );
         self.raster_into(ctx, cmd, verts, &self.pos[next], 0);
-        // Positions -> the emitter (and copies).
-        ctx.barrier(
-            cmd,
-            sync::FRAGMENT_WRITE,
-            sync::COMPUTE_READ | sync::TRANSFER_READ,
-        );
         scopes.end(ctx, cmd);
         self.current = next;
         Ok(())
@@ -245,8 +221,9 @@ impl UvSurface {
         pos: &Buffer,
         mode: u32,
     ) {
-        begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
         let bufs = self.bufs(verts, pos);
+        self.raster.prepare(ctx, cmd, &bufs);
+        begin_empty_rendering(ctx, cmd, self.size[0], self.size[1]);
         for &(rect, first, count) in &self.parts {
             let push = UvPush {
                 atlas: rect,
@@ -276,11 +253,6 @@ impl UvSurface {
             &self.scratch,
         )?;
         self.compact.dispatch(ctx, cmd, &bufs, &self.push, texels);
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::COMPUTE_READ | sync::TRANSFER_READ | sync::HOST_READ,
-        );
         Ok(())
     }
 

@@ -308,7 +308,7 @@ fn scaling_sph(
         }
         if !stopped {
             opts.counts = vec![n];
-            let r = crate::bench::sph::steps(ctx, &opts)?;
+            let r = crate::bench::sph::steps(ctx, opts)?;
             for row in r {
                 if row.main.median > sw.cap_ms {
                     sw.stops.push(format!(
@@ -342,7 +342,7 @@ fn scaling_render(
         let n = (base_n as f64 * f).round() as usize;
         sw.steps.start(&format!("render {} N = {n}", list.as_str()));
         if !stopped {
-            match render_row(ctx, env, &ropts, list, n, seed, &cam) {
+            match render_row(ctx, env, ropts, list, n, seed, cam) {
                 Ok(row) => {
                     if row.main.median > sw.cap_ms {
                         sw.stops.push(format!(
@@ -371,7 +371,7 @@ fn scaling_render(
 
 /// Findings of the scaling sweep: grid against hash, and render cost rising with N.
 fn scaling_findings(sph: &[&Row], render: &[&Row], lists: &[ListKind]) -> Vec<Finding> {
-    let mut found = grid_findings(&sph, "grid/counting", "hash/bitonic", "SPH step");
+    let mut found = grid_findings(sph, "grid/counting", "hash/bitonic", "SPH step");
     let mut fails = Vec::new();
     for list in lists {
         let ms: Vec<f64> = render

@@ -221,9 +221,16 @@ impl Context {
             dst_offset: 0,
             size: len,
         };
-        let r = self.one_shot(|cmd| unsafe {
-            self.device
-                .cmd_copy_buffer(cmd, src.raw, staging.raw, &[region]);
+        let r = self.one_shot(|cmd| {
+            // The writes of earlier submissions -> this copy.
+            let writes = super::sync::COMPUTE_WRITE
+                | super::sync::TRANSFER_WRITE
+                | super::sync::FRAGMENT_WRITE;
+            self.barrier(cmd, writes, super::sync::TRANSFER_READ);
+            unsafe {
+                self.device
+                    .cmd_copy_buffer(cmd, src.raw, staging.raw, &[region])
+            };
         });
         if r.is_ok() {
             let m = staging.mapped().expect("staging is mapped");

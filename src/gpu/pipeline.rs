@@ -516,16 +516,24 @@ impl<I: Interface> GraphicsPipeline<I> {
         })
     }
 
-    /// Bind the pipeline, its buffers and push constants (inside a rendering scope: the
-    /// tracker records the draws' uses but places no barrier there).
-    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
+    /// Declare that the next rendering scope draws this pipeline with `bufs` (call before
+    /// it begins): the tracker places the barriers the draws need now.
+    pub fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>) {
+        ctx.prepare_draws(cmd, &self.draw_uses(bufs));
+    }
+
+    fn draw_uses(&self, bufs: &I::Bufs<'_>) -> Vec<BufferUse> {
         let buffers = I::buffers(bufs);
-        let uses: Vec<BufferUse> = self
-            .uses
+        self.uses
             .iter()
             .flat_map(|(stage, map)| bound_uses(&buffers, map, *stage))
-            .collect();
-        ctx.track(cmd, &uses, false);
+            .collect()
+    }
+
+    /// Bind the pipeline, its buffers and push constants (inside a rendering scope: uses
+    /// not declared by `prepare` are counted as hazards where no barrier can be placed).
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
+        ctx.track(cmd, &self.draw_uses(bufs), false);
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);

@@ -111,9 +111,33 @@ impl Context {
     /// Record the buffer uses of the next command (`gpu::track`); `place`: record the
     /// barrier it needs, if any (never inside a rendering scope).
     pub fn track(&self, cmd: vk::CommandBuffer, uses: &[BufferUse], place: bool) {
+        self.track_as(cmd, uses, place, |t, u| t.before(u, place));
+    }
+
+    /// Declare the buffer uses of the next rendering scope's draws (before it begins):
+    /// the barrier they need is recorded now.
+    pub fn prepare_draws(&self, cmd: vk::CommandBuffer, uses: &[BufferUse]) {
+        self.track_as(cmd, uses, true, |t, u| t.declare(u));
+    }
+
+    /// The host reads `buffers` (mapped) after this command buffer's fence: the barrier
+    /// that makes the device's writes visible there.
+    pub fn host_reads(&self, cmd: vk::CommandBuffer, buffers: &[&super::Buffer]) {
+        let uses: Vec<BufferUse> = buffers.iter().map(|b| BufferUse::host(b.raw)).collect();
+        self.track_as(cmd, &uses, true, |t, u| t.host_read(u));
+    }
+
+    fn track_as(
+        &self,
+        cmd: vk::CommandBuffer,
+        uses: &[BufferUse],
+        place: bool,
+        how: impl FnOnce(&mut super::track::Tracker, &[BufferUse]) -> Option<(Access, Access)>,
+    ) {
         let (need, debug) = {
             let mut t = self.trackers.lock().unwrap();
-            (t.get(cmd).before(uses, place), t.debug)
+            let debug = t.debug;
+            (how(t.get(cmd), uses), debug)
         };
         if need.is_some() && debug {
             let bt = std::backtrace::Backtrace::force_capture().to_string();

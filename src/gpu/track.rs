@@ -5,8 +5,11 @@
 //! visible to it; after reads, a later write waits for them; reads after reads and
 //! commands on other buffers get none. Barriers recorded by hand count too, so the tracker
 //! places only what they leave out (zero where the hand placement is complete).
-//! Draws are tracked but never given a barrier (none may be recorded inside a rendering
-//! scope): a hazard found there is counted in `unplaced`.
+//! Draws get their barriers before their rendering scope begins: the pipelines drawn there
+//! declare their uses first (`GraphicsPipeline::prepare`), and a draw in the scope finds
+//! its uses declared. A draw that was not declared is tracked but never given a barrier
+//! (none may be recorded inside a rendering scope): a hazard found there is counted in
+//! `unplaced`. Host reads after the fence are uses of the host stage.
 use super::sync::Access;
 use ash::vk;
 use std::collections::HashMap;
@@ -37,6 +40,12 @@ impl BufferUse {
         let a = vk::AccessFlags2::TRANSFER_READ;
         let w = vk::AccessFlags2::TRANSFER_WRITE;
         Self::at(buffer, Stages::ALL_TRANSFER, (!write, a), (write, w))
+    }
+
+    /// The host reading the buffer (mapped) after the command buffer's fence.
+    pub fn host(buffer: vk::Buffer) -> Self {
+        let a = vk::AccessFlags2::HOST_READ;
+        Self::at(buffer, Stages::HOST, (true, a), (false, Accesses::NONE))
     }
 
     pub fn indirect(buffer: vk::Buffer) -> Self {
@@ -71,6 +80,16 @@ impl BufferUse {
             ..self
         }
     }
+}
+
+/// `d` (a declared use) covers `u`: the same buffer, stage and accesses, over its bytes.
+fn covers(d: &BufferUse, u: &BufferUse) -> bool {
+    d.buffer == u.buffer
+        && d.stage.contains(u.stage)
+        && d.read.contains(u.read)
+        && d.write.contains(u.write)
+        && d.range.0 <= u.range.0
+        && u.range.1 <= d.range.1
 }
 
 fn overlap(a: (u64, u64), b: (u64, u64)) -> bool {
@@ -191,6 +210,9 @@ pub struct Tracker {
     /// Uses of the draws of the rendering scope being recorded: checked against what came
     /// before the scope, recorded at its end (draws of one scope are not ordered).
     deferred: Vec<BufferUse>,
+    /// Uses of the next rendering scope's draws, declared (their barriers placed and the
+    /// uses recorded) before it began.
+    declared: Vec<BufferUse>,
 }
 
 impl Tracker {
@@ -198,6 +220,16 @@ impl Tracker {
     /// recorded after it. `place`: whether the barrier will be recorded (else a hazard is
     /// counted in `unplaced`).
     pub fn before(&mut self, uses: &[BufferUse], place: bool) -> Option<(Access, Access)> {
+        // A draw's uses declared before its scope are already recorded.
+        let undeclared: Vec<BufferUse> = match place {
+            true => uses.to_vec(),
+            false => uses
+                .iter()
+                .filter(|u| !self.declared.iter().any(|d| covers(d, u)))
+                .copied()
+                .collect(),
+        };
+        let uses = &undeclared[..];
         let none = Access {
             stage: Stages::NONE,
             access: Accesses::NONE,
@@ -243,8 +275,39 @@ impl Tracker {
         barrier
     }
 
+    /// The draws of the next rendering scope will have `uses`: the barrier they need is
+    /// placed now (returned), and the scope's draws find them declared.
+    pub fn declare(&mut self, uses: &[BufferUse]) -> Option<(Access, Access)> {
+        let b = self.before(uses, true);
+        self.declared.extend_from_slice(uses);
+        b
+    }
+
+    /// The host reads `uses` (host-stage uses) after the fence: the barrier that makes
+    /// their writes visible there. A buffer with no use in this command buffer gets one
+    /// from every device write (its last write was in an earlier one).
+    pub fn host_read(&mut self, uses: &[BufferUse]) -> Option<(Access, Access)> {
+        let unknown = uses.iter().any(|u| !self.buffers.contains_key(&u.buffer));
+        let placed = self.before(uses, true);
+        if !unknown {
+            return placed;
+        }
+        let all =
+            super::sync::COMPUTE_WRITE | super::sync::TRANSFER_WRITE | super::sync::FRAGMENT_WRITE;
+        let host = super::sync::HOST_READ;
+        if placed.is_none() {
+            self.placed += 1;
+        }
+        self.barrier(all, host);
+        Some(match placed {
+            Some((f, t)) => (f | all, t | host),
+            None => (all, host),
+        })
+    }
+
     /// The rendering scope ended: its draws' uses are recorded.
     pub fn end_scope(&mut self) {
+        self.declared.clear();
         for u in std::mem::take(&mut self.deferred) {
             self.buffers.entry(u.buffer).or_default().record(&u);
         }

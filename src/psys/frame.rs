@@ -3,7 +3,7 @@
 use super::gpu::Passes;
 use super::system::{FrameInfo, ParticleSystem};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Context, Scopes};
+use crate::gpu::{Context, Scopes};
 use crate::render::Camera;
 use ash::vk;
 
@@ -37,11 +37,6 @@ pub fn record_simulation(
     for s in systems.iter_mut() {
         s.record_sort(ctx, cmd, prof, passes, f)?;
     }
-    ctx.barrier(
-        cmd,
-        sync::COMPUTE_WRITE,
-        sync::GRAPHICS_READ | sync::INDIRECT_READ,
-    );
     Ok(())
 }
 

@@ -11,7 +11,7 @@ use super::spec::{EventKind, EventSpec};
 use super::spec::{Shape, SystemSpec};
 use super::sprite;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, Guard, Scopes};
+use crate::gpu::{Buffer, Context, Guard, Scopes};
 use crate::kinds::{Integrator, SortAlgo, SpriteMode};
 use crate::primitives::counting::CountingBuffers;
 use crate::primitives::neighbors::NeighborBuffers;
@@ -410,12 +410,6 @@ impl ParticleSystem {
         f: &FrameInfo,
         births: u32,
     ) {
-        // A previous step recorded in the same command buffer, or a draw, read the lists.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE | sync::GRAPHICS_READ,
-            sync::COMPUTE_READ,
-        );
         self.frames += 1;
         self.last_time = f.time + f.dt as f64;
         let push = self.push(f, f.time, births);

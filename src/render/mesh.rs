@@ -76,14 +76,22 @@ impl MeshView {
         })
     }
 
-    /// Draw the mesh (inside a rendering scope of a colour + depth target).
-    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, m: &MeshDraw) {
-        let bufs = MeshBufs {
+    /// Declare the draw of `m` in the next rendering scope (before it begins).
+    pub fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, m: &MeshDraw) {
+        self.pipeline.prepare(ctx, cmd, &Self::bufs(m));
+    }
+
+    fn bufs<'a>(m: &MeshDraw<'a>) -> MeshBufs<'a> {
+        MeshBufs {
             pos: m.pos,
             nrm: m.nrm,
             indices: m.indices,
-        };
-        self.pipeline.bind(ctx, cmd, &bufs, &self.push);
+        }
+    }
+
+    /// Draw the mesh (inside a rendering scope of a colour + depth target).
+    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, m: &MeshDraw) {
+        self.pipeline.bind(ctx, cmd, &Self::bufs(m), &self.push);
         ctx.draw(cmd, 3 * m.triangles, 1);
     }
 

@@ -57,6 +57,11 @@ impl PointsView {
         })
     }
 
+    /// Declare the draw of the particles in the next rendering scope (before it begins).
+    pub fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, pos: &Buffer, color: &Buffer) {
+        self.pipeline.prepare(ctx, cmd, &PointsBufs { pos, color });
+    }
+
     /// Draw `n` particles (inside a rendering scope).
     pub fn draw(
         &self,

@@ -5,7 +5,7 @@ use crate::config::Switches;
 use crate::config::{Neighbors, RenderKind, ShowMesh, Skinning, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::target::save_rgba;
-use crate::gpu::{sync, Context, FrameWork, Guard, Profiler};
+use crate::gpu::{Context, FrameWork, Guard, Profiler};
 use crate::render::Camera;
 use crate::report::{Report, Summary};
 use crate::scene::character::{CharacterStats, SceneCharacter};

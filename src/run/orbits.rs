@@ -23,7 +23,6 @@ impl FrameWork for OrbitsWork<'_> {
         self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
         prof.end(ctx, cmd);
         // New positions -> the point view's vertex shader.
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::GRAPHICS_READ);
         let (s, save) = (&self.scene, self.frames.save(frame));
         self.view.record(
             ctx,

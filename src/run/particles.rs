@@ -153,6 +153,14 @@ impl SceneSystems {
         record_simulation(ctx, cmd, prof, &self.passes, &mut self.systems, &f)
     }
 
+    /// Declare the draws of `record_draws` for the next rendering scope (before it begins).
+    pub fn prepare_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: u64, opaque: bool) {
+        let f = self.frame(frame);
+        for s in self.systems.iter().filter(|s| s.opaque() == opaque) {
+            s.prepare_draw(ctx, cmd, &self.passes, &f);
+        }
+    }
+
     /// Record the draws (inside a rendering scope) of the systems drawn as points
     /// (opaque, depth-written) or of the others (alpha-blended, depth-tested only).
     pub fn record_draws(&self, ctx: &Context, cmd: vk::CommandBuffer, frame: u64, opaque: bool) {
@@ -183,6 +191,10 @@ pub struct SystemsFrame<'a> {
 }
 
 impl crate::viewer::Overlay for SystemsFrame<'_> {
+    fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, opaque: bool) {
+        self.scene.prepare_draws(ctx, cmd, self.frame, opaque);
+    }
+
     fn draw_opaque(&self, ctx: &Context, cmd: vk::CommandBuffer) {
         self.scene.record_draws(ctx, cmd, self.frame, true);
     }
@@ -241,6 +253,14 @@ impl FrameWork for ParticleWork<'_> {
         let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
         prof.begin(ctx, cmd, Passes::DRAW);
+        if let Some(Body {
+            ch, view: Some(v), ..
+        }) = &self.body
+        {
+            v.prepare(ctx, cmd, &ch.surface());
+        }
+        self.scene.prepare_draws(ctx, cmd, frame, true);
+        self.scene.prepare_draws(ctx, cmd, frame, false);
         let b = self.background;
         self.target
             .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);

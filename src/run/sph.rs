@@ -37,12 +37,6 @@ impl FrameWork for SphWork<'_> {
         let t = self.stepper.sim_time;
         self.targets
             .record_after(ctx, cmd, prof, &self.st, t, (frame, slot))?;
-        // The step's positions -> the view's copies and shaders.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::TRANSFER_READ | sync::GRAPHICS_READ,
-        );
         if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
             e.record(ctx, cmd, &self.st, slot, self.stepper.sim_time);
         }

@@ -3,7 +3,7 @@
 use crate::character::{self, anim, skin::Skinner, Animator, Character};
 use crate::config::{ShowMesh, Skinning};
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Context, Guard};
+use crate::gpu::{Context, Guard};
 use crate::render::mesh::MeshDraw;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -280,11 +280,6 @@ impl SceneCharacter {
         prof.begin(ctx, cmd, crate::character::skin::SkinPass::NAME);
         self.skinner.record(ctx, cmd, &joints)?;
         prof.end(ctx, cmd);
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::GRAPHICS_READ | sync::COMPUTE_READ,
-        );
         Ok(())
     }
 

@@ -9,7 +9,7 @@ use crate::config::{EmitterKind, Switches};
 use crate::emission::emit::EmitSettings;
 use crate::emission::emitter::Emitter;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, Context, MemoryLocation};
+use crate::gpu::{Buffer, Context, MemoryLocation};
 use ash::vk;
 use serde::{Deserialize, Serialize};
 
@@ -261,7 +261,7 @@ impl EmissionMetrics {
         let rb = &self.readbacks[slot];
         ctx.copy(cmd, &e.pass.stats, 0, rb, 0, 16);
         ctx.copy(cmd, &e.pass.counts, 0, rb, 16, 16);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ);
+        ctx.host_reads(cmd, &[rb]);
         e.pass.record_clear_stats(ctx, cmd);
     }
 

@@ -4,7 +4,7 @@
 //! mean and maximum. Reported per step in `steps.csv` and summed up in `summary.json`.
 use super::solver::SphState;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
@@ -193,8 +193,8 @@ impl StepErrors {
     }
 
     /// At the end of a frame's commands: the records -> the host.
-    pub fn record_frame_end(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        ctx.barrier(cmd, sync::COMPUTE_WRITE, sync::HOST_READ);
+    pub fn record_frame_end(&self, ctx: &Context, cmd: vk::CommandBuffer, slot: usize) {
+        ctx.host_reads(cmd, &[&self.records[slot]]);
     }
 
     /// After the slot's fence: its frame's first `steps` records.

@@ -3,7 +3,7 @@
 //! unstable, naming the frame and the quantity; CFL steps use the largest speed.
 use super::solver::SphState;
 use crate::error::{Error, Result};
-use crate::gpu::{sync, Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -82,7 +82,7 @@ impl Health {
         };
         self.pipeline.dispatch(ctx, cmd, &bufs, &st.n, st.n as u64);
         ctx.copy(cmd, &self.out, 0, &self.readbacks[slot], 0, 16);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // copy -> the host
+        ctx.host_reads(cmd, &[&self.readbacks[slot]]);
     }
 
     /// After the slot's fence: the health, or the error of an unstable frame.

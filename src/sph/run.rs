@@ -98,7 +98,7 @@ impl Stepper {
             self.errors.record(ctx, cmd, st, slot, k)?;
             prof.end(ctx, cmd);
         }
-        self.errors.record_frame_end(ctx, cmd);
+        self.errors.record_frame_end(ctx, cmd, slot);
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
         prof.begin(ctx, cmd, "sph/health");

@@ -19,7 +19,7 @@ fn step_density_errors_match_the_cpu() {
                 solver.record_step(&ctx, cmd, &mut Labels, &mut st).unwrap();
                 errors.record(&ctx, cmd, &st, 0, k).unwrap();
             }
-            errors.record_frame_end(&ctx, cmd);
+            errors.record_frame_end(&ctx, cmd, 0);
         })
         .unwrap();
     }

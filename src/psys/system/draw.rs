@@ -92,13 +92,9 @@ impl ParticleSystem {
 
     /// Record the draw (inside a rendering scope; the step's and sort's writes visible to
     /// vertex shaders and indirect reads).
-    pub fn record_draw(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        passes: &Passes,
-        f: &FrameInfo,
-    ) {
+    /// The draw's buffers, push constants and whether it draws every slot (1) or the
+    /// count a pass wrote (0).
+    fn draw_setup(&self, f: &FrameInfo) -> (DrawBufs<'_>, DrawPush, u32) {
         let (r, u) = f.cam.axes();
         let t = (f.time + f.dt as f64) as f32;
         let (order, offset, identity) = match (self.sort, &self.counting) {
@@ -130,6 +126,35 @@ impl ParticleSystem {
             order,
             sprite: &self.sprite,
         };
+        (bufs, push, identity)
+    }
+
+    /// Declare this system's draw in the next rendering scope (before it begins).
+    pub fn prepare_draw(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let (bufs, _, identity) = self.draw_setup(f);
+        passes.pipeline(self.mode).prepare(ctx, cmd, &bufs);
+        if identity == 0 {
+            ctx.prepare_draws(
+                cmd,
+                &[crate::gpu::track::BufferUse::indirect(self.counters.raw)],
+            );
+        }
+    }
+
+    pub fn record_draw(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        passes: &Passes,
+        f: &FrameInfo,
+    ) {
+        let (bufs, push, identity) = self.draw_setup(f);
         passes.pipeline(self.mode).bind(ctx, cmd, &bufs, &push);
         if identity == 1 {
             ctx.draw(cmd, vertices(self.mode) * self.capacity, 1);

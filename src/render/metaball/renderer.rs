@@ -9,8 +9,8 @@ use super::stats::{FrameStats, GpuStats};
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::{
-    sync, Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
-    Labels, Scopes,
+    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
+    Scopes,
 };
 use crate::kinds::ListKind;
 use crate::primitives::bounds::BoundsPass;
@@ -177,8 +177,7 @@ impl MetaballRenderer {
     }
 
     /// `record` without the readbacks: the picture in `b.pixels` (and `b.scene_depth` with
-    /// the opaque layer), for layers drawn over it before `record_readback`. Long because
-    /// it is the frame's pass order with the barriers its draws need between passes.
+    /// the opaque layer), for layers drawn over it before `record_readback`.
     #[allow(clippy::too_many_arguments)]
     pub fn record_picture(
         &self,
@@ -200,12 +199,6 @@ impl MetaballRenderer {
             )));
         }
         let params = RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on);
-        // The previous frame's passes and copies may still read what is reset here.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_READ | sync::GRAPHICS_READ | sync::TRANSFER_READ,
-            sync::TRANSFER_WRITE,
-        );
         ctx.update(cmd, &b.params, 0, &[params]);
         ctx.fill(cmd, &b.stats, 0);
         match s.list {
@@ -213,23 +206,12 @@ impl MetaballRenderer {
             ListKind::Abuffer => ctx.fill(cmd, &b.heads, u32::MAX),
             ListKind::None => {}
         }
-        // Parameters, zeroed counters and list heads -> every pass of the frame.
-        ctx.barrier(
-            cmd,
-            sync::TRANSFER_WRITE,
-            sync::COMPUTE_READ | sync::GRAPHICS_READ,
-        );
         scopes.begin(ctx, cmd, "bounds");
         self.bounds.record(ctx, cmd, centers, n as u64, &b.bounds)?;
         scopes.end(ctx, cmd);
-        // The metaballs' box -> billboards and march.
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::GRAPHICS_READ | sync::COMPUTE_READ,
-        );
         let bufs = self.bufs(b, centers);
         let draw = |p: &Graphics| {
+            p.prepare(ctx, cmd, &bufs);
             begin_empty_rendering(ctx, cmd, w, h);
             p.bind(ctx, cmd, &bufs, &());
             ctx.draw(cmd, 6, n);
@@ -239,7 +221,6 @@ impl MetaballRenderer {
             scopes.begin(ctx, cmd, "count");
             draw(count);
             scopes.end(ctx, cmd);
-            ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::COMPUTE_READ); // counts -> scan
             scopes.begin(ctx, cmd, "scan");
             self.scan.record(
                 ctx,
@@ -251,12 +232,6 @@ impl MetaballRenderer {
                 &b.scan,
             )?;
             scopes.end(ctx, cmd);
-            // Starts -> the total's copy and the fill.
-            ctx.barrier(
-                cmd,
-                sync::COMPUTE_WRITE,
-                sync::TRANSFER_READ | sync::GRAPHICS_READ,
-            );
             ctx.copy(
                 cmd,
                 &b.offsets,
@@ -265,18 +240,11 @@ impl MetaballRenderer {
                 GpuStats::SBUFFER_FRAGMENTS_OFFSET,
                 4,
             );
-            // The total in the stats -> the fill's and march's atomics on the stats.
-            ctx.barrier(
-                cmd,
-                sync::TRANSFER_WRITE,
-                sync::GRAPHICS_READ | sync::COMPUTE_READ,
-            );
         }
         if let Some(fill) = &self.fill {
             scopes.begin(ctx, cmd, "fill");
             draw(fill);
             scopes.end(ctx, cmd);
-            ctx.barrier(cmd, sync::FRAGMENT_WRITE, sync::COMPUTE_READ); // lists -> sort, march
         }
         let groups = px.div_ceil(self.march.local_size as u64);
         if let Some((depths, sort)) = &self.sort {
@@ -292,8 +260,7 @@ impl MetaballRenderer {
         Ok(())
     }
 
-    /// Copy the stats and pixels (made visible to copies by the caller) into this slot's
-    /// readbacks.
+    /// Copy the stats and pixels into this slot's readbacks, for the host.
     pub fn record_readback(
         &self,
         ctx: &Context,
@@ -304,7 +271,7 @@ impl MetaballRenderer {
         let px = self.settings.pixels();
         ctx.copy(cmd, &b.stats, 0, &b.stats_readback[slot], 0, GpuStats::SIZE);
         ctx.copy(cmd, &b.pixels, 0, &b.pixels_readback[slot], 0, px * 4);
-        ctx.barrier(cmd, sync::TRANSFER_WRITE, sync::HOST_READ); // readbacks -> the host
+        ctx.host_reads(cmd, &[&b.stats_readback[slot], &b.pixels_readback[slot]]);
     }
 
     /// The statistics of the frame last rendered in `slot` (after its fence).
