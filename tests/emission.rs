@@ -83,7 +83,7 @@ fn check_apart(layout: &UvLayout, texels: &[(u32, usize, Vec3)], size: [u32; 2])
 }
 
 #[test]
-fn atlas_packing_keeps_parts_apart() {
+fn generated_atlas_keeps_parts_apart_at_one_scale() {
     let ctx = common::ctx();
     let size = [256, 256];
     // Generated: the walker's capsules, one part each.
@@ -131,7 +131,14 @@ fn atlas_packing_keeps_parts_apart() {
         dens.len() >= 5 && hi / lo < 1.35,
         "texel densities per part {dens:?}"
     );
-    // Two UV sets in one file: CesiumMan and a copy 1 m to the side, both in [0,1]^2.
+    common::finish(&ctx);
+}
+
+/// Two UV sets in one file: CesiumMan and a copy 1 m to the side, both in [0,1]^2.
+#[test]
+fn two_uv_sets_in_one_mesh_pack_apart() {
+    let ctx = common::ctx();
+    let size = [256, 256];
     let ch: Character = character::load(&asset("CesiumMan.glb")).unwrap();
     let mut m = ch.mesh.clone();
     let (v, t) = (m.vertices() as u32, m.triangles() as u32);

@@ -86,6 +86,19 @@ fn run(ctx: &Context, ch: &Character, mats: &[Mat4], size: [u32; 2]) -> (Vec<u32
     (valid, pos)
 }
 
+/// Triangle `g`'s signed UV area (in texels) and how far texel `i`'s centre lies inside
+/// it (texels; negative: outside).
+fn uv_triangle_at(ch: &Character, g: usize, i: u32) -> (f32, f32) {
+    let u = [0, 1, 2].map(|k| ch.mesh.uvs[ch.mesh.indices[3 * g + k] as usize] * 256.0);
+    let area = (u[1] - u[0]).perp_dot(u[2] - u[0]);
+    let q = Vec2::new((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5);
+    let inside = [(u[0], u[1]), (u[1], u[2]), (u[2], u[0])]
+        .iter()
+        .map(|(a, b)| (*b - *a).perp_dot(q - *a) * area.signum() / (*b - *a).length())
+        .fold(f32::INFINITY, f32::min);
+    (area, inside)
+}
+
 #[test]
 fn uv_positions_match_a_cpu_rasterisation() {
     let ctx = common::ctx();
@@ -146,13 +159,7 @@ fn uv_positions_match_a_cpu_rasterisation() {
             // give a sliver a texel) or touching the centre within rounding.
             let g = p[3] as usize - 1;
             if g != tri {
-                let u = [0, 1, 2].map(|k| ch.mesh.uvs[ch.mesh.indices[3 * g + k] as usize] * 256.0);
-                let area = (u[1] - u[0]).perp_dot(u[2] - u[0]);
-                let q = Vec2::new((i % 256) as f32 + 0.5, (i / 256) as f32 + 0.5);
-                let inside = [(u[0], u[1]), (u[1], u[2]), (u[2], u[0])]
-                    .iter()
-                    .map(|(a, b)| (*b - *a).perp_dot(q - *a) * area.signum() / (*b - *a).length())
-                    .fold(f32::INFINITY, f32::min);
+                let (area, inside) = uv_triangle_at(&ch, g, i);
                 assert!(
                     area.abs() < 1e-3 || inside > -0.01,
                     "texel {i}: triangle {g} (area {area}, {inside} texels out) instead of {tri}"
@@ -171,14 +178,19 @@ fn uv_positions_match_a_cpu_rasterisation() {
             .enumerate()
             .all(|(i, p)| (p[3] >= 1.0) == got.contains(&(i as u32))));
     }
-    // A mesh without UVs is refused with the reason.
+    common::finish(&ctx);
+}
+
+/// A mesh without UVs is refused with the reason.
+#[test]
+fn a_mesh_without_uvs_is_refused() {
+    let size = [256, 256];
     let walker = character::load("builtin:walker").unwrap();
     let e = UvLayout::from_mesh(&walker.mesh, size)
         .err()
         .unwrap()
         .to_string();
     assert!(e.contains("no UVs"), "{e}");
-    common::finish(&ctx);
 }
 
 /// Algorithm 1 on CesiumMan's surface: births capped by the budget, on the surface, with

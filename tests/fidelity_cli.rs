@@ -30,7 +30,7 @@ fn run(dir: &std::path::Path, name: &str, frames: &str, extra: &[&str]) -> serde
 }
 
 #[test]
-fn metrics_presets_and_spacing_work_from_the_command_line() {
+fn metrics_and_presets_work_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
     let s = run(
         dir.path(),
@@ -86,7 +86,12 @@ fn metrics_presets_and_spacing_work_from_the_command_line() {
         fill(&s),
         fill(&th)
     );
-    // A finer spacing: more particles, mass rho0 s^3, h and the step scaled.
+}
+
+/// A finer spacing: more particles, mass rho0 s^3, h and the step scaled.
+#[test]
+fn the_spacing_switch_scales_the_fluid() {
+    let dir = tempfile::tempdir().unwrap();
     let fine = run(dir.path(), "fine", "1", &["--fluid", "spacing=0.02"]);
     let coarse = run(dir.path(), "coarse", "1", &[]);
     let n = |s: &serde_json::Value| s["stats"]["particles"].as_f64().unwrap();
@@ -116,7 +121,12 @@ fn metrics_presets_and_spacing_work_from_the_command_line() {
         steps(&fine) > steps(&coarse),
         "more steps per frame at a finer spacing"
     );
-    // Dual quaternions skin the control particles too.
+}
+
+/// Dual quaternions skin the control particles too.
+#[test]
+fn dqs_skins_the_control_particles() {
+    let dir = tempfile::tempdir().unwrap();
     let dqs = run(dir.path(), "dqs", "2", &["--skinning", "dqs"]);
     assert!(
         dqs["stats"]["control"]["targets"][0]["control_particles"]

@@ -139,6 +139,32 @@ fn orbits_step_matches_cpu_reference() {
     common::finish(&ctx);
 }
 
+type Disc = ([f32; 2], f32, [f32; 3]);
+
+/// The colour the points view gives the pixel centred at clip `(cx, cy)`: a disc's shaded
+/// colour, or the blue clear colour; None within 1.5 pixels of a disc's rim.
+fn expected_pixel(discs: &[Disc], (cx, cy): (f32, f32), side: u32) -> Option<[u8; 4]> {
+    let mut expected = [0u8, 0, 255, 255];
+    for (c, r, rgb) in discs {
+        // Distance in the disc's own uv (quad spans [-r, r] in both clip axes).
+        let (u, v) = ((cx - c[0]) / r, (cy - c[1]) / r);
+        let d2 = u * u + v * v;
+        let px_r = 1.5 * 2.0 / (side as f32 * r); // 1.5 pixels in uv units
+        if (d2.sqrt() - 1.0).abs() < px_r {
+            return None;
+        } else if d2 < 1.0 {
+            let s = 0.35 + 0.65 * (1.0 - d2).sqrt();
+            expected = [
+                (rgb[0] * s * 255.0).round() as u8,
+                (rgb[1] * s * 255.0).round() as u8,
+                (rgb[2] * s * 255.0).round() as u8,
+                255,
+            ];
+        }
+    }
+    Some(expected)
+}
+
 #[test]
 fn graphics_round_trip_matches_expected_pixels() {
     let ctx = common::ctx();
@@ -170,6 +196,7 @@ fn graphics_round_trip_matches_expected_pixels() {
     };
     let clear = [0.0, 0.0, 1.0, 1.0];
     ctx.one_shot(|cmd| {
+        view.prepare(&ctx, cmd, &bpos, &bcol);
         target.begin_rendering(&ctx, cmd, clear);
         view.draw(&ctx, cmd, &bpos, &bcol, 2, &push);
         target.end_rendering(&ctx, cmd);
@@ -184,28 +211,9 @@ fn graphics_round_trip_matches_expected_pixels() {
             // Pixel centre in clip space.
             let cx = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
             let cy = (y as f32 + 0.5) / h as f32 * 2.0 - 1.0;
-            let mut expected = [0u8, 0, 255, 255];
-            let mut ambiguous = false;
-            for (c, r, rgb) in &discs {
-                // Distance in the disc's own uv (quad spans [-r, r] in both clip axes).
-                let (u, v) = ((cx - c[0]) / r, (cy - c[1]) / r);
-                let d2 = u * u + v * v;
-                let px_r = 1.5 * 2.0 / (w.min(h) as f32 * r); // 1.5 pixels in uv units
-                if (d2.sqrt() - 1.0).abs() < px_r {
-                    ambiguous = true;
-                } else if d2 < 1.0 {
-                    let s = 0.35 + 0.65 * (1.0 - d2).sqrt();
-                    expected = [
-                        (rgb[0] * s * 255.0).round() as u8,
-                        (rgb[1] * s * 255.0).round() as u8,
-                        (rgb[2] * s * 255.0).round() as u8,
-                        255,
-                    ];
-                }
-            }
-            if ambiguous {
+            let Some(expected) = expected_pixel(&discs, (cx, cy), w.min(h)) else {
                 continue;
-            }
+            };
             if expected[2] == 255 {
                 outside += 1
             } else {

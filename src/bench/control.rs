@@ -59,7 +59,8 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
 type Coverage = Vec<(f64, f64)>;
 
 /// One run of the scene with adaptive mode `mode` and velocity gain `k`: its row, the
-/// device's name and the coverage over time.
+/// device's name and the coverage over time. Long because its row lists every measured
+/// column.
 fn one_run(
     opts: &BenchOptions,
     scene: &str,

@@ -77,14 +77,7 @@ fn group_only_control(solver: &[&str]) {
     let (fa, fb, fc) = (g1(&pa), g1(&pb), g1(&pc));
     assert_eq!(fa.len(), fb.len());
     // The premise: the free groups never meet (else control of one rightly moves the other).
-    let reach = |v: &[(u32, [f32; 3])], g: u32| {
-        let x = v.iter().filter(|x| x.0 == g).map(|x| x.1[0]);
-        (
-            x.clone().fold(f32::MAX, f32::min),
-            x.fold(f32::MIN, f32::max),
-        )
-    };
-    let gap = reach(&pa, 1).0 - reach(&pa, 0).1;
+    let gap = extent_x(&pa, 1).0 - extent_x(&pa, 0).1;
     assert!(
         gap > 0.1,
         "the free groups came within {gap} m of each other"
@@ -130,6 +123,15 @@ fn group_only_control(solver: &[&str]) {
         g0(&pb),
         g0(&pa)
     );
+}
+
+/// The smallest and largest x of group `g`'s points.
+fn extent_x(v: &[(u32, [f32; 3])], g: u32) -> (f32, f32) {
+    let x = v.iter().filter(|x| x.0 == g).map(|x| x.1[0]);
+    (
+        x.clone().fold(f32::MAX, f32::min),
+        x.fold(f32::MIN, f32::max),
+    )
 }
 
 /// Centroid and RMS spread of a body of points.

@@ -58,6 +58,23 @@ color = {{ mean = [1.0, 0.2, 0.1, 1.0], variance = [0.0, 0.0, 0.0, 0.0] }}
     s
 }
 
+/// Mean channel difference of two frames over the 5 x 5 pixels around `(x, y)`.
+fn diff(a: &image::RgbaImage, b: &image::RgbaImage, (x, y): (i32, i32)) -> f32 {
+    let mut sum = 0.0;
+    for dy in -2..=2 {
+        for dx in -2..=2 {
+            let (pa, pb) = (
+                a.get_pixel((x + dx) as u32, (y + dy) as u32),
+                b.get_pixel((x + dx) as u32, (y + dy) as u32),
+            );
+            sum += (0..3)
+                .map(|k| (pa[k] as f32 - pb[k] as f32).abs())
+                .sum::<f32>();
+        }
+    }
+    sum / 75.0
+}
+
 #[test]
 fn particles_composite_with_the_metaball_fluid_by_depth() {
     let dir = tempfile::tempdir().unwrap();
@@ -106,22 +123,6 @@ fn particles_composite_with_the_metaball_fluid_by_depth() {
             "{p} -> {x},{y}"
         );
         (x, y)
-    };
-    // Mean channel difference of two frames over the 5 x 5 pixels around `at`.
-    let diff = |a: &image::RgbaImage, b: &image::RgbaImage, (x, y): (i32, i32)| {
-        let mut sum = 0.0;
-        for dy in -2..=2 {
-            for dx in -2..=2 {
-                let (pa, pb) = (
-                    a.get_pixel((x + dx) as u32, (y + dy) as u32),
-                    b.get_pixel((x + dx) as u32, (y + dy) as u32),
-                );
-                sum += (0..3)
-                    .map(|k| (pa[k] as f32 - pb[k] as f32).abs())
-                    .sum::<f32>();
-            }
-        }
-        sum / 75.0
     };
     let fluid = render("fluid", sheet_scene("sprites", None));
     // The block's front face, and the sheet beside the block.

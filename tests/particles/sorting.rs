@@ -7,12 +7,95 @@ fn depth(cam: &Camera, p: Vec3) -> f32 {
     (cam.view_proj() * p.extend(1.0)).w
 }
 
+/// A ballistic system with `integrator`, sorted by `sort` every frame for 30 frames: the
+/// drawn slots are the live ones, back to front.
+fn sorted_back_to_front(
+    ctx: &Context,
+    passes: &Passes,
+    cam: &Camera,
+    integrator: Integrator,
+    sort: SortAlgo,
+) {
+    let cells = fluidform::psys::system::DEPTH_CELLS as f32;
+    let mut spec = ballistic(integrator, 3000);
+    spec.sort = Some(sort);
+    spec.emitter.rate = Some(Vary {
+        mean: 150.0,
+        variance: 50.0,
+    });
+    spec.particle.life = Vary {
+        mean: 0.25,
+        variance: 0.1,
+    };
+    let mut s = ParticleSystem::new(ctx, passes, &spec, 0, 11).unwrap();
+    let dt = 1.0 / 60.0;
+    let last = 30u64;
+    ctx.one_shot(|cmd| {
+        for k in 0..=last {
+            let f = frame(cam, k, dt);
+            s.record_step(ctx, cmd, &mut Labels, passes, &f);
+            s.record_sort(ctx, cmd, &mut Labels, passes, &f).unwrap();
+        }
+    })
+    .unwrap();
+    let d = s.read(ctx).unwrap();
+    let (_, order) = s.read_sorted(ctx).unwrap();
+    let t = s.time_now();
+    let g = Vec3::new(0.0, -9.81, 0.0);
+    let drawn: Vec<u32> = order
+        .iter()
+        .copied()
+        .take_while(|&x| x != u32::MAX)
+        .collect();
+    assert!(
+        order[drawn.len()..].iter().all(|&x| x == u32::MAX),
+        "{sort:?}: slots after the end"
+    );
+    let pos = |slot: u32| {
+        let (p, v) = (d.pos[slot as usize], d.vel[slot as usize]);
+        match integrator {
+            Integrator::Closed => closed_pos(
+                Vec3::from_slice(&p[..3]),
+                Vec3::from_slice(&v[..3]),
+                g,
+                (t - p[3] as f64) as f32,
+            ),
+            _ => Vec3::from_slice(&p[..3]),
+        }
+    };
+    // The drawn set is exactly the live particles.
+    let mut a: Vec<u32> = drawn.clone();
+    let mut b: Vec<u32> = match integrator {
+        Integrator::Closed => d.live_closed(t),
+        _ => d.alive.clone(),
+    };
+    a.sort();
+    b.sort();
+    assert!(a.len() > 500, "{integrator:?}/{sort:?}: {} drawn", a.len());
+    assert_eq!(
+        a, b,
+        "{integrator:?}/{sort:?}: drawn slots are the live ones"
+    );
+    // Counting: one log-depth cell of slack.
+    let slack = match sort {
+        SortAlgo::Counting => 1.0 + 2.0 * (cam.far / cam.near).ln() / cells,
+        _ => 1.0 + 1e-6,
+    };
+    for w in drawn.windows(2) {
+        let (d0, d1) = (depth(cam, pos(w[0])), depth(cam, pos(w[1])));
+        assert!(
+            d1 <= d0 * slack,
+            "{integrator:?}/{sort:?}: depth {d1} after {d0}"
+        );
+    }
+    s.destroy(ctx);
+}
+
 #[test]
 fn sprites_are_back_to_front_after_every_sort() {
     let ctx = common::ctx();
     let passes = Passes::new(&ctx).unwrap();
     let cam = cam();
-    let cells = fluidform::psys::system::DEPTH_CELLS as f32;
     for (integrator, sort) in [
         (Integrator::Euler, SortAlgo::OddEven),
         (Integrator::Euler, SortAlgo::Bitonic),
@@ -21,83 +104,7 @@ fn sprites_are_back_to_front_after_every_sort() {
         (Integrator::Closed, SortAlgo::OddEven),
         (Integrator::Closed, SortAlgo::Counting),
     ] {
-        let mut spec = ballistic(integrator, 3000);
-        spec.sort = Some(sort);
-        spec.emitter.rate = Some(Vary {
-            mean: 150.0,
-            variance: 50.0,
-        });
-        spec.particle.life = Vary {
-            mean: 0.25,
-            variance: 0.1,
-        };
-        let mut s = ParticleSystem::new(&ctx, &passes, &spec, 0, 11).unwrap();
-        let dt = 1.0 / 60.0;
-        let last = 30u64;
-        ctx.one_shot(|cmd| {
-            for k in 0..=last {
-                let f = frame(&cam, k, dt);
-                s.record_step(&ctx, cmd, &mut Labels, &passes, &f);
-                ctx.barrier(
-                    cmd,
-                    fluidform::gpu::sync::COMPUTE_WRITE,
-                    fluidform::gpu::sync::COMPUTE_READ,
-                );
-                s.record_sort(&ctx, cmd, &mut Labels, &passes, &f).unwrap();
-            }
-        })
-        .unwrap();
-        let d = s.read(&ctx).unwrap();
-        let (_, order) = s.read_sorted(&ctx).unwrap();
-        let t = s.time_now();
-        let g = Vec3::new(0.0, -9.81, 0.0);
-        let drawn: Vec<u32> = order
-            .iter()
-            .copied()
-            .take_while(|&x| x != u32::MAX)
-            .collect();
-        assert!(
-            order[drawn.len()..].iter().all(|&x| x == u32::MAX),
-            "{sort:?}: slots after the end"
-        );
-        let pos = |slot: u32| {
-            let (p, v) = (d.pos[slot as usize], d.vel[slot as usize]);
-            match integrator {
-                Integrator::Closed => closed_pos(
-                    Vec3::from_slice(&p[..3]),
-                    Vec3::from_slice(&v[..3]),
-                    g,
-                    (t - p[3] as f64) as f32,
-                ),
-                _ => Vec3::from_slice(&p[..3]),
-            }
-        };
-        // The drawn set is exactly the live particles.
-        let mut a: Vec<u32> = drawn.clone();
-        let mut b: Vec<u32> = match integrator {
-            Integrator::Closed => d.live_closed(t),
-            _ => d.alive.clone(),
-        };
-        a.sort();
-        b.sort();
-        assert!(a.len() > 500, "{integrator:?}/{sort:?}: {} drawn", a.len());
-        assert_eq!(
-            a, b,
-            "{integrator:?}/{sort:?}: drawn slots are the live ones"
-        );
-        // Counting: one log-depth cell of slack.
-        let slack = match sort {
-            SortAlgo::Counting => 1.0 + 2.0 * (cam.far / cam.near).ln() / cells,
-            _ => 1.0 + 1e-6,
-        };
-        for w in drawn.windows(2) {
-            let (d0, d1) = (depth(&cam, pos(w[0])), depth(&cam, pos(w[1])));
-            assert!(
-                d1 <= d0 * slack,
-                "{integrator:?}/{sort:?}: depth {d1} after {d0}"
-            );
-        }
-        s.destroy(&ctx);
+        sorted_back_to_front(&ctx, &passes, &cam, integrator, sort);
     }
     let mut passes = passes;
     passes.destroy(&ctx);
