@@ -64,6 +64,8 @@ fn cell(v: &serde_json::Value, digits: usize) -> String {
     v.as_f64().map_or("-".into(), |x| format!("{x:.digits$}"))
 }
 
+/// Every scene with each preset: the table, the CSV, the plots and the frames side by
+/// side. Long because a scene's two runs share its frames and its unstable-run rows.
 pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let mut steps = Steps::new(
         "fidelity",
