@@ -235,6 +235,24 @@ pub struct ControlTarget {
     skinning: Skinning,
 }
 
+/// The inverses of the placed rest matrices (a singular one cannot bind particles).
+fn rest_inverses(ch: &Character, placed_rest: &[Mat4]) -> Result<Vec<Mat4>> {
+    placed_rest
+        .iter()
+        .map(|m| {
+            let inv = m.inverse();
+            match inv.is_finite() {
+                true => Ok(inv),
+                false => Err(Error::Model {
+                    path: ch.source.clone(),
+                    message: "a joint's rest matrix is singular: control particles cannot be bound"
+                        .into(),
+                }),
+            }
+        })
+        .collect()
+}
+
 impl ControlTarget {
     /// Place and bind control particles in `ch` (posed by `anim`) for fluid searched by
     /// `solver`.
@@ -296,21 +314,7 @@ impl ControlTarget {
             influence_sets: sets.min(MAX_INFLUENCES / 4),
             uv_parts: Vec::new(),
         };
-        let rest_inv = placed_rest
-            .iter()
-            .map(|m| {
-                let inv = m.inverse();
-                match inv.is_finite() {
-                    true => Ok(inv),
-                    false => Err(Error::Model {
-                        path: ch.source.clone(),
-                        message:
-                            "a joint's rest matrix is singular: control particles cannot be bound"
-                                .into(),
-                    }),
-                }
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let rest_inv = rest_inverses(ch, &placed_rest)?;
         let settings = desc.settings(fluid);
         let force = ControlForce::new(
             ctx,

@@ -130,6 +130,8 @@ fn create_messenger(
 
 impl Context {
     /// Open the chosen device headless: the one constructor for tests, benches and the CLI.
+    /// Long because every failure releases what was made before it (device, messenger,
+    /// instance) on its own path.
     pub fn new(opts: &ContextOptions) -> Result<Self> {
         let entry = load_entry()?;
         let (instance, has_debug) = create_instance(&entry, opts.validation)?;

@@ -60,7 +60,8 @@ impl DeviceInfo {
     }
 }
 
-/// Read properties and check requirements of one device.
+/// Read properties and check requirements of one device. Long because it fills
+/// `DeviceInfo` field by field from the property and feature chains.
 pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) -> DeviceInfo {
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();

@@ -115,6 +115,54 @@ impl Look {
 impl Scene {
     pub fn validate(&self) -> Result<()> {
         SphSetup::from(self).validate()?;
+        self.validate_fluid_bodies()?;
+        if let Some(c) = &self.character {
+            c.validate(&self.name)?;
+        }
+        if let Some(e) = &self.emission {
+            e.validate(&self.name)?;
+            if self.character.is_none() {
+                return Err(Error::Param(format!(
+                    "scene {}: [emission] needs a [character] to shed from",
+                    self.name
+                )));
+            }
+        }
+        if self.control.is_some() && (self.character.is_none() || !self.has_fluid()) {
+            return Err(Error::Param(format!(
+                "scene {}: [control] needs a [character] and fluid",
+                self.name
+            )));
+        }
+        if !self.targets.is_empty() && !self.has_fluid() {
+            return Err(Error::Param(format!(
+                "scene {}: [[targets]] need fluid",
+                self.name
+            )));
+        }
+        let names = self.control_targets();
+        for (i, t) in self.targets.iter().enumerate() {
+            t.character.validate(&self.name)?;
+            if names[..names.len() - self.targets.len() + i].contains(&t.name) {
+                return Err(Error::Param(format!(
+                    "scene {}: two control targets named '{}'",
+                    self.name, t.name
+                )));
+            }
+        }
+        crate::control::timeline::Timeline::new(&self.name, &self.timeline, &names)?;
+        if !self.has_fluid() && self.character.is_none() {
+            return Err(Error::Param(format!(
+                "scene {}: no fluid (blocks or balls) and no character",
+                self.name
+            )));
+        }
+        self.validate_systems()
+    }
+
+    /// Blocks and balls that are not empty and lie inside the domain (fluid outside it
+    /// would be dropped silently).
+    fn validate_fluid_bodies(&self) -> Result<()> {
         for b in &self.blocks {
             if (0..3).any(|k| b.max[k].is_nan() || b.max[k] <= b.min[k]) {
                 return Err(Error::Param(format!(
@@ -158,48 +206,7 @@ impl Scene {
                 )));
             }
         }
-        if let Some(c) = &self.character {
-            c.validate(&self.name)?;
-        }
-        if let Some(e) = &self.emission {
-            e.validate(&self.name)?;
-            if self.character.is_none() {
-                return Err(Error::Param(format!(
-                    "scene {}: [emission] needs a [character] to shed from",
-                    self.name
-                )));
-            }
-        }
-        if self.control.is_some() && (self.character.is_none() || !self.has_fluid()) {
-            return Err(Error::Param(format!(
-                "scene {}: [control] needs a [character] and fluid",
-                self.name
-            )));
-        }
-        if !self.targets.is_empty() && !self.has_fluid() {
-            return Err(Error::Param(format!(
-                "scene {}: [[targets]] need fluid",
-                self.name
-            )));
-        }
-        let names = self.control_targets();
-        for (i, t) in self.targets.iter().enumerate() {
-            t.character.validate(&self.name)?;
-            if names[..names.len() - self.targets.len() + i].contains(&t.name) {
-                return Err(Error::Param(format!(
-                    "scene {}: two control targets named '{}'",
-                    self.name, t.name
-                )));
-            }
-        }
-        crate::control::timeline::Timeline::new(&self.name, &self.timeline, &names)?;
-        if !self.has_fluid() && self.character.is_none() {
-            return Err(Error::Param(format!(
-                "scene {}: no fluid (blocks or balls) and no character",
-                self.name
-            )));
-        }
-        self.validate_systems()
+        Ok(())
     }
 
     /// Particle systems play with the fluid, apart from the character.

@@ -67,7 +67,8 @@ pub struct SceneTargets {
 
 impl SceneTargets {
     /// Load, place and bind every character and target of `scene` (errors before the
-    /// first frame); each control target searches the fluid the way `solver` does.
+    /// first frame); each control target searches the fluid the way `solver` does. Long
+    /// because each character and target is made under the guard of the whole.
     pub fn new(
         ctx: &Context,
         scene: &Scene,
