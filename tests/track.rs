@@ -175,12 +175,25 @@ void main() {
 #[test]
 fn every_scene_kind_runs_clean_under_synchronization_validation() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [&[&str]; 8] = [
+    let cases: [&[&str]; 10] = [
         &["--scene", "drop"],
         &["--scene", "drop", "--solver", "dfsph"],
         &["--scene", "character", "--control-every", "2"],
         &["--scene", "trail"],
         &["--scene", "fountain"],
+        // Particle systems on a character (its mesh drawn, the body's capsules).
+        &["--scene", "rain"],
+        // Rays placement (its two draws) and the points view with the mesh.
+        &[
+            "--scene",
+            "character",
+            "--placement",
+            "rays",
+            "--render",
+            "points",
+            "--show-mesh",
+            "shaded",
+        ],
         &["--scene", "demo", "--list", "none"],
         &["--scene", "demo", "--list", "abuffer"],
         &["--scene", "demo", "--list", "sbuffer"],
