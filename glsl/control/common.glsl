@@ -39,7 +39,8 @@ struct ControlParams {
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
 layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
 layout(std430, binding = CTL_B_CPREV) readonly buffer Cprev { vec4 cprev[]; };  // previous pose
-layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };            // fluid density there
+// The fluid density at each control particle, then (from C.dims.w) its eq. 7 weight.
+layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };
 layout(std430, binding = CTL_B_CSTART) readonly buffer Cstart { uint cstart[]; };
 layout(std430, binding = CTL_B_CCOUNT) readonly buffer Ccount { uint ccount[]; };
 layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     // rgb, w = group

@@ -41,7 +41,7 @@ void main() {
             float q = hc - r;
             // grad W_spiky = spiky_grad (h - r)^2 d / r with spiky_grad < 0 points from i
             // to j, so a positive c_cp pulls i towards j.
-            f += (C.pressure * crho[j] * adaptive_factor(crho[j])) * (C.spiky_grad * q * q / r) * d;
+            f += crho[C.dims.w + j] * (C.spiky_grad * q * q / r) * d;
             if (C.velocity > 0.0) {
                 float w = q * q * q;
                 vsum += w * control_velocity(j);

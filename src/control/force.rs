@@ -249,7 +249,8 @@ impl ControlForce {
         let prev = buf("control previous", if rays.is_some() { 16 } else { v4 })?;
         let sorted_pos = buf("control sorted positions", v4)?;
         let sorted_prev = buf("control sorted previous", v4)?;
-        let crho = buf("control densities", m as u64 * 4)?;
+        // Densities, then each one's eq. 7 weight (density.comp).
+        let crho = buf("control densities", m as u64 * 8)?;
         let cagg = buf("control cell sums", grid.cells() * 48)?;
         let cfield = buf("control field", grid.cells() * 32)?;
         let params = buf(
