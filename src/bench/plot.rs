@@ -216,6 +216,15 @@ fn per_element_lines(
     Ok(())
 }
 
+/// The label of the bar centred at `x` (bar i spans [i, i + 1]); none between bars.
+fn bar_label(labels: &[String], x: f64) -> String {
+    let i = (x - 0.5).round();
+    match (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+        true => labels[i as usize].clone(),
+        false => String::new(),
+    }
+}
+
 /// One bar per row (a single N each): the median, a line from min to max.
 fn bars(root: &Area, path: &Path, caption: &str, scope: &str, rows: &[Row]) -> Result<()> {
     let ymax = rows.iter().map(|r| r.main.max).fold(0.0f64, f64::max);
@@ -234,14 +243,7 @@ fn bars(root: &Area, path: &Path, caption: &str, scope: &str, rows: &[Row]) -> R
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(rows.len() * 2 + 1)
-        .x_label_formatter(&|x| {
-            let i = (*x - 0.5).round();
-            if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
-                labels[i as usize].clone()
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|x| bar_label(&labels, *x))
         .y_desc(format!("{scope} ms (median, bar: min..max)"))
         .draw()
         .map_err(|e| err(path, e))?;
@@ -355,14 +357,7 @@ pub fn grouped_bars(
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(labels.len() * 2 + 1)
-        .x_label_formatter(&|x| {
-            let i = (*x - 0.5).round();
-            if (x - 0.5 - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
-                labels[i as usize].clone()
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|x| bar_label(labels, *x))
         .y_desc(y_desc)
         .y_label_formatter(&|y| match *y >= 10.0 {
             true => format!("{y:.0}"),

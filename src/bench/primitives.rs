@@ -298,10 +298,14 @@ pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
 /// The median ms of variant v's row whose N is nearest n (within 25%: scenes round
 /// particle counts).
 fn ms_near(rows: &[Row], v: &str, n: u64) -> Option<f64> {
+    row_near(rows, v, n).map(|r| r.main.median)
+}
+
+/// The row of variant v whose N is nearest n, within 25%.
+fn row_near<'a>(rows: &'a [Row], v: &str, n: u64) -> Option<&'a Row> {
     rows.iter()
         .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
         .min_by_key(|r| r.n.abs_diff(n))
-        .map(|r| r.main.median)
 }
 
 fn emission_notes(rows: &[Row]) -> Vec<String> {
@@ -313,12 +317,7 @@ fn emission_notes(rows: &[Row]) -> Vec<String> {
             h / g
         ));
     }
-    let per = |v: &str, n: u64| {
-        rows.iter()
-            .filter(|r| r.variant == v && (r.n as f64 / n as f64 - 1.0).abs() <= 0.25)
-            .min_by_key(|r| r.n.abs_diff(n))
-            .map(|r| r.main.median / r.n as f64)
-    };
+    let per = |v: &str, n: u64| row_near(rows, v, n).map(|r| r.main.median / r.n as f64);
     for v in ["grid/counting", "hash/bitonic"] {
         if let (Some(a), Some(b)) = (per(v, 8 << 10), per(v, 64 << 10)) {
             out.push(format!(

@@ -221,15 +221,19 @@ impl Tracker {
     /// counted in `unplaced`).
     pub fn before(&mut self, uses: &[BufferUse], place: bool) -> Option<(Access, Access)> {
         // A draw's uses declared before its scope are already recorded.
-        let undeclared: Vec<BufferUse> = match place {
-            true => uses.to_vec(),
-            false => uses
-                .iter()
-                .filter(|u| !self.declared.iter().any(|d| covers(d, u)))
-                .copied()
-                .collect(),
+        // (Only draws inside a scope are filtered: dispatches take their uses as given.)
+        let undeclared: Vec<BufferUse>;
+        let uses = match place || self.declared.is_empty() {
+            true => uses,
+            false => {
+                undeclared = uses
+                    .iter()
+                    .filter(|u| !self.declared.iter().any(|d| covers(d, u)))
+                    .copied()
+                    .collect();
+                &undeclared[..]
+            }
         };
-        let uses = &undeclared[..];
         let none = Access {
             stage: Stages::NONE,
             access: Accesses::NONE,

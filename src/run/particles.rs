@@ -253,22 +253,22 @@ impl FrameWork for ParticleWork<'_> {
         let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
         prof.begin(ctx, cmd, Passes::DRAW);
-        if let Some(Body {
-            ch, view: Some(v), ..
-        }) = &self.body
-        {
-            v.prepare(ctx, cmd, &ch.surface());
+        let mesh = match &self.body {
+            Some(Body {
+                ch, view: Some(v), ..
+            }) => Some((v, ch.surface())),
+            _ => None,
+        };
+        if let Some((v, m)) = &mesh {
+            v.prepare(ctx, cmd, m);
         }
         self.scene.prepare_draws(ctx, cmd, frame, true);
         self.scene.prepare_draws(ctx, cmd, frame, false);
         let b = self.background;
         self.target
             .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);
-        if let Some(Body {
-            ch, view: Some(v), ..
-        }) = &self.body
-        {
-            v.draw(ctx, cmd, &ch.surface());
+        if let Some((v, m)) = &mesh {
+            v.draw(ctx, cmd, m);
         }
         // Opaque points first, so the blended draws after them are depth-tested against them.
         self.scene.record_draws(ctx, cmd, frame, true);

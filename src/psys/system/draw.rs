@@ -90,8 +90,6 @@ impl ParticleSystem {
         Ok(())
     }
 
-    /// Record the draw (inside a rendering scope; the step's and sort's writes visible to
-    /// vertex shaders and indirect reads).
     /// The draw's buffers, push constants and whether it draws every slot (1) or the
     /// count a pass wrote (0).
     fn draw_setup(&self, f: &FrameInfo) -> (DrawBufs<'_>, DrawPush, u32) {
@@ -147,6 +145,7 @@ impl ParticleSystem {
         }
     }
 
+    /// Record the draw (inside a rendering scope declared by `prepare_draw`).
     pub fn record_draw(
         &self,
         ctx: &Context,
