@@ -1,5 +1,5 @@
 // Control particles (seed 000, 3.1): the SPH bindings (as CTL_B_* numbers) and the control
-// set, sorted by its own grid (cell = control radius h_c). Bindings: ControlIo in
+// set, sorted by its own grid (cells of h_c / 2; sums and field on cells of h_c). Bindings: ControlIo in
 // src/control/force.rs; ControlParams mirrors ControlGpuParams there (offsets tested).
 #ifndef CONTROL_COMMON_GLSL
 #define CONTROL_COMMON_GLSL
@@ -39,8 +39,9 @@ struct ControlParams {
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
 layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
 layout(std430, binding = CTL_B_CPREV) readonly buffer Cprev { vec4 cprev[]; };  // previous pose
-// The fluid density at each control particle, then (from C.dims.w) its eq. 7 weight.
-layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };
+layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };  // fluid density there
+// Per control particle (density.comp): xyz its velocity, w its eq. 7 weight.
+layout(std430, binding = CTL_B_CVW) buffer Cvw { vec4 cvw[]; };
 layout(std430, binding = CTL_B_CSTART) readonly buffer Cstart { uint cstart[]; };
 layout(std430, binding = CTL_B_CCOUNT) readonly buffer Ccount { uint ccount[]; };
 layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     // rgb, w = group
@@ -52,6 +53,15 @@ layout(std430, binding = CTL_B_CFIELD) buffer Cfield { vec4 cfield[]; };
 // control velocity (w = 1 where some control particle lies within h_c) of the last refresh.
 layout(std430, binding = CTL_B_CFORCE) buffer Cforce { vec4 cforce[]; };
 layout(std430, binding = CTL_B_CVMEAN) buffer Cvmean { vec4 cvmean[]; };
+
+// The control set is sorted on a grid of half the cells (h_c / 2, same origin, twice the
+// dims: ControlGpu::fine), numbered x fastest, so a run of cells along x is one contiguous
+// range of the sorted set; aggregates and the field stay on cells of h_c.
+float fine_cell() { return 0.5 * C.grid.w; }
+uvec3 fine_dims() { return 2u * C.dims.xyz; }
+uint fine_id(ivec3 f) { uvec3 d = fine_dims(); return (uint(f.z) * d.y + uint(f.y)) * d.x + uint(f.x); }
+// The sorted slots of fine cells a .. b (ids a <= b): [start, end).
+uvec2 fine_range(uint a, uint b) { return uvec2(cstart[a], cstart[b] + ccount[b]); }
 
 const uint ALL_GROUPS = 0xFFFFFFFFu;
 bool controlled(uint i) { return C.group == ALL_GROUPS || floatBitsToUint(attr[i].w) == C.group; }

@@ -16,27 +16,55 @@ void main() {
     float R = C.reach;
     vec3 pull = vec3(0.0), vchar = vec3(0.0);
     float wall = 0.0, wdef = 0.0;
-    for (int dz = -n; dz <= n; ++dz) for (int dy = -n; dy <= n; ++dy) for (int dx = -n; dx <= n; ++dx) {
-        ivec3 c = c0 + ivec3(dx, dy, dz);
-        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(C.dims.xyz)))) continue;
-        uint id = (uint(c.z) * C.dims.y + uint(c.y)) * C.dims.x + uint(c.x);
-        vec4 at = cagg[3 * id + 1];
-        if (at.w == 0.0) continue;
-        vec4 def = cagg[3 * id];
-        if (def.w > 0.0) {
-            vec3 d = def.xyz / def.w - xi;
-            float r = length(d);
-            if (r < R) {
-                float w = (1.0 - r / R) * (1.0 - r / R) * def.w;
-                if (r > 1e-6) pull += (w / r) * d;
-                wdef += w;
+    // Rows of cells along x are contiguous in the sorted set (cells numbered x fastest):
+    // a row (clipped to the reach's chord) holding no control particle costs four reads,
+    // and a cell with none in its whole neighbourhood (most of the domain) a few.
+    ivec3 lo = max(c0 - n, ivec3(0)), hi = min(c0 + n, ivec3(C.dims.xyz) - 1);
+    // (Sorted on cells of h_c / 2: in one slab of fine cells along z, the ids from a box's
+    // first fine cell to its last span its fine cells and the rest of the rows between.)
+    bool empty = true;
+    for (int fz = 2 * lo.z; fz <= 2 * hi.z + 1 && empty; ++fz) {
+        uvec2 r = fine_range(fine_id(ivec3(2 * lo.xy, fz)), fine_id(ivec3(2 * hi.xy + 1, fz)));
+        empty = r.x == r.y;
+    }
+    if (empty) {
+        cfield[2 * k] = vec4(0.0);
+        cfield[2 * k + 1] = vec4(0.0);
+        return;
+    }
+    for (int cz = lo.z; cz <= hi.z; ++cz) for (int cy = lo.y; cy <= hi.y; ++cy) {
+        vec2 blo = C.grid.yz + vec2(cy, cz) * C.grid.w;
+        vec2 e = max(max(blo - xi.yz, xi.yz - blo - C.grid.w), vec2(0.0));
+        float rem = R * R - dot(e, e);
+        if (rem <= 0.0) continue;
+        float half_chord = sqrt(rem);
+        int x0 = max(int(floor((xi.x - half_chord - C.grid.x) / C.grid.w)), lo.x);
+        int x1 = min(int(floor((xi.x + half_chord - C.grid.x) / C.grid.w)), hi.x);
+        uint row = (uint(cz) * C.dims.y + uint(cy)) * C.dims.x;
+        if (x1 < x0) continue;
+        uvec2 r0 = fine_range(fine_id(ivec3(2 * x0, 2 * cy, 2 * cz)), fine_id(ivec3(2 * x1 + 1, 2 * cy + 1, 2 * cz)));
+        uvec2 r1 = fine_range(fine_id(ivec3(2 * x0, 2 * cy, 2 * cz + 1)), fine_id(ivec3(2 * x1 + 1, 2 * cy + 1, 2 * cz + 1)));
+        if (r0.x == r0.y && r1.x == r1.y) continue;
+        for (int cx = x0; cx <= x1; ++cx) {
+            uint id = row + uint(cx);
+            vec4 at = cagg[3 * id + 1];
+            if (at.w == 0.0) continue;
+            vec4 def = cagg[3 * id];
+            if (def.w > 0.0) {
+                vec3 d = def.xyz / def.w - xi;
+                float r = length(d);
+                if (r < R) {
+                    float w = (1.0 - r / R) * (1.0 - r / R) * def.w;
+                    if (r > 1e-6) pull += (w / r) * d;
+                    wdef += w;
+                }
             }
-        }
-        float r = length(at.xyz / at.w - xi);
-        if (r < R) {
-            float w = (1.0 - r / R) * (1.0 - r / R);
-            vchar += w * cagg[3 * id + 2].xyz;
-            wall += w * at.w;
+            float r = length(at.xyz / at.w - xi);
+            if (r < R) {
+                float w = (1.0 - r / R) * (1.0 - r / R);
+                vchar += w * cagg[3 * id + 2].xyz;
+                wall += w * at.w;
+            }
         }
     }
     vec3 a = wdef > 0.0 ? C.attraction * pull / max(wdef, 1.0) : vec3(0.0);

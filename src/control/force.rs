@@ -25,7 +25,7 @@ crate::gpu_interface! {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
         control = 11, cpos = 12, cprev = 13, crho = 14, cstart = 15, ccount = 16, attr = 17,
-        cagg = 18, cfield = 19, cforce = 20, cvmean = 21,
+        cagg = 18, cfield = 19, cforce = 20, cvmean = 21, cvw = 22,
     }
 }
 
@@ -86,11 +86,17 @@ struct ControlGpu {
     search: NeighborSearch,
     nb: NeighborBuffers,
     grid: GridSpec,
+    /// The grid the control set is sorted on: cells of h_c / 2, twice the dims (eq. 7's
+    /// walk visits a third of the candidates of 27 cells of h_c; see force.comp).
+    fine: GridSpec,
     gather: GatherPass,
     prev: Buffer,
     sorted_pos: Buffer,
     sorted_prev: Buffer,
     crho: Buffer,
+    /// Per control particle (density.comp): its velocity and eq. 7 weight, what eq. 7's
+    /// walk reads of it besides its position (one read instead of three).
+    cvw: Buffer,
     /// Per control-grid cell: the sums of aggregate.comp (3 vec4).
     cagg: Buffer,
     /// Per cell centre: the attraction and damping field of field.comp (2 vec4).
@@ -124,6 +130,7 @@ impl ControlGpu {
             &mut self.sorted_pos,
             &mut self.sorted_prev,
             &mut self.crho,
+            &mut self.cvw,
             &mut self.cagg,
             &mut self.cfield,
             &mut self.params,
@@ -220,6 +227,18 @@ impl ControlForce {
         let top = [domain.1[0], domain.1[1], domain.1[2] + spacing + 3.0 * r];
         let hi = if rays.is_some() { top } else { domain.1 };
         let grid = GridSpec::covering(domain.0, hi, r)?;
+        let fine = GridSpec {
+            cell: 0.5 * r,
+            dims: grid.dims.map(|d| 2 * d),
+            ..grid
+        };
+        if fine.cells() > crate::primitives::neighbors::MAX_CELLS {
+            return Err(Error::Param(format!(
+                "the control grid's {} cells of h_c / 2 exceed {}: raise the spacing or shrink the domain",
+                fine.cells(),
+                crate::primitives::neighbors::MAX_CELLS
+            )));
+        }
         let rays = match rays {
             Some((spacing, capacity)) => {
                 let g = super::rays::RaysGrid::new(domain.0, domain.1, spacing)?;
@@ -237,7 +256,7 @@ impl ControlForce {
             None => None,
         };
         let search = Guard::new(ctx, NeighborSearch::new(ctx, kind, Some(sort))?);
-        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &grid, 0)?);
+        let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &fine, 0)?);
         let skin = SkinPass::new(ctx, skinning, mesh.influence_sets)?;
         let skin = Guard::new(ctx, skin);
         let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
@@ -249,8 +268,8 @@ impl ControlForce {
         let prev = buf("control previous", if rays.is_some() { 16 } else { v4 })?;
         let sorted_pos = buf("control sorted positions", v4)?;
         let sorted_prev = buf("control sorted previous", v4)?;
-        // Densities, then each one's eq. 7 weight (density.comp).
-        let crho = buf("control densities", m as u64 * 8)?;
+        let crho = buf("control densities", m as u64 * 4)?;
+        let cvw = buf("control velocities and weights", v4)?;
         let cagg = buf("control cell sums", grid.cells() * 48)?;
         let cfield = buf("control field", grid.cells() * 32)?;
         let params = buf(
@@ -270,11 +289,13 @@ impl ControlForce {
                 search: search.take(),
                 nb: nb.take(),
                 grid,
+                fine,
                 gather: gather.take(),
                 prev: prev.take(),
                 sorted_pos: sorted_pos.take(),
                 sorted_prev: sorted_prev.take(),
                 crho: crho.take(),
+                cvw: cvw.take(),
                 cagg: cagg.take(),
                 cfield: cfield.take(),
                 params: params.take(),
@@ -408,7 +429,7 @@ impl ControlForce {
         };
         scopes.begin(ctx, cmd, "control-grid");
         g.search
-            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.grid)?;
+            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.fine)?;
         g.gather
             .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
         g.gather
@@ -441,6 +462,7 @@ impl ControlForce {
             cpos: &g.sorted_pos,
             cprev: &g.sorted_prev,
             crho: &g.crho,
+            cvw: &g.cvw,
             cstart,
             ccount,
             attr: st.attr(),
