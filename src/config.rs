@@ -213,7 +213,8 @@ pub struct ControlArgs {
     /// control particles within --control-reach still short of rest density (0: off)
     #[arg(long)]
     pub control_attraction: Option<f32>,
-    /// Reach of the deficit attraction and the damping in metres (default 3 h_c)
+    /// Reach of the deficit attraction and the damping in metres (default 5 h_c; the
+    /// thesis preset 3 h_c)
     #[arg(long)]
     pub control_reach: Option<f32>,
     /// Damping (1/s) of the fluid's velocity relative to the character's near it, within

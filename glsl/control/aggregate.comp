@@ -1,7 +1,7 @@
 #version 450
-// Per control-grid cell, the sums the deficit attraction and the damping read (one thread
-// a cell over its sorted control particles): deficit-weighted position and deficit,
-// position and count, velocity. Far cells then cost one read each instead of a loop over
+// Per control-grid cell, what the deficit attraction and the damping read (one thread a
+// cell over its sorted control particles): deficit-weighted centre and deficit, centre
+// and count, velocity sum. Far cells then cost one read each instead of a loop over
 // their particles (about 40 at the rest spacing in a cell of h_c).
 #include "common.glsl"
 void main() {
@@ -21,7 +21,8 @@ void main() {
             v.xyz += cvw[j].xyz;
         }
     }
-    cagg[3 * k] = def;
-    cagg[3 * k + 1] = at;
+    // Centres, not sums: the field reads them for every cell within the reach.
+    cagg[3 * k] = def.w > 0.0 ? vec4(def.xyz / def.w, def.w) : vec4(0.0);
+    cagg[3 * k + 1] = at.w > 0.0 ? vec4(at.xyz / at.w, at.w) : vec4(0.0);
     cagg[3 * k + 2] = v;
 }

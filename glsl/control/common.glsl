@@ -45,7 +45,8 @@ layout(std430, binding = CTL_B_CVW) buffer Cvw { vec4 cvw[]; };
 layout(std430, binding = CTL_B_CSTART) readonly buffer Cstart { uint cstart[]; };
 layout(std430, binding = CTL_B_CCOUNT) readonly buffer Ccount { uint ccount[]; };
 layout(std430, binding = CTL_B_ATTR) readonly buffer Attr { vec4 attr[]; };     // rgb, w = group
-// Per control-grid cell (aggregate.comp): sum d c, sum d (d = deficit); sum c, count; sum v.
+// Per control-grid cell (aggregate.comp): deficit-weighted centre, sum of deficits; centre,
+// count; sum v.
 layout(std430, binding = CTL_B_CAGG) buffer Cagg { vec4 cagg[]; };
 // Per cell centre (field.comp): attraction acceleration; mean character velocity, mask.
 layout(std430, binding = CTL_B_CFIELD) buffer Cfield { vec4 cfield[]; };

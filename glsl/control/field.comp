@@ -51,7 +51,7 @@ void main() {
             if (at.w == 0.0) continue;
             vec4 def = cagg[3 * id];
             if (def.w > 0.0) {
-                vec3 d = def.xyz / def.w - xi;
+                vec3 d = def.xyz - xi;
                 float r = length(d);
                 if (r < R) {
                     float w = (1.0 - r / R) * (1.0 - r / R) * def.w;
@@ -59,7 +59,7 @@ void main() {
                     wdef += w;
                 }
             }
-            float r = length(at.xyz / at.w - xi);
+            float r = length(at.xyz - xi);
             if (r < R) {
                 float w = (1.0 - r / R) * (1.0 - r / R);
                 vchar += w * cagg[3 * id + 2].xyz;
