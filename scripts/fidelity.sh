@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate results/<device-slug>/fidelity.md (+ .csv): the liquid-character fidelity
+# Regenerate results/<device-slug>/control-fidelity.md (+ .csv): the liquid-character fidelity
 # metrics (README "Fidelity metrics") per control-switch combination on the built-in
 # walker standing in his own pool (tests/scenes/walker_pool.toml, 2 s: metrics over the
 # second 1 s walk cycle), and the thesis's control against the fidelity preset on
@@ -9,8 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/bench_common.sh "$@"
-md=$dir/fidelity.md
-csv=$dir/fidelity.csv
+md=$dir/control-fidelity.md
+csv=$dir/control-fidelity.csv
 walker=tests/scenes/walker_pool.toml
 cesium=tests/scenes/cesium_man_pool.toml
 runs=(

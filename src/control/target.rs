@@ -32,17 +32,17 @@ fn default_pressure() -> f32 {
 }
 
 /// The fidelity preset's velocity term K (1/s), deficit attraction (m/s^2) and damping
-/// (1/s), chosen from the runs in results/<device>/fidelity.md.
+/// (1/s), chosen from the runs in results/<device>/control-fidelity.md.
 pub const FIDELITY_VELOCITY: f32 = 10.0;
 pub const FIDELITY_ATTRACTION: f32 = 120.0;
 pub const FIDELITY_DAMPING: f32 = 4.0;
 /// The fidelity preset's reach of the attraction and damping, in control radii h_c: at 5
 /// (was 3) CesiumMan drew his whole pool up (fill 0.97, 90% after 0.42 s, against 0.77
-/// and never) and the walker kept his metrics (results/<device>/fidelity.md).
+/// and never) and the walker kept his metrics (results/<device>/control-fidelity.md).
 pub const FIDELITY_REACH: f32 = 5.0;
 /// The fidelity preset's time between refreshes of the control's sums (`--control-every`
 /// is this over the step, rounded): on the walker, 4 steps of 0.36 ms held every metric of
-/// a refresh each step; 6 doubled the speed excess (results/<device>/fidelity.md).
+/// a refresh each step; 6 doubled the speed excess (results/<device>/control-fidelity.md).
 pub const FIDELITY_REFRESH_S: f32 = 1.5e-3;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the

@@ -16,7 +16,7 @@ pub const COARSEST: f32 = 35.0;
 
 /// The default pool holds this many times the character's volume: 1.15 (was 1.3) once the
 /// attraction's reach of 5 h_c drew the whole pool up: the 0.3 spare then sat as a lump on
-/// a leg (CesiumMan's iou 0.67 at 1.3, 0.74 at 1.15; results/<device>/fidelity.md).
+/// a leg (CesiumMan's iou 0.67 at 1.3, 0.74 at 1.15; results/<device>/control-fidelity.md).
 fn volume() -> f32 {
     1.15
 }
