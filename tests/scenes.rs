@@ -125,3 +125,55 @@ fn fluid_overrides_reach_each_solvers_table() {
         assert_eq!(e.lines().count(), 1, "{e}");
     }
 }
+
+/// Choosing a solver gives its own step (its table's cfl and dt_max); an explicit value in
+/// [fluid], its table or --fluid wins, each on its own; wcsph keeps the fixed step.
+#[test]
+fn each_solver_takes_its_own_step_unless_told_otherwise() {
+    use fluidform::kinds::Solver;
+    let f = FluidParams::default();
+    let o = |args: &[&str], s: Option<Solver>| {
+        let a: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+        f.with_overrides(&a, s).unwrap()
+    };
+    let w = o(&[], None);
+    assert_eq!((w.solver, w.cfl, w.dt_max), (Solver::Wcsph, None, None));
+    assert!(
+        w.describe_step().contains("fixed steps"),
+        "{}",
+        w.describe_step()
+    );
+    for (s, own) in [
+        (Solver::Pcisph, f.pcisph.dt_max),
+        (Solver::Dfsph, f.dfsph.dt_max),
+        (Solver::Pbf, f.pbf.dt_max),
+    ] {
+        let g = o(&[], Some(s));
+        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(own)), "{s:?}");
+        let line = g.describe_step();
+        assert!(line.contains("CFL 0.4") && line.contains("0.1%"), "{line}");
+        // The table's values, then explicit ones, each on its own.
+        let g = o(
+            &[&format!("{}.dt_max=0.003", format!("{s:?}").to_lowercase())],
+            Some(s),
+        );
+        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(0.003)), "{s:?}");
+        let g = o(&["cfl=0.2"], Some(s));
+        assert_eq!((g.cfl, g.dt_max), (Some(0.2), Some(own)), "{s:?}");
+        let g = o(&["dt_max=0.001"], Some(s));
+        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(0.001)), "{s:?}");
+    }
+    // A scene file's solver gets the same.
+    let d = FluidParams {
+        solver: Solver::Dfsph,
+        ..FluidParams::default()
+    };
+    let g = d.with_overrides(&[], None).unwrap();
+    assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(f.dfsph.dt_max)));
+    // wcsph with dt_max alone is still refused.
+    let e = f
+        .with_overrides(&["dt_max=0.001".to_string()], None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("needs fluid.cfl"), "{e}");
+}

@@ -25,32 +25,26 @@ pub const COUNTS: &[u32] = &[16 << 10, 64 << 10, 256 << 10];
 /// Mean density errors the matched-accuracy rows reach: 1% and 0.1%.
 pub const TARGETS: [f64; 2] = [0.01, 0.001];
 
-/// A configuration's largest step, where the solver stays stable on the dam break
-/// (PCISPH fails at 4 ms: its iterations hit the limit and particles are flung).
-fn own_dt_max(solver: Solver) -> f32 {
-    match solver {
-        Solver::Pcisph => 0.002,
-        Solver::Dfsph => 0.008,
-        _ => 0.004,
-    }
+/// A configuration's largest step, where the solver stays stable on the dam break: its
+/// table's own `dt_max` (PCISPH fails at 4 ms: its iterations hit the limit and particles
+/// are flung).
+fn own_dt_max(base: &FluidParams, solver: Solver) -> f32 {
+    let f = FluidParams {
+        solver,
+        ..base.clone()
+    };
+    f.own_step().map_or(f.dt, |(_, m)| m)
 }
 
-/// The solver's own stable configuration: WCSPH as the scene has it (Tait, c = 40 m/s,
-/// 0.4 ms steps); the others CFL 0.4 up to their own largest step, at their default
-/// density error target (0.1%).
+/// The solver's own stable configuration, what `--solver X` gives: WCSPH as the scene has
+/// it (Tait, c = 40 m/s, 0.4 ms steps); the others their table's CFL number up to their
+/// own largest step, at their default density error target (0.1%).
 pub fn own(base: &FluidParams, solver: Solver) -> FluidParams {
-    match solver {
-        Solver::Wcsph => FluidParams {
-            solver,
-            ..base.clone()
-        },
-        _ => FluidParams {
-            solver,
-            cfl: Some(0.4),
-            dt_max: Some(own_dt_max(solver)),
-            ..base.clone()
-        },
+    FluidParams {
+        solver,
+        ..base.clone()
     }
+    .with_own_step()
 }
 
 /// The candidates a matched-accuracy row tries, cheapest first: WCSPH raises the speed of
@@ -74,8 +68,8 @@ pub fn ladder(base: &FluidParams, solver: Solver, target: f64) -> Vec<FluidParam
             .map(|k| {
                 FluidParams {
                     solver,
-                    cfl: Some(0.4),
-                    dt_max: Some(own_dt_max(solver) * k),
+                    cfl: Some(crate::sph::params::OWN_CFL),
+                    dt_max: Some(own_dt_max(base, solver) * k),
                     ..base.clone()
                 }
                 .with_density_error(target as f32)

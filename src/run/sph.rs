@@ -155,7 +155,10 @@ fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::S
     let mut sw = scene.look.apply(sw);
     scene.fluid = sw.fluid_args.apply(&scene.fluid)?;
     // A liquid character's spacing and pool from its character (scene::fit).
-    for line in crate::scene::fit::fit(&mut scene)?.describe() {
+    let mut lines = crate::scene::fit::fit(&mut scene)?.describe();
+    // The step and the stopping rule the solver takes (its own unless [fluid] sets them).
+    lines.push(scene.fluid.describe_step());
+    for line in lines {
         if !sw.common.quiet {
             eprintln!("{}: {line}", scene.name);
         }

@@ -4,8 +4,8 @@
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
 //! Euler (glsl/sph/dfsph.comp, euler.comp).
 use super::pressure::{
-    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER,
-    LOOP_DENSITY, LOOP_DIVERGENCE,
+    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
+    EULER, LOOP_DENSITY, LOOP_DIVERGENCE,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -34,7 +34,14 @@ pub struct DfsphParams {
     /// list instead of searching 27 grid cells; a particle with more neighbours is searched
     /// as before (exact; counted in `stats.density_error.list_overflows`).
     pub neighbor_list: u32,
+    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it).
+    pub cfl: f32,
+    pub dt_max: f32,
 }
+
+/// DFSPH's largest own step (stable on the dam break at 8 ms: results/<device>/solvers.md).
+pub const OWN_DT_MAX: f32 = 0.008;
 
 impl Default for DfsphParams {
     fn default() -> Self {
@@ -44,6 +51,8 @@ impl Default for DfsphParams {
             min_iterations: 2,
             max_iterations: 100,
             neighbor_list: DEFAULT_NEIGHBOR_LIST,
+            cfl: super::params::OWN_CFL,
+            dt_max: OWN_DT_MAX,
         }
     }
 }
@@ -54,6 +63,7 @@ impl DfsphParams {
         let d = self.divergence_error;
         check_range("dfsph", "divergence_error", d, (1e-6, 0.5))?;
         check_iterations("dfsph", self.min_iterations, self.max_iterations)?;
+        check_step("dfsph", self.cfl, self.dt_max)?;
         if self.neighbor_list > MAX_NEIGHBOR_LIST {
             return Err(crate::error::Error::Param(format!(
                 "fluid.dfsph.neighbor_list must be at most {MAX_NEIGHBOR_LIST} (0: off), got {}",

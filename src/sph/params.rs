@@ -10,6 +10,10 @@ pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
 pub use super::pressure::Convergence;
 
+/// The incompressible solvers' own CFL number (with each table's `dt_max`: the setup
+/// `bench solvers` found stable on the dam break).
+pub const OWN_CFL: f32 = 0.4;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 #[repr(u32)]
@@ -188,9 +192,9 @@ impl FluidParams {
                     "fluid.dt_max must be positive, got {d}"
                 )));
             }
-            if self.cfl.is_none() {
+            if self.cfl.is_none() && self.own_step().is_none() {
                 return Err(Error::Param(
-                    "fluid.dt_max needs fluid.cfl (without it every step is dt)".into(),
+                    "fluid.dt_max needs fluid.cfl with wcsph (without it every step is dt)".into(),
                 ));
             }
         }
@@ -210,20 +214,73 @@ impl FluidParams {
 
     /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
     /// a scene file's [fluid] table: unknown keys and invalid values are errors.
-    /// The parameters with `KEY=VALUE` `overrides` (`--fluid`) and `solver` applied.
+    /// The parameters with `KEY=VALUE` `overrides` (`--fluid`) and `solver` applied, and
+    /// the solver's own step (its table's `cfl` and `dt_max`) where [fluid] sets no `cfl`.
     pub fn with_overrides(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
-        let mut out = self.with_values(overrides)?;
-        if let Some(s) = solver {
-            out.solver = s;
-            out.validate()?;
-        }
+        let mut out = self.with_values(overrides, solver)?;
         out.resolve_spacing()?;
         Ok(out)
     }
 
-    fn with_values(&self, overrides: &[String]) -> Result<Self> {
+    /// The step the solver takes by its own table, `cfl` and `dt_max` each where [fluid]
+    /// (or --fluid) sets none: wcsph keeps the fixed `dt`, its stable step at its speed of
+    /// sound.
+    pub fn with_own_step(mut self) -> Self {
+        if let Some((cfl, dt_max)) = self.own_step() {
+            self.cfl = Some(self.cfl.unwrap_or(cfl));
+            self.dt_max = Some(self.dt_max.unwrap_or(dt_max));
+        }
+        self
+    }
+
+    /// The chosen solver's own (cfl, dt_max): None for wcsph.
+    pub fn own_step(&self) -> Option<(f32, f32)> {
+        match self.solver {
+            Solver::Wcsph => None,
+            Solver::Pcisph => Some((self.pcisph.cfl, self.pcisph.dt_max)),
+            Solver::Dfsph => Some((self.dfsph.cfl, self.dfsph.dt_max)),
+            Solver::Pbf => Some((self.pbf.cfl, self.pbf.dt_max)),
+        }
+    }
+
+    /// One line on the step and stopping rule a run takes (printed at its start).
+    pub fn describe_step(&self) -> String {
+        let step = match (self.cfl, self.dt_max) {
+            (Some(c), m) => format!(
+                "CFL {c}, steps up to {:.2} ms",
+                m.unwrap_or(self.dt) * 1000.0
+            ),
+            (None, _) => format!(
+                "fixed steps of {:.3} ms, {} a frame",
+                self.dt * 1000.0,
+                self.substeps
+            ),
+        };
+        let stop = match self.solver {
+            Solver::Wcsph => String::new(),
+            Solver::Pbf if self.pbf.iterations > 0 => {
+                format!(", {} iterations a step", self.pbf.iterations)
+            }
+            _ => format!(
+                ", iterating to a mean density error of {}%",
+                self.convergence().density_error * 100.0
+            ),
+        };
+        let solver = format!("{:?}", self.solver).to_lowercase();
+        let how = match self.solver {
+            Solver::Wcsph => "--fluid cfl= for a CFL-limited step".to_string(),
+            _ => format!("its own by [fluid.{solver}]; --fluid cfl=, dt_max= override"),
+        };
+        format!("solver {solver}: {step}{stop} ({how})")
+    }
+
+    fn with_values(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
         if overrides.is_empty() {
-            return Ok(self.clone());
+            let mut out = self.clone();
+            out.solver = solver.unwrap_or(out.solver);
+            let out = out.with_own_step();
+            out.validate()?;
+            return Ok(out);
         }
         let mut value = toml::Value::try_from(self)
             .map_err(|e| Error::Param(format!("fluid parameters: {e}")))?;
@@ -243,10 +300,12 @@ impl FluidParams {
                 set_path(table, &path, parsed.clone())?;
             }
         }
-        let out: FluidParams = value.try_into().map_err(|e| {
+        let mut out: FluidParams = value.try_into().map_err(|e| {
             let e = e.to_string().replace('\n', " ");
             Error::Param(format!("--fluid: {}", e.trim()))
         })?;
+        out.solver = solver.unwrap_or(out.solver);
+        let out = out.with_own_step();
         out.validate()?;
         Ok(out)
     }

@@ -3,7 +3,8 @@
 //! apply) to the density error target or a fixed count, velocities from the positions,
 //! then vorticity confinement and XSPH viscosity (glsl/sph/pbf.comp).
 use super::pressure::{
-    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, LOOP_DENSITY,
+    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
+    LOOP_DENSITY,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -33,7 +34,14 @@ pub struct PbfParams {
     pub xsph: f32,
     /// Vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
     pub vorticity: f32,
+    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it).
+    pub cfl: f32,
+    pub dt_max: f32,
 }
+
+/// PBF's largest own step (results/<device>/solvers.md).
+pub const OWN_DT_MAX: f32 = 0.004;
 
 impl Default for PbfParams {
     fn default() -> Self {
@@ -48,6 +56,8 @@ impl Default for PbfParams {
             scorr_dq: 0.2,
             xsph: 0.01,
             vorticity: 0.01,
+            cfl: super::params::OWN_CFL,
+            dt_max: OWN_DT_MAX,
         }
     }
 }
@@ -66,6 +76,7 @@ impl PbfParams {
             check_range("pbf", name, v, range)?;
         }
         check_iterations("pbf", self.min_iterations, self.max_iterations)?;
+        check_step("pbf", self.cfl, self.dt_max)?;
         if self.iterations > super::params::MAX_ITERATIONS {
             return Err(crate::error::Error::Param(format!(
                 "fluid.pbf.iterations must be at most {}, got {}",

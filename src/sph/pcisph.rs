@@ -2,8 +2,8 @@
 //! pressure iterations to the density error target, then symplectic Euler
 //! (glsl/sph/pcisph.comp, euler.comp).
 use super::pressure::{
-    check_iterations, check_range, Convergence, PassDecl, Pipelines, PressureSolver, EULER,
-    LOOP_DENSITY,
+    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
+    EULER, LOOP_DENSITY,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -20,7 +20,15 @@ pub struct PcisphParams {
     /// Iterations each solve takes at least and at most.
     pub min_iterations: u32,
     pub max_iterations: u32,
+    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it).
+    pub cfl: f32,
+    pub dt_max: f32,
 }
+
+/// PCISPH's largest own step: at 4 ms on the dam break its iterations hit the limit and
+/// particles were flung (results/<device>/solvers.md).
+pub const OWN_DT_MAX: f32 = 0.002;
 
 impl Default for PcisphParams {
     fn default() -> Self {
@@ -28,6 +36,8 @@ impl Default for PcisphParams {
             density_error: 0.001,
             min_iterations: 2,
             max_iterations: 100,
+            cfl: super::params::OWN_CFL,
+            dt_max: OWN_DT_MAX,
         }
     }
 }
@@ -35,7 +45,8 @@ impl Default for PcisphParams {
 impl PcisphParams {
     pub fn validate(&self) -> Result<()> {
         check_range("pcisph", "density_error", self.density_error, (1e-6, 0.5))?;
-        check_iterations("pcisph", self.min_iterations, self.max_iterations)
+        check_iterations("pcisph", self.min_iterations, self.max_iterations)?;
+        check_step("pcisph", self.cfl, self.dt_max)
     }
 
     pub fn convergence(&self) -> Convergence {

@@ -456,6 +456,12 @@ pub(crate) fn check_range(table: &str, name: &str, v: f32, (lo, hi): (f32, f32))
     }
 }
 
+/// A solver table's own step (`cfl`, `dt_max`), in range.
+pub(crate) fn check_step(table: &str, cfl: f32, dt_max: f32) -> Result<()> {
+    check_range(table, "cfl", cfl, (1e-3, 1.0))?;
+    check_range(table, "dt_max", dt_max, (1e-6, 1.0))
+}
+
 /// 1 <= min <= max <= MAX_ITERATIONS for `fluid.TABLE`.
 pub(crate) fn check_iterations(table: &str, min: u32, max: u32) -> Result<()> {
     use super::params::MAX_ITERATIONS;
