@@ -43,7 +43,19 @@ uint nb_lower_bound(uint key) {  // first sorted slot with nb_keys[slot] >= key
 #define NB_CELL_END(id, s) (nb_end[id])
 #endif
 
-#if NB_STRATEGY == NB_GRID
+#if NB_STRATEGY == NB_GRID && NB_CELL_COUNTS
+// Cell starts are a scan of the counts (empty cells included) and cells are numbered x
+// fastest, so each of the 9 rows of three cells along x is one contiguous range.
+#define NB_BEGIN(P, R, J) { ivec3 nb_c0 = nb_grid_cell(P); \
+    int nb_x0 = max(nb_c0.x - 1, 0), nb_x1 = min(nb_c0.x + 1, int(NB_DIMS.x) - 1); \
+    for (int nb_dz = -1; nb_dz <= 1; ++nb_dz) for (int nb_dy = -1; nb_dy <= 1; ++nb_dy) { \
+        ivec2 nb_yz = nb_c0.yz + ivec2(nb_dy, nb_dz); \
+        if (any(lessThan(nb_yz, ivec2(0))) || any(greaterThanEqual(nb_yz, ivec2(NB_DIMS.yz)))) continue; \
+        uint nb_a = nb_grid_id(ivec3(nb_x0, nb_yz)), nb_b = nb_grid_id(ivec3(nb_x1, nb_yz)); \
+        uint nb_s = nb_start[nb_a]; uint nb_e = nb_start[nb_b] + nb_end[nb_b]; \
+        for (uint J = nb_s; J < nb_e; ++J) {
+#define NB_END }}}
+#elif NB_STRATEGY == NB_GRID
 #define NB_BEGIN(P, R, J) { ivec3 nb_c0 = nb_grid_cell(P); \
     for (int nb_dz = -1; nb_dz <= 1; ++nb_dz) for (int nb_dy = -1; nb_dy <= 1; ++nb_dy) \
     for (int nb_dx = -1; nb_dx <= 1; ++nb_dx) { \
