@@ -42,8 +42,9 @@ pub const FIDELITY_DAMPING: f32 = 4.0;
 pub const FIDELITY_REACH: f32 = 5.0;
 /// The fidelity preset's time between refreshes of the control's sums (`--control-every`
 /// is this over the step, rounded): on the walker, 4 steps of 0.36 ms held every metric of
-/// a refresh each step; 6 doubled the speed excess (results/<device>/control-fidelity.md).
-pub const FIDELITY_REFRESH_S: f32 = 1.5e-3;
+/// a refresh each step, and with damping 4/s so did 5 (here, on CesiumMan too); 6 more than
+/// doubled the speed excess (results/<device>/control-fidelity.md).
+pub const FIDELITY_REFRESH_S: f32 = 1.8e-3;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
 /// built-in walker fills from a pool in about two seconds).
