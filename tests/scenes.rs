@@ -163,6 +163,14 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         let g = o(&["dt_max=0.001"], Some(s));
         assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(0.001)), "{s:?}");
     }
+    // cfl 0 in the table: fixed steps.
+    let g = o(&["dfsph.cfl=0"], Some(Solver::Dfsph));
+    assert_eq!((g.cfl, g.dt_max), (None, None));
+    assert!(
+        g.describe_step().contains("fixed steps"),
+        "{}",
+        g.describe_step()
+    );
     // A scene file's solver gets the same.
     let d = FluidParams {
         solver: Solver::Dfsph,
@@ -175,5 +183,5 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         .with_overrides(&["dt_max=0.001".to_string()], None)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("needs fluid.cfl"), "{e}");
+    assert!(e.contains("needs a CFL-limited step"), "{e}");
 }

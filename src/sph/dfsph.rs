@@ -35,7 +35,8 @@ pub struct DfsphParams {
     /// as before (exact; counted in `stats.density_error.list_overflows`).
     pub neighbor_list: u32,
     /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
-    /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it).
+    /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it; cfl 0:
+    /// fixed steps of `dt`).
     pub cfl: f32,
     pub dt_max: f32,
 }

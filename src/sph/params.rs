@@ -194,7 +194,7 @@ impl FluidParams {
             }
             if self.cfl.is_none() && self.own_step().is_none() {
                 return Err(Error::Param(
-                    "fluid.dt_max needs fluid.cfl with wcsph (without it every step is dt)".into(),
+                    "fluid.dt_max needs a CFL-limited step: fluid.cfl, or the solver's own (without it every step is dt)".into(),
                 ));
             }
         }
@@ -233,14 +233,16 @@ impl FluidParams {
         self
     }
 
-    /// The chosen solver's own (cfl, dt_max): None for wcsph.
+    /// The chosen solver's own (cfl, dt_max): None for wcsph and for a table whose `cfl`
+    /// is 0 (fixed steps of `dt`).
     pub fn own_step(&self) -> Option<(f32, f32)> {
-        match self.solver {
+        let own = match self.solver {
             Solver::Wcsph => None,
             Solver::Pcisph => Some((self.pcisph.cfl, self.pcisph.dt_max)),
             Solver::Dfsph => Some((self.dfsph.cfl, self.dfsph.dt_max)),
             Solver::Pbf => Some((self.pbf.cfl, self.pbf.dt_max)),
-        }
+        };
+        own.filter(|&(cfl, _)| cfl > 0.0)
     }
 
     /// One line on the step and stopping rule a run takes (printed at its start).

@@ -29,6 +29,13 @@ fn control_and_groups_work_with_every_solver() {
             "max_iterations=8",
             "--fluid",
             "pbf_iterations=8",
+            // Fixed steps, not the solvers' own CFL-limited ones.
+            "--fluid",
+            "pcisph.cfl=0",
+            "--fluid",
+            "dfsph.cfl=0",
+            "--fluid",
+            "pbf.cfl=0",
         ]);
     }
 }
