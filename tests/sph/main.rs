@@ -273,3 +273,104 @@ fn assert_sane(d: &fluidform::sph::solver::StateDump, scene: &Scene, what: &str)
         );
     }
 }
+
+/// Two balls of different sizes colliding head-on without gravity, far from every wall:
+/// the total momentum (equal masses: the sum of the velocities) stays what it was, with
+/// every solver. Pressure, viscosity, DFSPH's and PCISPH's pressure forces, PBF's position
+/// corrections and XSPH all act in equal and opposite pairs; surface tension (Kelager's
+/// colour-field force) and PBF's vorticity confinement do not, so both are off.
+#[test]
+fn every_solver_conserves_momentum_without_walls() {
+    use fluidform::kinds::Solver;
+    let ctx = common::ctx();
+    for solver_kind in [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf] {
+        let mut fluid = FluidParams {
+            gravity: [0.0; 3],
+            surface_tension: 0.0,
+            dt: 0.001,
+            solver: solver_kind,
+            ..FluidParams::default()
+        };
+        fluid.pbf.vorticity = 0.0;
+        let ball = |center: [f32; 3], radius: f32, vx: f32, group: u32| Ball {
+            center,
+            radius,
+            group,
+            color: [1.0; 3],
+            velocity: [vx, 0.0, 0.0],
+        };
+        let scene = Scene {
+            domain: Domain {
+                min: [0.0; 3],
+                max: [1.2, 1.2, 1.2],
+            },
+            blocks: vec![],
+            balls: vec![
+                ball([0.4, 0.6, 0.6], 0.12, 0.5, 0),
+                ball([0.78, 0.6, 0.6], 0.08, -0.5, 1),
+            ],
+            ..block_scene(fluid)
+        };
+        let parts = scene.particles(1);
+        let mut solver = SphSolver::new(&ctx, Neighbors::Grid, None).unwrap();
+        let mut st = solver.state(&ctx, &scene, &parts).unwrap();
+        let n = st.n as usize;
+        let momentum = |d: &fluidform::sph::solver::StateDump| {
+            let mut p = [0.0f64; 3];
+            let mut speed = 0.0f64;
+            for v in &d.vel[..n] {
+                for k in 0..3 {
+                    p[k] += v[k] as f64;
+                }
+                speed += (0..3).map(|k| (v[k] as f64).powi(2)).sum::<f64>().sqrt();
+            }
+            (p, speed)
+        };
+        let (p0, s0) = momentum(&st.read(&ctx).unwrap());
+        // 0.3 s: the balls meet after about 0.18 s and merge.
+        for _ in 0..6 {
+            ctx.one_shot(|cmd| {
+                for _ in 0..50 {
+                    solver.record_step(&ctx, cmd, &mut Labels, &mut st).unwrap();
+                }
+            })
+            .unwrap();
+        }
+        let d = st.read(&ctx).unwrap();
+        let (p1, _) = momentum(&d);
+        // The premise: they collided (the small ball's particles turned back or stopped)
+        // and no particle came near a wall.
+        let h = scene.fluid.h;
+        for x in &d.pos[..n] {
+            assert!(
+                (0..3).all(|k| x[k] > h && x[k] < 1.2 - h),
+                "{solver_kind:?}: a particle near a wall at {x:?}"
+            );
+        }
+        let small_vx: f64 = (0..n)
+            .filter(|&i| d.attr[i][3].to_bits() == 1)
+            .map(|i| d.vel[i][0] as f64)
+            .sum();
+        assert!(
+            small_vx > -0.25 * 0.5 * n as f64,
+            "{solver_kind:?}: no collision"
+        );
+        let dp = (0..3).map(|k| (p1[k] - p0[k]).powi(2)).sum::<f64>().sqrt();
+        // Measured (llvmpipe, 2026-11-25): WCSPH, PCISPH and DFSPH lose 1e-8..3e-8 of the
+        // total speed, f32 rounding; PBF 2e-4 (1.6e-4 with vorticity on), probably where a
+        // pair is one-sided: its neighbour sets come from the step's start positions while
+        // its corrections act at the predicted ones (a known gap, README).
+        let bound = if solver_kind == Solver::Pbf {
+            1e-3
+        } else {
+            1e-6
+        };
+        assert!(
+            dp < bound * s0,
+            "{solver_kind:?}: momentum {p0:?} -> {p1:?} (|dp| {dp:.3e} of {s0:.3e})"
+        );
+        st.destroy(&ctx);
+        solver.destroy(&ctx);
+    }
+    common::finish(&ctx);
+}
