@@ -98,6 +98,8 @@ pub struct Outcome {
     pub simulated_s: f64,
     /// The timed steps' `sph` scopes (the whole step: search, density, forces, solve).
     pub gpu_ms: f64,
+    /// ... and their `sph/pressure` and `sph/divergence` scopes (the solves).
+    pub solve_ms: [f64; 2],
     /// GPU ms per step, one value per timed frame.
     pub per_step_ms: Vec<f64>,
     pub errors: DensityErrorStats,
@@ -177,12 +179,16 @@ pub fn play(
         Err(e) => return Err(e),
     };
     for t in timings.iter().filter(|t| t.frame >= opts.warmup) {
-        let ms: f64 = t
-            .passes
-            .iter()
-            .filter(|(k, _)| k == "sph")
-            .map(|(_, v)| v)
-            .sum();
+        let scope = |name: &str| -> f64 {
+            t.passes
+                .iter()
+                .filter(|(k, _)| k == name)
+                .map(|(_, v)| v)
+                .sum()
+        };
+        let ms = scope("sph");
+        out.solve_ms[0] += scope("sph/pressure");
+        out.solve_ms[1] += scope("sph/divergence");
         let steps: Vec<_> = stepper.steps.iter().filter(|s| s.0 == t.frame).collect();
         for s in &steps {
             out.errors.add(&s.3);
@@ -227,11 +233,28 @@ fn row(variant: String, f: &FluidParams, o: &Outcome) -> Result<Row> {
                 "divergence iterations".into(),
                 format!("{:.1}", e.divergence_iterations_mean),
             ),
+            (
+                "ms per iteration".into(),
+                per_iteration(o.solve_ms[0], e.iterations_mean, o.steps),
+            ),
+            (
+                "ms per divergence iteration".into(),
+                per_iteration(o.solve_ms[1], e.divergence_iterations_mean, o.steps),
+            ),
             ("mean error %".into(), format!("{:.3}", e.mean * 100.0)),
             ("max error %".into(), format!("{:.2}", e.max * 100.0)),
             ("status".into(), status),
         ],
     })
+}
+
+/// GPU ms of a solve's scope over the iterations its steps took ('-' for none): the
+/// iterations recorded past convergence (empty dispatches) count in the time.
+fn per_iteration(ms: f64, iterations_mean: f64, steps: u64) -> String {
+    match iterations_mean * steps as f64 {
+        n if n > 0.0 => format!("{:.3}", ms / n),
+        _ => "-".into(),
+    }
 }
 
 /// The solvers to run: --solver, else all four.
