@@ -226,10 +226,11 @@ pub struct ControlArgs {
     /// frame ahead)
     #[arg(long, value_enum)]
     pub control_motion: Option<ControlMotion>,
-    /// Steps between refreshes of the control's sums (control densities, the deficit
-    /// field, eq. 7's walk); the steps between apply each particle's stored eq. 7 sum with
-    /// their own density and velocity, and a frame's first step always refreshes (1: every
-    /// step, the thesis's preset; fidelity: 1.5 ms over the step, rounded)
+    /// Steps between refreshes of the control's sums (control densities, eq. 7's walk; the
+    /// deficit field follows each pose); the steps between apply each particle's stored
+    /// eq. 7 sum with their own density and velocity, and a frame's first step always
+    /// refreshes (1: every step, the thesis's preset; fidelity: 1.8 ms over the step,
+    /// rounded)
     #[arg(long, value_name = "K")]
     pub control_every: Option<u32>,
     /// Scene time in seconds from which the fidelity metrics are summarised in
