@@ -227,18 +227,7 @@ impl ControlForce {
         let top = [domain.1[0], domain.1[1], domain.1[2] + spacing + 3.0 * r];
         let hi = if rays.is_some() { top } else { domain.1 };
         let grid = GridSpec::covering(domain.0, hi, r)?;
-        let fine = GridSpec {
-            cell: 0.5 * r,
-            dims: grid.dims.map(|d| 2 * d),
-            ..grid
-        };
-        if fine.cells() > crate::primitives::neighbors::MAX_CELLS {
-            return Err(Error::Param(format!(
-                "the control grid's {} cells of h_c / 2 exceed {}: raise the spacing or shrink the domain",
-                fine.cells(),
-                crate::primitives::neighbors::MAX_CELLS
-            )));
-        }
+        let fine = grid.halved()?;
         let rays = match rays {
             Some((spacing, capacity)) => {
                 let g = super::rays::RaysGrid::new(domain.0, domain.1, spacing)?;

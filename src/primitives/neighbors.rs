@@ -45,18 +45,34 @@ impl GridSpec {
             }
             dims[k] = ((ext / cell).ceil() as u64).clamp(1, 1 << 20) as u32;
         }
-        let g = Self {
+        Self {
             origin: lo,
             cell,
             dims,
-        };
-        if g.cells() > MAX_CELLS {
+        }
+        .checked()
+    }
+
+    /// The same box in cells of half the size (twice the cells per axis, same origin).
+    pub fn halved(&self) -> Result<Self> {
+        Self {
+            cell: 0.5 * self.cell,
+            dims: self.dims.map(|d| 2 * d),
+            ..*self
+        }
+        .checked()
+    }
+
+    /// This grid, or an error when it has more than MAX_CELLS cells.
+    fn checked(self) -> Result<Self> {
+        if self.cells() > MAX_CELLS {
+            let d = self.dims;
             return Err(Error::Param(format!(
                 "a grid of {}x{}x{} cells exceeds {MAX_CELLS}: raise the cell size (radius)",
-                dims[0], dims[1], dims[2]
+                d[0], d[1], d[2]
             )));
         }
-        Ok(g)
+        Ok(self)
     }
 
     pub fn cells(&self) -> u64 {
