@@ -217,7 +217,10 @@ impl FluidParams {
     /// The parameters with `KEY=VALUE` `overrides` (`--fluid`) and `solver` applied, and
     /// the solver's own step (its table's `cfl` and `dt_max`) where [fluid] sets no `cfl`.
     pub fn with_overrides(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
-        let mut out = self.with_values(overrides, solver)?;
+        let mut out = self.with_values(overrides)?;
+        out.solver = solver.unwrap_or(out.solver);
+        let mut out = out.with_own_step();
+        out.validate()?;
         out.resolve_spacing()?;
         Ok(out)
     }
@@ -268,7 +271,7 @@ impl FluidParams {
                 self.convergence().density_error * 100.0
             ),
         };
-        let solver = format!("{:?}", self.solver).to_lowercase();
+        let solver = self.solver.as_str();
         let how = match self.solver {
             Solver::Wcsph => "--fluid cfl= for a CFL-limited step".to_string(),
             _ => format!("its own by [fluid.{solver}]; --fluid cfl=, dt_max= override"),
@@ -276,13 +279,10 @@ impl FluidParams {
         format!("solver {solver}: {step}{stop} ({how})")
     }
 
-    fn with_values(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
+    /// The parameters with `overrides` parsed in (checked by the caller).
+    fn with_values(&self, overrides: &[String]) -> Result<Self> {
         if overrides.is_empty() {
-            let mut out = self.clone();
-            out.solver = solver.unwrap_or(out.solver);
-            let out = out.with_own_step();
-            out.validate()?;
-            return Ok(out);
+            return Ok(self.clone());
         }
         let mut value = toml::Value::try_from(self)
             .map_err(|e| Error::Param(format!("fluid parameters: {e}")))?;
@@ -302,14 +302,10 @@ impl FluidParams {
                 set_path(table, &path, parsed.clone())?;
             }
         }
-        let mut out: FluidParams = value.try_into().map_err(|e| {
+        value.try_into().map_err(|e| {
             let e = e.to_string().replace('\n', " ");
             Error::Param(format!("--fluid: {}", e.trim()))
-        })?;
-        out.solver = solver.unwrap_or(out.solver);
-        let out = out.with_own_step();
-        out.validate()?;
-        Ok(out)
+        })
     }
 
     /// Every iterative solver's density error target set to `e`.
