@@ -61,6 +61,16 @@ layout(std430, binding = CTL_B_CVMEAN) buffer Cvmean { vec4 cvmean[]; };
 float fine_cell() { return 0.5 * C.grid.w; }
 uvec3 fine_dims() { return 2u * C.dims.xyz; }
 uint fine_id(ivec3 f) { uvec3 d = fine_dims(); return (uint(f.z) * d.y + uint(f.y)) * d.x + uint(f.x); }
+// The cells along x (unclamped: x0 > x1 when none) of the row (y, z) = `yz` of a grid of
+// `cell`-sized cells that hold points within `r` of `x`: the sphere's chord in that row.
+ivec2 row_span(vec3 x, ivec2 yz, float cell, float r) {
+    vec2 lo = C.grid.yz + vec2(yz) * cell;
+    vec2 e = max(max(lo - x.yz, x.yz - lo - cell), vec2(0.0));
+    float rem = r * r - dot(e, e);
+    if (rem <= 0.0) return ivec2(1, 0);
+    float half_chord = sqrt(rem);
+    return ivec2(floor((x.x - half_chord - C.grid.x) / cell), floor((x.x + half_chord - C.grid.x) / cell));
+}
 // The sorted slots of fine cells a .. b (ids a <= b): [start, end).
 uvec2 fine_range(uint a, uint b) { return uvec2(cstart[a], cstart[b] + ccount[b]); }
 

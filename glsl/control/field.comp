@@ -33,15 +33,10 @@ void main() {
         return;
     }
     for (int cz = lo.z; cz <= hi.z; ++cz) for (int cy = lo.y; cy <= hi.y; ++cy) {
-        vec2 blo = C.grid.yz + vec2(cy, cz) * C.grid.w;
-        vec2 e = max(max(blo - xi.yz, xi.yz - blo - C.grid.w), vec2(0.0));
-        float rem = R * R - dot(e, e);
-        if (rem <= 0.0) continue;
-        float half_chord = sqrt(rem);
-        int x0 = max(int(floor((xi.x - half_chord - C.grid.x) / C.grid.w)), lo.x);
-        int x1 = min(int(floor((xi.x + half_chord - C.grid.x) / C.grid.w)), hi.x);
-        uint row = (uint(cz) * C.dims.y + uint(cy)) * C.dims.x;
+        ivec2 span = row_span(xi, ivec2(cy, cz), C.grid.w, R);
+        int x0 = max(span.x, lo.x), x1 = min(span.y, hi.x);
         if (x1 < x0) continue;
+        uint row = (uint(cz) * C.dims.y + uint(cy)) * C.dims.x;
         uvec2 r0 = fine_range(fine_id(ivec3(2 * x0, 2 * cy, 2 * cz)), fine_id(ivec3(2 * x1 + 1, 2 * cy + 1, 2 * cz)));
         uvec2 r1 = fine_range(fine_id(ivec3(2 * x0, 2 * cy, 2 * cz + 1)), fine_id(ivec3(2 * x1 + 1, 2 * cy + 1, 2 * cz + 1)));
         if (r0.x == r0.y && r1.x == r1.y) continue;

@@ -34,13 +34,9 @@ void main() {
     if (C.pressure != 0.0 || C.velocity > 0.0) for (int dz = -2; dz <= 2; ++dz) for (int dy = -2; dy <= 2; ++dy) {
         ivec2 cyz = c0.yz + ivec2(dy, dz);
         if (any(lessThan(cyz, ivec2(0))) || any(greaterThanEqual(cyz, fd.yz))) continue;
-        vec2 lo = C.grid.yz + vec2(cyz) * fc;
-        vec2 e = max(max(lo - xi.yz, xi.yz - lo - fc), vec2(0.0));
-        float rem = hc2 - dot(e, e);
-        if (rem <= 0.0) continue;
-        float half_chord = sqrt(rem);
-        int x0 = clamp(int(floor((xi.x - half_chord - C.grid.x) / fc)), 0, fd.x - 1);
-        int x1 = clamp(int(floor((xi.x + half_chord - C.grid.x) / fc)), 0, fd.x - 1);
+        ivec2 span = row_span(xi, cyz, fc, hc);
+        if (span.x > span.y) continue;
+        int x0 = clamp(span.x, 0, fd.x - 1), x1 = clamp(span.y, 0, fd.x - 1);
         uvec2 run = fine_range(fine_id(ivec3(x0, cyz)), fine_id(ivec3(x1, cyz)));
         for (uint j = run.x; j < run.y; ++j) {
             vec3 d = xi - cpos[j].xyz;
