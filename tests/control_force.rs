@@ -217,6 +217,16 @@ fn compare(settings: ControlSettings, velocity: Vec3) -> (f64, f64) {
     }
     let crho = control.densities(&ctx).unwrap();
     let (d0, d1) = (&accs[0], &accs[1]);
+    // Each run sorts the particles anew, and the counting sort's order within a cell
+    // follows its atomics: the run without control is matched to the run with it by
+    // position (unchanged: no step integrates), not by slot.
+    let key = |p: &[f32; 4]| [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+    let slot0: std::collections::HashMap<_, usize> = d0
+        .pos
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i))
+        .collect();
     let f = &sc.fluid;
     let (h, hc, m) = (f.h as f64, settings.radius as f64, f.mass as f64);
     let group = |a: &[f32; 4]| a[3].to_bits();
@@ -294,7 +304,8 @@ fn compare(settings: ControlSettings, velocity: Vec3) -> (f64, f64) {
                 want += wt.x * wt.y * wt.z * (pull + settings.damping as f64 * mask * (vc - v));
             }
         }
-        let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - d0.acc[i][k]) as f64));
+        let a0 = d0.acc[slot0[&key(&d1.pos[i])]];
+        let got = glam::DVec3::from_array([0, 1, 2].map(|k| (d1.acc[i][k] - a0[k]) as f64));
         rows.push((want, got));
         scale = scale.max(want.length());
         touched += (want.length() > 0.0) as usize;
