@@ -97,3 +97,91 @@ fn a_given_spacing_stays_and_bad_pools_are_refused() {
     .to_string();
     assert!(e.contains("[pool]"), "{e}");
 }
+
+/// A scene with a character and no `[domain]` or `[camera]` (scene::around): the domain
+/// holds the placed skin at every moment of its lap, off the sampled times too, stands on
+/// the floor the character stands on, and the camera sees the whole of it.
+#[test]
+fn the_domain_and_camera_are_fitted_around_the_motion() {
+    use fluidform::config::Skinning;
+    use fluidform::scene::character::placed_matrices;
+    let dir = std::env::temp_dir().join("fluidform-fit-3");
+    std::fs::create_dir_all(&dir).unwrap();
+    let body = "name = \"around\"\n[pool]\n[control]\n[character]\nfile = \"builtin:walker\"\nheight = 1.0\npath = [[-0.3, 0.1, -0.2], [0.3, 0.1, -0.2], [0.3, 0.1, 0.2], [-0.3, 0.1, 0.2]]\npath_speed = 0.5\n";
+    let s = scene(&dir, body).unwrap();
+    let (lo, hi) = (s.domain.min, s.domain.max);
+    assert_eq!(lo[1], 0.1, "the floor is where the path stands");
+    let desc = s.character.as_ref().unwrap();
+    let (ch, anim) = desc.load().unwrap();
+    let path = desc.path();
+    let cam = s.camera.clone().expect("a fitted camera");
+    let eye = glam::Vec3::from(cam.eye);
+    let ahead = (glam::Vec3::from(cam.target) - eye).normalize();
+    let half = (0.5 * cam.fov).to_radians();
+    // The lap is 2 m at 0.5 m/s: 4 s, sampled at times between the fit's own samples.
+    for k in 0..160 {
+        let t = 0.0137 + k as f64 * 0.025;
+        let mats = placed_matrices(&ch, &anim, desc.speed, path.as_ref(), t);
+        for p in ch.skinned_at(&mats, Skinning::Lbs).unwrap().0 {
+            for a in 0..3 {
+                let below_floor = a == 1 && p[1] < lo[1];
+                assert!(
+                    below_floor || (p[a] >= lo[a] && p[a] <= hi[a]),
+                    "t {t}: skin point {p} outside the domain {lo:?}..{hi:?}"
+                );
+            }
+            let d = (p - eye).normalize();
+            assert!(
+                d.dot(ahead).clamp(-1.0, 1.0).acos() < half,
+                "t {t}: {p} outside the camera's view"
+            );
+        }
+    }
+    // Fitted, the scene plays as one with a domain: its pool lies inside it.
+    let mut s = s;
+    fit(&mut s).unwrap();
+    s.validate().unwrap();
+    // Without a character there is nothing to fit a domain around.
+    let e = scene(
+        &dir,
+        "name = \"none\"\n[[blocks]]\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.1, 0.1]\n",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("no [domain]"), "{e}");
+}
+
+/// A pool whose thinnest-part spacing would hold more than the budget's particles is
+/// coarsened to about the budget (within a layer), and says so.
+#[test]
+fn the_spacing_keeps_the_pool_within_the_budget() {
+    use fluidform::scene::fit::BUDGET;
+    let dir = std::env::temp_dir().join("fluidform-fit-4");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut s = scene(
+        &dir,
+        &format!("{HEAD}height = 1.2\n[control]\n[pool]\nvolume = 6\n"),
+    )
+    .unwrap();
+    let f = fit(&mut s).unwrap();
+    let (sp, why) = f.spacing.clone().unwrap();
+    assert!(
+        why.contains("budget") || why.contains(&format!("{BUDGET}")),
+        "{why}"
+    );
+    let (ch, _) = s.character.as_ref().unwrap().load().unwrap();
+    let (lo, hi) = ch.rest_bounds().unwrap();
+    let scale = 1.2 / (hi.y - lo.y);
+    let d = thinnest(&ch).unwrap().diameter * scale;
+    assert!(
+        sp > (d / ACROSS).clamp(1.2 / FINEST, 1.2 / COARSEST),
+        "coarser than the thinnest part asks"
+    );
+    let n = s.particles(1).len() as f32;
+    let b = &s.blocks[0];
+    let layer = (b.max[0] - b.min[0]) * (b.max[2] - b.min[2]) / (sp * sp);
+    assert!(
+        n >= 0.95 * BUDGET && n <= BUDGET + layer + 1.0,
+        "{n} particles (layer {layer})"
+    );
+}

@@ -13,6 +13,11 @@ pub const ACROSS: f32 = 2.5;
 /// The chosen spacing stays within [height / FINEST, height / COARSEST].
 pub const FINEST: f32 = 70.0;
 pub const COARSEST: f32 = 35.0;
+/// The chosen spacing puts at most about this many particles in the pool: a character whose
+/// thinnest part is thin for its size (a quadruped's feet) would otherwise take tens of
+/// thousands of particles and tiny steps (the fox: 28.7K at 74 steps a frame), beyond what
+/// a 2-core machine plays in minutes. `--fluid spacing=S` goes finer.
+pub const BUDGET: f32 = 8192.0;
 
 /// The default pool holds this many times the character's volume: 1.15 (was 1.3) once the
 /// attraction's reach of 5 h_c drew the whole pool up: the 0.3 spare then sat as a lump on
@@ -95,19 +100,31 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     // (A mass other than the default's already says the spacing: mass = rho_0 S^3.)
     let default_mass = scene.fluid.mass == crate::sph::FluidParams::default().mass;
     if scene.fluid.spacing.is_none() && default_mass {
-        let (s, why) = match thinnest(&ch) {
+        let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
+        let pool = scene.pool.as_ref().map_or(1.0, |p| p.volume);
+        // The spacing the thinnest part asks for, and that part's name and width.
+        let (s, part) = match thinnest(&ch) {
             Some(t) => {
                 let d = t.diameter * scale;
                 let s = (d / ACROSS).clamp(height / FINEST, height / COARSEST);
-                let why = format!(
-                    "{:.2} across the thinnest part, '{}' {d:.4} m, within height / {FINEST} .. height / {COARSEST}",
-                    d / s,
-                    t.joint
-                );
-                (s, why)
+                (s, Some((t.joint, d)))
             }
-            None => (height / COARSEST, format!("height / {COARSEST}")),
+            None => (height / COARSEST, None),
         };
+        // (A spacing the budget coarsens still stays within height / COARSEST.)
+        let budget = (volume * pool / BUDGET).cbrt().min(height / COARSEST);
+        let why = match (budget > s, part) {
+            (true, _) => format!(
+                "the pool held to about {BUDGET} particles: {s:.4} m would give {:.0}",
+                volume * pool / s.powi(3)
+            ),
+            (false, None) => format!("height / {COARSEST}"),
+            (false, Some((joint, d))) => format!(
+                "{:.2} across the thinnest part, '{joint}' {d:.4} m, within height / {FINEST} .. height / {COARSEST}",
+                d / s
+            ),
+        };
+        let s = s.max(budget);
         scene.fluid.spacing = Some(s);
         scene.fluid.resolve_spacing()?;
         out.spacing = Some((s, why));
@@ -122,7 +139,15 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         // The placed skin at scene time 0 (the path's start included).
         let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
         let first = ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0;
-        let (plo, phi) = crate::character::check::bounds(&first);
+        // Under the lower half of the body only: arms held out (a T-pose) would spread the
+        // pool beyond the attraction's reach of the legs, leaving puddles under the hands.
+        let (lo, _) = crate::character::check::bounds(&first);
+        let low: Vec<Vec3> = first
+            .iter()
+            .copied()
+            .filter(|p| p.y <= lo.y + 0.5 * height)
+            .collect();
+        let (plo, phi) = crate::character::check::bounds(&low);
         let want = (ch.check.signed_volume.abs() as f32) * scale.powi(3) * pool.volume;
         let b = pool_block(scene, (plo, phi), want, pool.color)?;
         let s = scene.fluid.spacing();

@@ -1,5 +1,6 @@
 //! Scenes: the schema and its built-ins, and the parts a scene plays beside the fluid
 //! (characters, control targets, emission, the `orbits` test scene).
+pub mod around;
 pub mod builtin;
 pub mod character;
 pub mod emission;

@@ -31,6 +31,8 @@ fn default_frames() -> u64 {
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     pub name: String,
+    /// Fitted around the character's motion when a scene with `[character]` gives none.
+    #[serde(default, skip_serializing_if = "Domain::is_unset")]
     pub domain: Domain,
     #[serde(default)]
     pub fluid: FluidParams,
@@ -114,6 +116,12 @@ impl Look {
 
 impl Scene {
     pub fn validate(&self) -> Result<()> {
+        if self.domain.is_unset() {
+            return Err(Error::Param(format!(
+                "scene {}: no [domain] (only a scene with a [character] has one fitted)",
+                self.name
+            )));
+        }
         SphSetup::from(self).validate()?;
         self.validate_fluid_bodies()?;
         if let Some(c) = &self.character {

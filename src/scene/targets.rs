@@ -271,7 +271,12 @@ impl SceneTargets {
             let next = (c.force.settings.motion == ControlMotion::Skin)
                 .then(|| ch.matrices(t + frame_dt as f64));
             c.set_pose(&ch.ch, &mats, next.as_deref(), frame_dt)?;
-            let before = ch.matrices(t - SKIN_SPEED_DT);
+            // (Ahead of the clip's start rather than across a loop's seam into its end.)
+            let moment = match t >= SKIN_SPEED_DT {
+                true => t - SKIN_SPEED_DT,
+                false => t + SKIN_SPEED_DT,
+            };
+            let before = ch.matrices(moment);
             l.poses[slot] = Some((mats, before, t));
         }
         Ok(())

@@ -7,11 +7,19 @@ use crate::error::{Error, Result};
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// The box the fluid lives in. The default, all zeros, stands for "not given": a scene
+/// with a character has one fitted around its motion (`scene::fit`), any other is refused.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Domain {
     pub min: [f32; 3],
     pub max: [f32; 3],
+}
+
+impl Domain {
+    pub fn is_unset(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 pub fn white() -> [f32; 3] {
