@@ -226,6 +226,11 @@ pub struct ControlArgs {
     /// frame ahead)
     #[arg(long, value_enum)]
     pub control_motion: Option<ControlMotion>,
+    /// What the deficit attraction measures a control particle's deficit against: rest
+    /// density (default), or shape (the density fluid filling the shape exactly has there:
+    /// about 0.8 at a flat surface; needs --placement random)
+    #[arg(long, value_enum)]
+    pub control_deficit: Option<Deficit>,
     /// Steps between refreshes of the control's sums (control densities, eq. 7's walk; the
     /// deficit field follows each pose); the steps between apply each particle's stored
     /// eq. 7 sum with their own density and velocity, and a frame's first step always

@@ -76,6 +76,7 @@ switch_enum!(OnOff { On, Off });
 switch_enum!(Adaptive { Off, On, Smooth });
 switch_enum!(ControlPreset { Thesis, Fidelity });
 switch_enum!(ControlMotion { Frames, Skin });
+switch_enum!(Deficit { Rest, Shape });
 switch_enum!(BoneWeights { Eq8, Eq9, Skin });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });

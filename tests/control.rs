@@ -232,3 +232,63 @@ fn the_timeline_attaches_switches_unites_releases_and_scales() {
     let e = Timeline::new("s", &bad, &names).unwrap_err().to_string();
     assert!(e.contains("event 2") && e.contains("not attached"), "{e}");
 }
+
+/// The shape's fill at control particles (`--control-deficit shape`): a 20^3 lattice cube
+/// at spacing 1, h = 2 (the fluid's 2 spacings), each particle a unit of its volume.
+/// Interior particles see the whole kernel (1, the lattice sum being 1.0098 before the
+/// cap), a face's centre about 0.82 (the lattice layer sits half a spacing inside the
+/// face), a corner about 0.52; nothing exceeds 1.
+#[test]
+fn the_shape_fill_is_one_inside_and_falls_at_faces_and_corners() {
+    use fluidform::control::placement::fill;
+    let n = 20;
+    let mut pts = Vec::new();
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                pts.push(glam::Vec3::new(i as f32, j as f32, k as f32));
+            }
+        }
+    }
+    let f = fill(&pts, (n * n * n) as f32, 2.0);
+    let at = |i: usize, j: usize, k: usize| f[(k * n + j) * n + i];
+    assert!(f.iter().all(|v| *v > 0.0 && *v <= 1.0));
+    assert!(
+        (at(10, 10, 10) - 1.0).abs() < 1e-6,
+        "interior {}",
+        at(10, 10, 10)
+    );
+    let face = at(10, 10, 0);
+    assert!((0.78..0.86).contains(&face), "face {face}");
+    let corner = at(0, 0, 0);
+    assert!((0.48..0.56).contains(&corner), "corner {corner}");
+    // The same cube's particles standing for twice the volume read twice as full (capped).
+    let g = fill(&pts, 2.0 * (n * n * n) as f32, 2.0);
+    assert!((g[0] - (2.0 * corner).min(1.0)).abs() < 1e-5);
+}
+
+/// Which deficit a target measures: rest density unless the shape's fill is asked for,
+/// which placements that put no particles inside refuse.
+#[test]
+fn the_deficit_measure_follows_the_preset_and_placement() {
+    use fluidform::control::target::ControlDesc;
+    use fluidform::kinds::{ControlPreset, Deficit, Placement};
+    let d = ControlDesc::default();
+    assert_eq!(d.deficit().unwrap(), Deficit::Rest);
+    let shape = ControlDesc {
+        preset: Some(ControlPreset::Thesis),
+        deficit: Some(Deficit::Shape),
+        ..ControlDesc::default()
+    };
+    assert_eq!(shape.deficit().unwrap(), Deficit::Shape);
+    for p in [Placement::Vertices, Placement::Rays] {
+        let mut d = ControlDesc {
+            placement: p,
+            ..ControlDesc::default()
+        };
+        assert_eq!(d.deficit().unwrap(), Deficit::Rest);
+        d.deficit = Some(Deficit::Shape);
+        let e = d.deficit().unwrap_err().to_string();
+        assert!(e.contains("--control-deficit"), "{e}");
+    }
+}

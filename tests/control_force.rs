@@ -180,7 +180,7 @@ fn compare(settings: ControlSettings, velocity: Vec3) -> (f64, f64) {
         1,
         settings.clone(),
         (sc.domain.min, sc.domain.max),
-        (None, Skinning::Lbs),
+        (None, Skinning::Lbs, None),
     )
     .unwrap();
     let mut st = solver.state(&ctx, &sc, &parts).unwrap();
@@ -425,8 +425,16 @@ fn stored_control_sums_follow_the_particles_through_the_sort() {
     };
     let mesh = control_mesh(0.03);
     let domain = (sc.domain.min, sc.domain.max);
-    let mut control =
-        ControlForce::new(&ctx, &solver, &mesh, 1, s, domain, (None, Skinning::Lbs)).unwrap();
+    let mut control = ControlForce::new(
+        &ctx,
+        &solver,
+        &mesh,
+        1,
+        s,
+        domain,
+        (None, Skinning::Lbs, None),
+    )
+    .unwrap();
     let mut st = solver.state(&ctx, &sc, &parts).unwrap();
     let joints =
         fluidform::character::pose::gpu_joints(&[Mat4::IDENTITY], Skinning::Lbs, &|_| "j".into())

@@ -2,7 +2,7 @@
 //! on a mesh with eight influences per vertex.
 mod common;
 use common::asset;
-use fluidform::character::skin::Skinner;
+use fluidform::character::skin::{SkinnedMesh, Skinner};
 use fluidform::character::{self, Animator, Character};
 use fluidform::config::Skinning;
 use fluidform::gpu::{sync, Context};
@@ -10,7 +10,8 @@ use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};
 
 /// Skin on the GPU; the largest position error relative to the mesh size, and the largest
-/// normal error, against the CPU reference.
+/// normal error, against the CPU reference. Each vertex carries a tag in its rest position's
+/// w (the control particles' fill of the shape), which must come out unchanged.
 fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
     let anim = Animator {
         clip: (!ch.clips.is_empty()).then_some(0),
@@ -19,7 +20,17 @@ fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32
     };
     let mats = anim.joint_matrices(ch, t);
     let joints = ch.gpu_joints(&mats, method).unwrap();
-    let mut sk = Skinner::new(ctx, ch, method).unwrap();
+    let tags: Vec<f32> = (0..ch.mesh.vertices())
+        .map(|v| 0.5 + (v % 7) as f32 / 16.0)
+        .collect();
+    let plain = Skinner::new(ctx, ch, method).unwrap();
+    let mesh = SkinnedMesh::tagged(ctx, &ch.mesh, ch.skeleton.joints.len(), Some(&tags)).unwrap();
+    let mut sk = Skinner {
+        pass: plain.pass,
+        mesh,
+    };
+    let mut unused = plain.mesh;
+    unused.destroy(ctx);
     ctx.one_shot(|cmd| {
         sk.record(ctx, cmd, &joints).unwrap();
         ctx.barrier(
@@ -32,6 +43,9 @@ fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32
     let pos: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.pos).unwrap();
     let nrm: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.nrm).unwrap();
     sk.destroy(ctx);
+    for (v, p) in pos.iter().enumerate() {
+        assert_eq!(p[3], tags[v], "{method:?}: vertex {v}'s tag");
+    }
     let (cp, cn) = ch.skinned_at(&mats, method).unwrap();
     let (lo, hi) = character::check::bounds(&cp);
     let size = (hi - lo).length();

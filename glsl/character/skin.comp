@@ -42,7 +42,7 @@ void main() {
             t += j.m[3].xyz * w[k];
         }
     }
-    out_pos[v] = vec4(a * p + t, 1.0);
+    out_pos[v] = vec4(a * p + t, rest_pos[v].w);
     vec3 nn = cofactor(a) * n;
 #elif SKIN_METHOD == 1
     vec4 q0 = joints[joint_of(joint_ids[v * SKIN_SETS], 0u)].real;
@@ -63,7 +63,7 @@ void main() {
     r /= len;
     d /= len;
     vec3 t = 2.0 * (r.w * d.xyz - d.w * r.xyz + cross(r.xyz, d.xyz));
-    out_pos[v] = vec4(rotate(r, st * p) + t, 1.0);
+    out_pos[v] = vec4(rotate(r, st * p) + t, rest_pos[v].w);
     vec3 nn = rotate(r, cofactor(st) * n);
 #else
 #error "SKIN_METHOD is 0 (linear blend) or 1 (dual quaternion)"

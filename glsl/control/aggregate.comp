@@ -15,7 +15,11 @@ void main() {
         ivec3 f = 2 * c + ivec3(0, o & 1, o >> 1);
         uvec2 r = fine_range(fine_id(f), fine_id(f) + 1u);
         for (uint j = r.x; j < r.y && j < C.live; ++j) {
-            float d = max(1.0 - crho[j] / P.rest_density, 0.0);
+            // A control particle's deficit is against the density the shape's own fill
+            // gives there (its w, --control-deficit shape: about 1/2 at the surface, where
+            // full fluid has only one side) or, w = 1 (rest) or 0 (rays), rest density.
+            float full = cpos[j].w > 0.0 ? cpos[j].w : 1.0;
+            float d = max(1.0 - crho[j] / (P.rest_density * full), 0.0);
             def += vec4(d * cpos[j].xyz, d);
             at += vec4(cpos[j].xyz, 1.0);
             v.xyz += cvw[j].xyz;

@@ -37,7 +37,7 @@ struct ControlParams {
     float damping;    // damping relative to the character's velocity (1/s, 0: off)
 };
 layout(std430, binding = CTL_B_CONTROL) readonly buffer Control { ControlParams C; };
-layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz
+layout(std430, binding = CTL_B_CPOS) readonly buffer Cpos { vec4 cpos[]; };    // sorted, xyz; w: shape's fill
 layout(std430, binding = CTL_B_CPREV) readonly buffer Cprev { vec4 cprev[]; };  // previous pose
 layout(std430, binding = CTL_B_CRHO) buffer Crho { float crho[]; };  // fluid density there
 // Per control particle (density.comp): xyz its velocity, w its eq. 7 weight.

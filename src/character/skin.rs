@@ -104,10 +104,27 @@ pub struct SkinnedMesh {
 
 impl SkinnedMesh {
     pub fn new(ctx: &Context, mesh: &Mesh, joint_count: usize) -> Result<Self> {
+        Self::tagged(ctx, mesh, joint_count, None)
+    }
+
+    /// With a value per vertex that skinning carries along in the positions' w (the
+    /// control particles' fill of the shape; 1 without).
+    pub fn tagged(
+        ctx: &Context,
+        mesh: &Mesh,
+        joint_count: usize,
+        tags: Option<&[f32]>,
+    ) -> Result<Self> {
         let n = mesh.vertices();
         let sets = mesh.influence_sets;
         let v4 = |v: &glam::Vec3, w: f32| [v.x, v.y, v.z, w];
-        let pos: Vec<[f32; 4]> = mesh.positions.iter().map(|p| v4(p, 1.0)).collect();
+        let tag = |i: usize| tags.and_then(|t| t.get(i).copied()).unwrap_or(1.0);
+        let pos: Vec<[f32; 4]> = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| v4(p, tag(i)))
+            .collect();
         let nrm: Vec<[f32; 4]> = mesh.normals.iter().map(|p| v4(p, 0.0)).collect();
         let mut ids = Vec::with_capacity(n * sets);
         let mut ws = Vec::with_capacity(n * sets);

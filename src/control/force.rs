@@ -190,6 +190,8 @@ impl ControlForce {
     /// weights (normals unused), skinned by `joints` joints, for fluid searched by
     /// `solver`, in the domain [lo, hi], skinned by `skinning`. With `rays` (spacing,
     /// capacity), `mesh` is the target's surface, skinned and re-placed by rays every frame.
+    /// `fill`: per control particle, the fraction of rest density the shape's own fill
+    /// gives there (`--control-deficit shape`; None: rest density).
     /// Long because each pipeline and buffer is made under its own guard and moved into
     /// the force at the end (a failure part-way frees what was made).
     pub fn new(
@@ -199,7 +201,7 @@ impl ControlForce {
         joints: usize,
         settings: ControlSettings,
         domain: ([f32; 3], [f32; 3]),
-        (rays, skinning): (Option<(f32, u32)>, crate::kinds::Skinning),
+        (rays, skinning, fill): (Option<(f32, u32)>, crate::kinds::Skinning, Option<&[f32]>),
     ) -> Result<Self> {
         let m = control_count(mesh, &settings, rays)?;
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
@@ -248,7 +250,7 @@ impl ControlForce {
         let nb = Guard::new(ctx, search.buffers(ctx, m as u64, &fine, 0)?);
         let skin = SkinPass::new(ctx, skinning, mesh.influence_sets)?;
         let skin = Guard::new(ctx, skin);
-        let cmesh = Guard::new(ctx, SkinnedMesh::new(ctx, mesh, joints)?);
+        let cmesh = Guard::new(ctx, SkinnedMesh::tagged(ctx, mesh, joints, fill)?);
         let gather = Guard::new(ctx, GatherPass::new(ctx)?);
         let buf =
             |name: &str, bytes: u64| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
