@@ -71,6 +71,10 @@ pub struct Pose {
     pub next: Option<Vec<GpuJoint>>,
 }
 
+/// How a control set is placed and skinned: `--placement rays` (spacing, capacity), the
+/// skinning, and each control particle's fill of the shape (`--control-deficit shape`).
+pub type SetKind<'a> = (Option<(f32, u32)>, crate::kinds::Skinning, Option<&'a [f32]>);
+
 /// GPU state of a control set.
 struct ControlGpu {
     density: ComputePipeline<ControlIo>,
@@ -201,7 +205,7 @@ impl ControlForce {
         joints: usize,
         settings: ControlSettings,
         domain: ([f32; 3], [f32; 3]),
-        (rays, skinning, fill): (Option<(f32, u32)>, crate::kinds::Skinning, Option<&[f32]>),
+        (rays, skinning, fill): SetKind,
     ) -> Result<Self> {
         let m = control_count(mesh, &settings, rays)?;
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
