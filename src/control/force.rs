@@ -73,7 +73,11 @@ pub struct Pose {
 
 /// How a control set is placed and skinned: `--placement rays` (spacing, capacity), the
 /// skinning, and each control particle's fill of the shape (`--control-deficit shape`).
-pub type SetKind<'a> = (Option<(f32, u32)>, crate::kinds::Skinning, Option<&'a [f32]>);
+pub type SetKind<'a> = (
+    Option<(f32, u32)>,
+    crate::kinds::Skinning,
+    Option<&'a [f32]>,
+);
 
 /// GPU state of a control set.
 struct ControlGpu {

@@ -1,7 +1,7 @@
 //! A scene with a `[character]` that gives no `[domain]` (or no `[camera]`) gets one fitted
 //! around the character's motion: the box its skin sweeps over its clip, its path's lap and
 //! the scene's frames, grown by a margin; the camera frames that box from the front three
-//! quarters. A scene file for a character nobody tuned for then names only the file, the
+//! quarters (the side three quarters for a long one). A scene file for a character nobody tuned for then names only the file, the
 //! animation, the height and a pool.
 use super::character::{placed_matrices, CharacterDesc};
 use super::schema::{CameraDesc, Domain, Scene};
@@ -17,9 +17,12 @@ const RATE: f64 = 30.0;
 const MAX_SAMPLES: usize = 240;
 /// Longest sweep sampled (seconds): a longer clip or lap repeats its ground.
 const MAX_SPAN: f64 = 60.0;
-/// The fitted camera's field of view (degrees) and its direction from the box's centre.
+/// The fitted camera's field of view (degrees) and its direction from the box's centre:
+/// from the front three quarters (+Z is the front), or from the side three quarters when
+/// the motion is longer along Z than wide (a quadruped seen from the front hides its body).
 const FOV: f32 = 40.0;
-const VIEW: Vec3 = Vec3::new(0.55, 0.3, 1.0);
+const FRONT: Vec3 = Vec3::new(0.55, 0.3, 1.0);
+const SIDE: Vec3 = Vec3::new(1.0, 0.3, 0.55);
 
 /// Fit the domain and the camera that `scene` leaves out, when it has a character.
 pub fn fit_around(scene: &mut Scene) -> Result<()> {
@@ -54,7 +57,10 @@ pub fn fit_around(scene: &mut Scene) -> Result<()> {
     }
     if scene.camera.is_none() {
         let c = 0.5 * (lo + hi);
-        let dir = VIEW.normalize();
+        let dir = match hi.z - lo.z > hi.x - lo.x {
+            true => SIDE.normalize(),
+            false => FRONT.normalize(),
+        };
         let dist = framing_distance(lo, hi, dir);
         scene.camera = Some(CameraDesc {
             eye: (c + dir * dist).into(),

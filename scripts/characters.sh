@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# Liquid characters nobody tuned for: for each FILE[:HEIGHT[:FRAMES]] given (a closed,
+# skinned .glb/.gltf or a closed .obj; height in metres, default 1.7; frames default 120),
+# write a scene that names only the file, its height, [pool] and [control] (the domain,
+# camera, spacing and pool are fitted: README "Your own character"), run it with the
+# points view and print one markdown row of its fidelity metrics (mean and minimum over
+# the second half of the run). Scenes and outputs go to out/characters/<name>/.
+# Usage: scripts/characters.sh [--device N|NAME] FILE[:HEIGHT[:FRAMES]] ...
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${FLUIDFORM_BIN:-}
+if [ -z "$bin" ]; then
+  cargo build --release --quiet
+  bin=target/release/fluidform
+fi
+dev=()
+files=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --device) dev=(--device "$2"); shift 2 ;;
+    *) files+=("$1"); shift ;;
+  esac
+done
+[ ${#files[@]} -gt 0 ] || { echo "usage: scripts/characters.sh [--device D] FILE[:HEIGHT[:FRAMES]] ..." >&2; exit 2; }
+echo "| character | height m | frames | particles | spacing m | fill | (min) | iou | (min) | spray | surface p95 | density in shape | speed excess m/s | time to 90% s | control share | wall s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+for spec in "${files[@]}"; do
+  IFS=':' read -r file height frames <<< "$spec"
+  height=${height:-1.7}
+  frames=${frames:-120}
+  name=$(basename "$file" | sed 's/\.[^.]*$//')
+  out=out/characters/$name
+  mkdir -p "$out"
+  cat > "$out/scene.toml" <<EOF
+name = "$name"
+frames = $frames
+[character]
+file = "$(realpath "$file")"
+height = $height
+[pool]
+[control]
+EOF
+  start=$(date +%s)
+  if ! "$bin" run --scene "$out/scene.toml" --render points --save-every 0 --out "$out" "${dev[@]}" > "$out/log" 2>&1; then
+    echo "| $name | $height | $frames | FAILED: $(tail -1 "$out/log" | tr '|' '/') |"
+    continue
+  fi
+  wall=$(( $(date +%s) - start ))
+  python3 - "$out/summary.json" "$out/log" "$name" "$height" "$frames" "$wall" <<'PY'
+import json, re, sys
+s = json.load(open(sys.argv[1]))
+log = open(sys.argv[2]).read()
+t = s["stats"]["control"]["targets"][0]
+w = t["fidelity"]
+g = lambda k, f="mean": (w.get(k) or {}).get(f, float("nan"))
+p = s["pass_ms"]
+share = p.get("sph/control", {"median": 0.0})["median"] / p["sph"]["median"]
+n = re.search(r"pool [^,]*, (\d+) particles", log)
+sp = re.search(r"spacing ([0-9.]+) m", log)
+t90 = t["time_to_90"]
+print(f"| {sys.argv[3]} | {sys.argv[4]} | {sys.argv[5]} | {n.group(1) if n else ''} | {sp.group(1) if sp else ''} | "
+      f"{g('fill'):.3f} | {g('fill','min'):.3f} | {g('iou'):.3f} | {g('iou','min'):.3f} | {g('spray'):.4f} | "
+      f"{g('surface_p95'):.2f} | {g('density_in_shape'):.3f} | {g('speed_excess'):.2f} | "
+      f"{'' if t90 is None else f'{t90:.2f}'} | {share:.2f} | {sys.argv[6]} |")
+PY
+done
