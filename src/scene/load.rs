@@ -127,7 +127,10 @@ impl Scene {
 /// The water of scenes that release their control targets (the built-in `character`'s
 /// `[fluid]`): a metre's collapse hits the pool at about 4.4 m/s, and weakly compressible
 /// SPH wants c >= 10 v; c = 40 m/s, 24 steps of 0.45 ms a frame, walls with a little
-/// friction (a drained pool's film races along a frictionless floor's edges).
+/// friction (a drained pool's film races along a frictionless floor's edges), and a
+/// viscosity of 20 (Kelager's 3.5 let the water held in a shape circulate: CesiumMan's
+/// speed excess 1.71 -> 0.88 m/s, a standing figure's 2.5 -> 1.5 m/s, fill and iou held;
+/// results/<device>/control-fidelity.md).
 const RELEASED_WATER: &str = r#"
 eos = "tait"
 sound_speed = 40.0
@@ -135,6 +138,7 @@ clamp_negative_pressure = true
 dt = 0.00045
 substeps = 24
 friction = 0.02
+viscosity = 20.0
 "#;
 
 impl ParticleScene {
