@@ -10,12 +10,13 @@
 //!   mesh, in spacings;
 //! - `density_in_shape`: mean density of the fluid inside over rest density;
 //! - `speed_excess`: the fastest fluid in the box minus the fastest skin point.
+use super::grid::Grid;
 use super::inside::InsideTest;
 use super::surface::SurfaceDistance;
 use crate::character::check;
 use glam::{IVec3, Vec3};
 use serde::{Deserialize, Serialize};
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 /// Fewer neighbours than this within h: isolated (spray when airborne and away).
 pub const SPRAY_NEIGHBORS: usize = 5;
@@ -50,34 +51,6 @@ pub struct Fidelity {
     /// None: no fluid inside.
     pub density_in_shape: Option<f64>,
     pub speed_excess: f64,
-}
-
-/// A uniform hash grid of particle indices (cell = h).
-struct Grid {
-    cell: f32,
-    cells: HashMap<IVec3, Vec<u32>>,
-}
-
-impl Grid {
-    fn new(pos: &[Vec3], keep: impl Fn(usize) -> bool, cell: f32) -> Self {
-        let mut cells: HashMap<IVec3, Vec<u32>> = HashMap::new();
-        for (i, p) in pos.iter().enumerate().filter(|(i, _)| keep(*i)) {
-            cells
-                .entry((*p / cell).floor().as_ivec3())
-                .or_default()
-                .push(i as u32);
-        }
-        Self { cell, cells }
-    }
-
-    /// Every stored index within the 27 cells about `p`.
-    fn near(&self, p: Vec3) -> impl Iterator<Item = u32> + '_ {
-        let c = (p / self.cell).floor().as_ivec3();
-        (0..27).flat_map(move |k| {
-            let d = IVec3::new(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
-            self.cells.get(&(c + d)).into_iter().flatten().copied()
-        })
-    }
 }
 
 /// Voxel counts over a box: the target's interior, how much of it the fluid fills, and

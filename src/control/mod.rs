@@ -4,6 +4,7 @@ pub mod binding;
 pub mod cache;
 pub mod fidelity;
 pub mod force;
+pub mod grid;
 pub mod inside;
 pub mod metrics;
 pub mod placement;

@@ -155,32 +155,22 @@ pub fn place(
 /// Per control particle, the fraction of rest density that fluid filling the shape exactly
 /// would have there: the poly6 sum over the control set (support `h`, the fluid's), each
 /// particle standing for an equal share of the shape's `volume`. About 1 inside, 0.8 at a
-/// flat surface (h = 2 spacings), less at edges and tips; at most 1. What `--control-deficit shape` measures
-/// a control particle's deficit against (a surface particle is full at half density).
+/// flat surface (h = 2 spacings), less at edges and tips; at most 1. What `--control-deficit
+/// shape` measures a control particle's deficit against.
 pub fn fill(points: &[Vec3], volume: f32, h: f32) -> Vec<f32> {
-    use std::collections::HashMap;
-    let cell = |p: Vec3| (p / h).floor().as_ivec3();
-    let mut grid: HashMap<glam::IVec3, Vec<u32>> = HashMap::new();
-    for (i, p) in points.iter().enumerate() {
-        grid.entry(cell(*p)).or_default().push(i as u32);
-    }
+    let grid = super::grid::Grid::new(points, |_| true, h);
     let share = volume / points.len().max(1) as f32;
     let poly6 = 315.0 / (64.0 * std::f32::consts::PI * h.powi(9));
     let h2 = h * h;
     points
         .iter()
         .map(|p| {
-            let c = cell(*p);
-            let mut sum = 0.0f32;
-            for o in 0..27 {
-                let n = c + glam::IVec3::new(o % 3 - 1, (o / 3) % 3 - 1, o / 9 - 1);
-                for &k in grid.get(&n).map_or(&[][..], |v| v.as_slice()) {
-                    let r2 = p.distance_squared(points[k as usize]);
-                    if r2 < h2 {
-                        sum += (h2 - r2).powi(3);
-                    }
-                }
-            }
+            let sum: f32 = grid
+                .near(*p)
+                .map(|k| p.distance_squared(points[k as usize]))
+                .filter(|r2| *r2 < h2)
+                .map(|r2| (h2 - r2).powi(3))
+                .sum();
             (share * poly6 * sum).min(1.0)
         })
         .collect()
