@@ -16,7 +16,7 @@ void main() {
         uvec2 r = fine_range(fine_id(f), fine_id(f) + 1u);
         for (uint j = r.x; j < r.y && j < C.live; ++j) {
             // A control particle's deficit is against the density the shape's own fill
-            // gives there (its w, --control-deficit shape: about 1/2 at the surface, where
+            // gives there (its w, --control-deficit shape: about 0.8 at a flat surface, where
             // full fluid has only one side) or, w = 1 (rest) or 0 (rays), rest density.
             float full = cpos[j].w > 0.0 ? cpos[j].w : 1.0;
             float d = max(1.0 - crho[j] / (P.rest_density * full), 0.0);

@@ -90,8 +90,8 @@ pub struct ControlDesc {
     pub damping: Option<f32>,
     #[serde(default)]
     pub motion: Option<ControlMotion>,
-    /// What the attraction measures a control particle's deficit against (default: the
-    /// preset's; see `deficit`).
+    /// What the attraction measures a control particle's deficit against (default: rest
+    /// density; see `deficit`).
     #[serde(default)]
     pub deficit: Option<Deficit>,
     /// The controlled group (default: all).
@@ -201,9 +201,7 @@ impl ControlDesc {
             }),
         }
     }
-}
 
-impl ControlDesc {
     /// The deficit measure: as set, else rest density (the shape's fill, tried as the
     /// fidelity default, held less water at the skin and let it run faster: the walker's
     /// fill 0.95 -> 0.93, speed excess 0.66 -> 3.7 m/s; results/<device>/control-fidelity.md).

@@ -1,9 +1,9 @@
 //! A scene with a `[character]` that gives no `[domain]` (or no `[camera]`) gets one fitted
 //! around the character's motion: the box its skin sweeps over its clip, its path's lap and
 //! the scene's frames, grown by a margin; the camera frames that box from the front three
-//! quarters (the side three quarters for a long one). A scene file for a character nobody tuned for then names only the file, the
-//! animation, the height and a pool.
-use super::character::{placed_matrices, CharacterDesc};
+//! quarters (the side three quarters for a long one). A scene file for a character nobody
+//! tuned for then names only the file, the animation, the height and a pool.
+use super::character::{perimeter, placed_matrices, CharacterDesc};
 use super::schema::{CameraDesc, Domain, Scene};
 use crate::character::{check::bounds, Animator, Character};
 use crate::config::Skinning;
@@ -106,13 +106,9 @@ fn swept(
         .clip
         .map_or(0.0, |c| ch.clips[c].duration as f64 / speed);
     let path = desc.path();
-    let lap = path.as_ref().map_or(0.0, |(p, v)| {
-        let n = p.len();
-        let perimeter: f32 = (0..n).map(|i| p[i].distance(p[(i + 1) % n])).sum();
-        match *v > 0.0 {
-            true => (perimeter / v) as f64,
-            false => 0.0,
-        }
+    let lap = path.as_ref().map_or(0.0, |(p, v)| match *v > 0.0 {
+        true => perimeter(p) / *v as f64,
+        false => 0.0,
     });
     let f = &scene.fluid;
     let run = scene.frames as f64 * f.dt as f64 * f.substeps as f64;

@@ -52,6 +52,14 @@ pub struct CharacterDesc {
     pub path_speed: f32,
 }
 
+/// The length of the closed loop through `points`.
+pub fn perimeter(points: &[Vec3]) -> f64 {
+    let n = points.len();
+    (0..n)
+        .map(|i| points[i].distance(points[(i + 1) % n]) as f64)
+        .sum()
+}
+
 /// Where on a closed loop through `points` a walker at `speed` is after `t` seconds, and
 /// its heading (yaw about +Y from +Z).
 pub fn path_pose(points: &[Vec3], speed: f32, t: f64) -> (Vec3, f32) {
@@ -60,7 +68,7 @@ pub fn path_pose(points: &[Vec3], speed: f32, t: f64) -> (Vec3, f32) {
         return (points.first().copied().unwrap_or(Vec3::ZERO), 0.0);
     }
     let seg = |i: usize| (points[i], points[(i + 1) % n]);
-    let perimeter: f64 = (0..n).map(|i| seg(i).0.distance(seg(i).1) as f64).sum();
+    let perimeter = perimeter(points);
     let mut d = match perimeter > 0.0 {
         true => (speed as f64 * t).rem_euclid(perimeter),
         false => 0.0,

@@ -97,10 +97,10 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let (lo, hi) = ch.rest_bounds()?;
     let scale = anim.placement.x_axis.truncate().length();
     let height = (hi.y - lo.y) * scale;
+    let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
     // (A mass other than the default's already says the spacing: mass = rho_0 S^3.)
     let default_mass = scene.fluid.mass == crate::sph::FluidParams::default().mass;
     if scene.fluid.spacing.is_none() && default_mass {
-        let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
         let pool = scene.pool.as_ref().map_or(1.0, |p| p.volume);
         // The spacing the thinnest part asks for, and that part's name and width.
         let (s, part) = match thinnest(&ch) {
@@ -148,7 +148,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
             .filter(|p| p.y <= lo.y + 0.5 * height)
             .collect();
         let (plo, phi) = crate::character::check::bounds(&low);
-        let want = (ch.check.signed_volume.abs() as f32) * scale.powi(3) * pool.volume;
+        let want = volume * pool.volume;
         let b = pool_block(scene, (plo, phi), want, pool.color)?;
         let s = scene.fluid.spacing();
         let n: u64 = (0..3)

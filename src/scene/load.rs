@@ -15,13 +15,14 @@ pub enum SceneKind {
 }
 
 /// Which kind `text` is: particle scenes have `[[system]]` and no `[domain]` or `[pool]` (SPH
-/// scenes may hold systems too; a liquid character's domain may be fitted). Text too malformed to parse counts as a particle scene when it
-/// declares `[[system]]` and no `[domain]`, so its error is the particle scene's.
+/// scenes may hold systems too; a liquid character's domain may be fitted). Text too
+/// malformed to parse counts as a particle scene when it declares them so, and its error is
+/// the particle scene's.
 pub fn kind_of(text: &str) -> SceneKind {
     let declares = |table: &str| text.lines().any(|l| l.trim_start().starts_with(table));
     let particles = match text.parse::<toml::Table>() {
         Ok(t) => t.contains_key("system") && !t.contains_key("domain") && !t.contains_key("pool"),
-        Err(_) => declares("[[system]]") && !declares("[domain]"),
+        Err(_) => declares("[[system]]") && !declares("[domain]") && !declares("[pool]"),
     };
     match particles {
         true => SceneKind::Particles,
