@@ -1,5 +1,6 @@
 //! The incompressible solvers (pcisph, dfsph, pbf): one step against the f64 CPU reference,
-//! a resting pool, momentum without walls, and the control force with groups, each solver.
+//! momentum without walls, and the control force with groups, each solver (a resting
+//! pool: tests/physics.rs).
 mod common;
 use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
@@ -113,28 +114,33 @@ fn by_tag(d: fluidform::sph::solver::StateDump) -> fluidform::sph::solver::State
 fn one_step_of_each_solver_matches_the_f64_reference() {
     let ctx = common::ctx();
     let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
-    // (solver, particles in a corner of the domain): DFSPH's walls act in its solves.
-    let cases = SOLVERS
-        .iter()
-        .map(|s| (*s, false))
-        .chain([(Solver::Dfsph, true)]);
+    // (solver, particles in a corner of the domain): the walls act in every solve.
+    let cases = SOLVERS.iter().flat_map(|s| [(*s, false), (*s, true)]);
     for (s, corner) in cases {
         let f = fixed_iterations(s, 3);
         let sc = scene(f.clone(), [0.4; 3], vec![]);
         // Packed tighter than rest (up to 3x in places): every solve has work to do.
         let parts = if corner {
             // Packed a little, 2 mm off three walls, moving at up to 0.5 m/s: some into
-            // a wall within the step.
+            // a wall within the step. PBF's corrections of that packing (and of a random
+            // one at the rest spacing) move pairs closer by about h, past the neighbour
+            // sets of the step's start (a known gap): its particles start sparser than
+            // rest, half a spacing off the walls (clumps and the walls still compress).
             let sp = f.spacing();
-            let side = 0.8 * sp * 400f32.cbrt();
-            tagged(common::random_particles(sp, 400, [0.002; 3], side, 0.5, 5))
+            let (packing, off) = if s == Solver::Pbf {
+                (1.2, 0.5 * sp)
+            } else {
+                (0.8, 0.002)
+            };
+            let side = packing * sp * 400f32.cbrt();
+            tagged(common::random_particles(sp, 400, [off; 3], side, 0.5, 5))
         } else {
             tagged(random_particles(&f, 400, 0.2, 0.5, 7))
         };
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
         let (pos, vel, after) = one_step(&ctx, &solver, &mut st);
         st.destroy(&ctx);
-        let walls = cpu_pressure::Walls::new(&f, sc.domain.min, sc.domain.max);
+        let walls = fluidform::sph::boundary::Boundary::new(&f, sc.domain.min, sc.domain.max);
         let (x, v) = cpu_pressure::step(&f, &walls, f.dt as f64, &pos, &vel, 3);
         let vmax = v
             .iter()
@@ -266,94 +272,6 @@ fn momentum_is_conserved_without_walls() {
             "{s:?}: momentum drifted by {drift:.3e}"
         );
     }
-    solver.destroy(&ctx);
-    common::finish(&ctx);
-}
-
-/// A pool from wall to wall settles and stays: after 1.5 s (the released lattice compacts
-/// and sloshes first) and again 0.25 s later, the mean density error is under the target,
-/// every particle is slower than a tenth of the speed of a fall through the pool's height
-/// (0.15 m/s; single surface particles keep jittering at up to 0.1 m/s) and the mean speed
-/// is under 2% of it (3 cm/s).
-#[test]
-fn a_resting_pool_stays_at_rest_under_the_target() {
-    let ctx = common::ctx();
-    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
-    let mut bad = Vec::new();
-    for s in SOLVERS {
-        let mut f = FluidParams {
-            solver: s,
-            dt: 2e-3,
-            ..Default::default()
-        }
-        .with_density_error(0.005);
-        f.dfsph.divergence_error = 0.005;
-        // Recorded per solve and step: a bound that keeps the command buffer small.
-        f.pcisph.max_iterations = 30;
-        f.dfsph.max_iterations = 30;
-        f.pbf.max_iterations = 30;
-        let sc = scene(
-            f.clone(),
-            [0.24, 0.3, 0.24],
-            vec![Block {
-                min: [0.0; 3],
-                max: [0.24, 0.12, 0.24],
-                group: 0,
-                color: [0.2, 0.5, 1.0],
-                velocity: [0.0; 3],
-            }],
-        );
-        let parts = sc.particles(1);
-        let mut st = solver.state(&ctx, &sc, &parts).unwrap();
-        let mut run = |steps: u32| {
-            ctx.one_shot(|cmd| {
-                for _ in 0..steps {
-                    solver.record_step(&ctx, cmd, &mut Labels, &mut st)?;
-                }
-                Ok::<_, fluidform::Error>(())
-            })
-            .unwrap()
-            .unwrap();
-            st.read(&ctx).unwrap()
-        };
-        // 1.5 s in command buffers of 125 steps.
-        for _ in 0..5 {
-            run(125);
-        }
-        let settled = run(125);
-        let later = run(125);
-        st.destroy(&ctx);
-        for (when, d) in [("1.5 s", settled), ("1.75 s", later)] {
-            let speeds: Vec<f32> = d
-                .vel
-                .iter()
-                .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
-                .collect();
-            let vmax = speeds.iter().copied().fold(0.0f32, f32::max);
-            let vmean = speeds.iter().sum::<f32>() / speeds.len().max(1) as f32;
-            let rho0 = f.rest_density;
-            let err = d
-                .rho_p
-                .iter()
-                .map(|r| (r[0] / rho0 - 1.0).max(0.0) as f64)
-                .sum::<f64>()
-                / d.rho_p.len() as f64;
-            eprintln!(
-                "{s:?} at {when}: {} particles, max speed {vmax:.3e} m/s, mean {vmean:.3e} m/s, mean density error {err:.3e}",
-                d.pos.len()
-            );
-            let fall = (2.0f32 * 9.81 * 0.12).sqrt();
-            if vmax >= 0.1 * fall
-                || vmean >= 0.02 * fall
-                || err > f.convergence().density_error as f64
-            {
-                bad.push(format!(
-                    "{s:?} at {when}: max speed {vmax} m/s, mean {vmean} m/s, density error {err:.3e}"
-                ));
-            }
-        }
-    }
-    assert!(bad.is_empty(), "pools not at rest: {bad:?}");
     solver.destroy(&ctx);
     common::finish(&ctx);
 }

@@ -72,10 +72,15 @@ vec3 respond(vec3 v, vec3 n, vec3 wall_v) {
     return wall_v + vt * (1.0 - P.domain_max.w) - P.domain_min.w * vn * n;
 }
 
-// Collision response against the colliders and the domain box: x pushed out, both
-// velocities (leapfrog's half step and full; the same one twice elsewhere) answered with
-// restitution and friction; a final clamp, so no particle ever leaves the domain.
+// Collision response against the colliders and the domain box: x pushed out to half a
+// rest spacing from the surface (where a lattice particle rests next to a wall, and the
+// boundary's density is the lattice's missing part; at the surface itself it would add
+// rho0 / 2), both velocities (leapfrog's half step and full; the same one twice
+// elsewhere) answered with restitution and friction; a final clamp, so no particle ever
+// leaves the domain.
+float rest_margin() { return 0.5 * pow(P.mass / P.rest_density, 1.0 / 3.0); }
 void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
+    float r = rest_margin();
     for (uint c = 0u; c < P.colliders; ++c) {
         Collider col = cols[c];
         uint kind = uint(col.b.w);
@@ -83,7 +88,7 @@ void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
         float depth;
         if (kind == 0u) {
             n = col.a.xyz;
-            depth = col.a.w - dot(n, x);
+            depth = col.a.w + r - dot(n, x);
         } else {
             vec3 q = col.a.xyz;
             if (kind == 2u) {
@@ -94,7 +99,7 @@ void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
             vec3 d = x - q;
             float len = length(d);
             n = len > 1e-12 ? d / len : vec3(0.0, 1.0, 0.0);
-            depth = col.a.w - len;
+            depth = col.a.w + r - len;
         }
         if (depth > 0.0) {
             x += depth * n;
@@ -102,13 +107,18 @@ void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
             vb = respond(vb, n, col.vel.xyz);
         }
     }
+    // The margin never more than half the domain.
+    vec3 lo = P.domain_min.xyz, hi = P.domain_max.xyz;
+    vec3 m = min(vec3(r), 0.5 * (hi - lo));
+    lo += m;
+    hi -= m;
     for (int k = 0; k < 3; ++k) {
         vec3 n = vec3(0.0);
         n[k] = 1.0;
-        if (x[k] < P.domain_min[k]) { x[k] = P.domain_min[k]; va = respond(va, n, vec3(0.0)); vb = respond(vb, n, vec3(0.0)); }
-        if (x[k] > P.domain_max[k]) { x[k] = P.domain_max[k]; va = respond(va, -n, vec3(0.0)); vb = respond(vb, -n, vec3(0.0)); }
+        if (x[k] < lo[k]) { x[k] = lo[k]; va = respond(va, n, vec3(0.0)); vb = respond(vb, n, vec3(0.0)); }
+        if (x[k] > hi[k]) { x[k] = hi[k]; va = respond(va, -n, vec3(0.0)); vb = respond(vb, -n, vec3(0.0)); }
     }
-    x = clamp(x, P.domain_min.xyz, P.domain_max.xyz);
+    x = clamp(x, lo, hi);
 }
 
 float pressure_of(float rho) {
@@ -116,4 +126,5 @@ float pressure_of(float rho) {
                           : P.stiffness * (rho - P.rest_density);
     return P.clamp_negative != 0u ? max(p, 0.0) : p;
 }
+#include "boundary.glsl"
 #endif

@@ -1,5 +1,6 @@
 #version 450
-// Density (poly6, self included) and pressure from the equation of state.
+// Density (poly6, self included, plus the solid boundary's: boundary.glsl) and pressure
+// from the equation of state.
 #include "common.glsl"
 void main() {
     uint i = global_id();
@@ -12,6 +13,8 @@ void main() {
         float r2 = dot(d, d);
         if (r2 < h2) { float q = h2 - r2; sum += q * q * q; }
     NB_END
-    float rho = P.mass * P.poly6 * sum;
+    vec3 g;
+    float rate;
+    float rho = P.mass * P.poly6 * sum + P.rest_density * boundary(xi, vec3(0.0), g, rate);
     rho_p[i] = vec2(rho, pressure_of(rho));
 }

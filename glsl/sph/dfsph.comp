@@ -2,8 +2,9 @@
 // DFSPH (Bender & Koschier 2015, 2017), one pass per PASS. Densities relative to rho0,
 // V = m / rho0. aux.x: factor alpha = 1 / (|sum V grad W|^2 + sum |V grad W|^2);
 // aux.y: the solve's source s (density: max(rho_adv / rho0 - 1, 0), rho_adv predicted
-// from the velocities; divergence: max(D(rho/rho0)/Dt, 0)); aux.z: the walls' density /
-// rho0 (rho_p keeps the fluid's, which the step's error measures). aux2.x, aux2.y: the
+// from the velocities; divergence: max(D(rho/rho0)/Dt, 0)). rho_p.x counts the solid
+// boundary (boundary.glsl), which also pushes with the particle's own stiffness (as
+// SPlisHSPlasH's DFSPH with boundary particles). aux2.x, aux2.y: the
 // stiffness kappa the density and divergence solves apply in this step, kept for the next
 // step's warm start in vel.w (by euler.comp) and vhalf.w (by PREDICT): reordered with them.
 //   FACTOR    density (as density.comp), alpha, the step's neighbour lists
@@ -17,35 +18,6 @@
 // FOR_NEIGHBORS (pressure.glsl).
 // DIVERGENCE: 1 for the divergence-free solve, 0 for the constant-density solve.
 #include "pressure.glsl"
-
-// The domain's walls in the solves: each a solid half-space at rest density, the
-// continuum limit of boundary particles (Akinci et al. 2012, as DFSPH's boundaries). At a
-// distance d < h from a wall, with u = d / h:
-//   density / rho0     I(u) = 1/2 - 315/256 (u - 4/3 u^3 + 6/5 u^5 - 4/7 u^7 + u^9 / 9)
-//                      (the poly6 integral over the half-space, as the densities);
-//   sum V grad W       -A(u) n, A(u) = 30 / h (w^4 / 4 - w^5 / 5), w = 1 - u
-//                      (spiky's, as the gradients), n the wall's normal into the fluid.
-// src/sph/cpu_pressure.rs has the same.
-float wall_density(float d) {
-    float u = clamp(d / P.h, 0.0, 1.0), u2 = u * u;
-    float f = u * (1.0 + u2 * (-4.0 / 3.0 + u2 * (6.0 / 5.0 + u2 * (-4.0 / 7.0 + u2 / 9.0))));
-    return 0.5 - 315.0 / 256.0 * f;
-}
-float wall_push(float d) {
-    float w = 1.0 - clamp(d / P.h, 0.0, 1.0), w4 = w * w * w * w;
-    return 30.0 / P.h * (w4 / 4.0 - w4 * w / 5.0);
-}
-// The walls' density / rho0 at x, and their sum V grad W.
-float walls(vec3 x, out vec3 g) {
-    float rho = 0.0;
-    g = vec3(0.0);
-    for (int k = 0; k < 3; ++k) {
-        float lo = x[k] - P.domain_min[k], hi = P.domain_max[k] - x[k];
-        if (lo < P.h) { rho += wall_density(lo); g[k] -= wall_push(lo); }
-        if (hi < P.h) { rho += wall_density(hi); g[k] += wall_push(hi); }
-    }
-    return rho;
-}
 
 #if DIVERGENCE
 float kappa_of(uint i) { return 0.5 * vhalf[i].w; }
@@ -85,13 +57,13 @@ void main() {
         if (count > P.list_max) atomicAdd(list_overflows, 1u);
     }
     // As density.comp, which DFSPH skips (the same sum in the same order).
-    float rho = P.mass * P.poly6 * sum;
-    rho_p[i] = vec2(rho, pressure_of(rho));
     vec3 gw;
-    float rho_w = walls(xi, gw);
-    sg += gw;
+    float rate;
+    float rho = P.mass * P.poly6 * sum + P.rest_density * boundary(xi, vec3(0.0), gw, rate);
+    rho_p[i] = vec2(rho, 0.0);
+    sg += gw;  // the boundary adds to the gradient sum (it does not move: no square)
     float denom = dot(sg, sg) + s2;
-    aux[i] = vec4(denom > 1e-3 * P.proto_grad2 ? 1.0 / denom : 0.0, 0.0, rho_w, 0.0);
+    aux[i] = vec4(denom > 1e-3 * P.proto_grad2 ? 1.0 / denom : 0.0, 0.0, 0.0, 0.0);
 #elif PASS == PASS_SOURCE
     bool live = sph_alive(i);
     float e = 0.0;
@@ -99,8 +71,8 @@ void main() {
         vec3 xi = pos[i].xyz;
         vec3 vi = vel[i].xyz;
         vec3 gw;
-        walls(xi, gw);
-        float rate = dot(vi, gw);  // the walls stand still
+        float rate;
+        boundary(xi, vi, gw, rate);
 #define VISIT(j) { vec3 d = xi - pos[j].xyz; float r2 = dot(d, d); \
             if (j != i && r2 < h2) rate += V * dot(vi - vel[j].xyz, grad_w(d, r2)); }
         FOR_NEIGHBORS(i, xi, VISIT)
@@ -109,7 +81,7 @@ void main() {
         float s = max(rate, 0.0);
         e = s * dt;
 #else
-        float s = max(rho_p[i].x / P.rest_density + aux[i].z + dt * rate - 1.0, 0.0);
+        float s = max(rho_p[i].x / P.rest_density + dt * rate - 1.0, 0.0);
         e = s;
 #endif
         aux[i].y = s;
@@ -123,9 +95,10 @@ void main() {
 #else
     float ki = k_of(i, dt);
 #endif
-    // A wall answers with the particle's own stiffness (a mirrored pressure).
+    // The boundary answers with the particle's own stiffness.
     vec3 gw;
-    walls(xi, gw);
+    float rate;
+    boundary(xi, vec3(0.0), gw, rate);
     vec3 dv = -dt * ki * gw;
 #if PASS == PASS_WARM
 #define KAPPA_J(j) kappa_of(j)

@@ -1,6 +1,7 @@
 #version 450
-// Forces: pressure (spiky gradient, symmetric), viscosity (viscosity Laplacian), surface
-// tension (colour field, where |n| >= threshold), gravity; writes the acceleration f / rho.
+// Forces: pressure (spiky gradient, symmetric; the solid boundary's, boundary.glsl),
+// viscosity (viscosity Laplacian), surface tension (colour field, where |n| >= threshold),
+// gravity; writes the acceleration f / rho.
 #ifdef PASS
 // DFSPH's forces pass (src/sph/pressure.rs): neighbours from the step's lists.
 #include "pressure.glsl"
@@ -36,6 +37,12 @@ void main() {
         } }
     FOR_NEIGHBORS(i, xi, VISIT)
 #undef VISIT
+    // The solid boundary mirrors the particle's pressure (p_b = p_i, rho_b = rho0; none
+    // pulls the fluid onto a wall): -sum_b m / rho0 p_i grad W = -p_i g.
+    vec3 gb;
+    float rate;
+    boundary(xi, vi, gb, rate);
+    f_press -= max(p_i, 0.0) * gb;
     vec3 f = f_press + P.viscosity * f_visc + rho_i * P.gravity.xyz;
     float nl = length(n);
     if (nl >= P.tension_threshold) f -= P.tension * lap * n / nl;

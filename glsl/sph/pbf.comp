@@ -2,7 +2,9 @@
 // Position based fluids (Macklin & Mueller 2013), one pass per PASS, neighbours from the
 // step's start positions. aux.xyz: predicted position x* (after the solve: vorticity
 // omega); aux2.xyz: the position correction (after the solve: the XSPH velocity change);
-// rho_p.y: lambda. V = m / rho0.
+// rho_p.y: lambda (after the solve: the pressure in Pa, -rho0 sum lambda / dt^2, the sum
+// over the iterations kept in aux.w). V = m / rho0. The solid boundary (boundary.glsl)
+// counts in the constraint and moves the particle alone (lambda_b = 0).
 //   PREDICT    x* = x + dt (v + dt a_nonpressure), collided
 //   LAMBDA     C = max(rho*/rho0 - 1, 0); lambda = -C / (sum_k |grad_k C|^2 + eps);
 //              the iteration's error C
@@ -47,8 +49,14 @@ void main() {
                 }
             }
         NB_END
-        float c = max(P.mass * P.poly6 * sum / P.rest_density - 1.0, 0.0);
-        rho_p[i].y = -c / (dot(sg, sg) + s2 + P.pbf_relaxation * P.proto_grad2);
+        vec3 gw;
+        float rate;
+        float rho_b = boundary(xi, vec3(0.0), gw, rate);
+        sg += gw;
+        float c = max(P.mass * P.poly6 * sum / P.rest_density + rho_b - 1.0, 0.0);
+        float lambda = -c / (dot(sg, sg) + s2 + P.pbf_relaxation * P.proto_grad2);
+        rho_p[i].y = lambda;
+        aux[i].w += lambda;  // neighbours read aux.xyz only
         e = c;
     }
     reduce_error(e, live);
@@ -66,7 +74,10 @@ void main() {
             dx += V * (li + rho_p[j].y + scorr) * grad_w(d, r2);
         }
     NB_END
-    aux2[i] = vec4(dx, 0.0);
+    vec3 gw;
+    float rate;
+    boundary(xi, vec3(0.0), gw, rate);
+    aux2[i] = vec4(dx + li * gw, 0.0);
 #elif PASS == PASS_APPLY
     if (!sph_alive(i)) return;
     vec3 x = aux[i].xyz + aux2[i].xyz;
@@ -78,6 +89,7 @@ void main() {
     vec3 x = aux[i].xyz;
     vel[i].xyz = (x - pos[i].xyz) / dt;
     pos[i].xyz = x;
+    rho_p[i].y = -P.rest_density * aux[i].w / (dt * dt);
 #elif PASS == PASS_VORTICITY
     if (!sph_alive(i)) return;
     vec3 xi = pos[i].xyz;

@@ -2,7 +2,11 @@
 // PCISPH (Solenthaler & Pajarola 2009), one pass per PASS, neighbours from the step's start
 // positions. aux.xyz: predicted position x*, aux.w: delta; aux2.xyz: pressure acceleration
 // (zeroed at the solve's start); rho_p.y: pressure (0 from the density pass), in units of
-// rho0 (p / rho0).
+// rho0 (p / rho0; euler.comp leaves Pa). The solid boundary (boundary.glsl) counts in the
+// densities and pushes with the particle's own pressure; delta is the fluid's alone (with
+// the boundary's gradient in it, the solve at 0.1% diverged in a resting pool: near a
+// wall the fluid's one-sided sum and the boundary's cancel, so delta takes a full
+// neighbourhood's value while the wall answers with p_i alone).
 //   FACTOR    delta_i = 1/2 / (2 dt^2 (|sum V grad W|^2 + sum |V grad W|^2)) at x
 //   PREDICT   x* = x + dt (v + dt (a_np + a_p)), collided
 //   PRESSURE  rho* at x*; p += delta_i (rho*/rho0 - 1), 0 <= p <= cap;
@@ -50,7 +54,9 @@ void main() {
             float r2 = dot(d, d);
             if (r2 < h2) { float q = h2 - r2; sum += q * q * q; }
         NB_END
-        float rho = P.mass * P.poly6 * sum;
+        vec3 gw;
+        float rate;
+        float rho = P.mass * P.poly6 * sum + P.rest_density * boundary(xi, vec3(0.0), gw, rate);
         float err = rho / P.rest_density - 1.0;
         // At most the pressure that resolves a 20% compression of a full neighbourhood in
         // one step: a clump the walls pin (whose density no pressure lowers) would
@@ -70,8 +76,11 @@ void main() {
         float r2 = dot(d, d);
         if (j != i && r2 < h2) a -= (pi + rho_p[j].y) * grad_w(d, r2);
     NB_END
-    // p is in units of rho0 (see delta): a = -V sum (p_i + p_j) grad W.
-    aux2[i] = vec4(vol0() * a, 0.0);
+    // p is in units of rho0 (see delta): a = -V sum (p_i + p_j) grad W - p_i sum_b V grad W.
+    vec3 gw;
+    float rate;
+    boundary(xi, vec3(0.0), gw, rate);
+    aux2[i] = vec4(vol0() * a - pi * gw, 0.0);
 #else
 #error "PASS names no PCISPH pass"
 #endif

@@ -1,6 +1,8 @@
 //! CPU reference in f64 with brute-force neighbours: density, pressure and acceleration
 //! by the same formulas as glsl/sph (self term in density and colour Laplacian; pairs
-//! closer than 1e-6 h skip the spiky and viscosity terms).
+//! closer than 1e-6 h skip the spiky and viscosity terms; the solid boundary of
+//! boundary.rs in the densities and, mirroring p_i, in the pressure force).
+use super::boundary::Boundary;
 use super::params::{Eos, FluidParams};
 
 pub struct Reference {
@@ -24,7 +26,7 @@ pub fn pressure(f: &FluidParams, rho: f64) -> f64 {
     }
 }
 
-pub fn evaluate(f: &FluidParams, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Reference {
+pub fn evaluate(f: &FluidParams, b: &Boundary, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Reference {
     let n = pos.len();
     let h = f.h as f64;
     let h2 = h * h;
@@ -50,7 +52,7 @@ pub fn evaluate(f: &FluidParams, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Referenc
                     s += (h2 - r2).powi(3);
                 }
             }
-            m * poly6 * s
+            m * poly6 * s + f.rest_density as f64 * b.solid(h, x[i], [0.0; 3]).rho
         })
         .collect();
     let pressure: Vec<f64> = density.iter().map(|&r| pressure(f, r)).collect();
@@ -90,6 +92,10 @@ pub fn evaluate(f: &FluidParams, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Referenc
                     fv[k] += vol * (v[j][k] - v[i][k]) * visc_lap * w;
                 }
             }
+        }
+        let gb = b.solid(h, x[i], v[i]).g;
+        for k in 0..3 {
+            fp[k] -= pressure[i].max(0.0) * gb[k];
         }
         let nl = dot(&nrm, &nrm).sqrt();
         let mut a = [0.0; 3];

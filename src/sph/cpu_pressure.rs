@@ -1,9 +1,9 @@
 //! CPU reference in f64 of one step of the incompressible solvers, brute-force neighbours,
-//! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count.
-//! DFSPH's includes the domain's walls (their density and push in the solves, the
-//! collision response of the velocity passes and the positions); PCISPH's and PBF's leave
-//! the collision response out (no wall in reach). Starts from a state with no warm-start
-//! stiffness (a scene's first step).
+//! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count,
+//! the solid boundary (boundary.rs) in the densities and solves and the collision
+//! response where the shaders apply it. Starts from a state with no warm-start stiffness
+//! (a scene's first step).
+use super::boundary::{Boundary, Solid};
 use super::params::{Eos, FluidParams, Kernels};
 use crate::kinds::Solver;
 
@@ -23,84 +23,6 @@ fn cross(a: V3, b: V3) -> V3 {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
-}
-
-/// The domain box: (min, max) corners, restitution, friction.
-pub struct Walls {
-    pub min: [f32; 3],
-    pub max: [f32; 3],
-    pub restitution: f32,
-    pub friction: f32,
-}
-
-impl Walls {
-    pub fn new(f: &FluidParams, min: [f32; 3], max: [f32; 3]) -> Self {
-        Self {
-            min,
-            max,
-            restitution: f.restitution,
-            friction: f.friction,
-        }
-    }
-
-    /// The walls' density / rho0 at x and their sum V grad W (glsl/sph/dfsph.comp).
-    fn solid(&self, h: f64, x: V3) -> (f64, V3) {
-        let density = |d: f64| {
-            let u = (d / h).clamp(0.0, 1.0);
-            let f = u - 4.0 / 3.0 * u.powi(3) + 6.0 / 5.0 * u.powi(5) - 4.0 / 7.0 * u.powi(7)
-                + u.powi(9) / 9.0;
-            0.5 - 315.0 / 256.0 * f
-        };
-        let push = |d: f64| {
-            let w = 1.0 - (d / h).clamp(0.0, 1.0);
-            30.0 / h * (w.powi(4) / 4.0 - w.powi(5) / 5.0)
-        };
-        let (mut rho, mut g) = (0.0, [0.0; 3]);
-        for k in 0..3 {
-            let lo = x[k] - self.min[k] as f64;
-            let hi = self.max[k] as f64 - x[k];
-            if lo < h {
-                rho += density(lo);
-                g[k] -= push(lo);
-            }
-            if hi < h {
-                rho += density(hi);
-                g[k] += push(hi);
-            }
-        }
-        (rho, g)
-    }
-
-    /// The collision response of glsl/sph/common.glsl's `collide` (box only): x clamped,
-    /// v's normal part into a wall reflected with restitution, its tangent damped.
-    fn collide(&self, x: &mut V3, v: &mut V3) {
-        let respond = |v: V3, k: usize, sign: f64| -> V3 {
-            let vn = v[k] * sign;
-            if vn >= 0.0 {
-                return v;
-            }
-            let mut out = v.map(|c| c * (1.0 - self.friction as f64));
-            out[k] = -(self.restitution as f64) * vn * sign;
-            out
-        };
-        for (k, xk) in x.iter_mut().enumerate() {
-            if *xk < self.min[k] as f64 {
-                *xk = self.min[k] as f64;
-                *v = respond(*v, k, 1.0);
-            }
-            if *xk > self.max[k] as f64 {
-                *xk = self.max[k] as f64;
-                *v = respond(*v, k, -1.0);
-            }
-        }
-    }
-
-    /// The velocity the response leaves to a particle at x moving with v for dt.
-    fn response(&self, x: V3, dt: f64, v: V3) -> V3 {
-        let (mut y, mut v) = (axpy(dt, v, x), v);
-        self.collide(&mut y, &mut v);
-        v
-    }
 }
 
 struct K {
@@ -129,6 +51,7 @@ impl K {
         let s = self.v * self.k.spiky_grad * (self.h - r).powi(2) / r;
         [s * d[0], s * d[1], s * d[2]]
     }
+    /// The fluid's density at x_i (the boundary's is added by the callers).
     fn density(&self, x: &[V3], i: usize) -> f64 {
         self.m
             * x.iter()
@@ -147,9 +70,11 @@ impl K {
         }
         (sg, s2)
     }
-    /// (|sum V grad W|^2 + sum |V grad W|^2) at x_i.
-    fn grad2(&self, x: &[V3], i: usize) -> f64 {
+    /// (|sum V grad W + g_b|^2 + sum |V grad W|^2) at x_i, g_b the boundary's sum (it
+    /// does not move: no square of its own).
+    fn grad2(&self, x: &[V3], i: usize, gb: V3) -> f64 {
         let (sg, s2) = self.grad_sums(x, i);
+        let sg = axpy(1.0, gb, sg);
         dot(sg, sg) + s2
     }
 }
@@ -157,7 +82,7 @@ impl K {
 /// Positions and velocities after one step of `f.solver` with `iterations` per solve.
 pub fn step(
     f: &FluidParams,
-    walls: &Walls,
+    b: &Boundary,
     dt: f64,
     pos: &[[f32; 4]],
     vel: &[[f32; 4]],
@@ -180,7 +105,9 @@ pub fn step(
         .iter()
         .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
         .collect();
-    let rho: Vec<f64> = (0..n).map(|i| kk.density(&x, i)).collect();
+    let rho: Vec<f64> = (0..n)
+        .map(|i| kk.density(&x, i) + kk.rho0 * b.solid(kk.h, x[i], [0.0; 3]).rho)
+        .collect();
     // Non-pressure accelerations (the forces pass with no equation of state).
     let mut fnp = f.clone();
     fnp.eos = Eos::Ideal;
@@ -193,9 +120,10 @@ pub fn step(
             .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32, 0.0])
             .collect()
     };
-    let a_np = |v: &[V3]| super::cpu::evaluate(&fnp, pos, &f32s(v)).acc;
+    let a_np = |v: &[V3]| super::cpu::evaluate(&fnp, b, pos, &f32s(v)).acc;
     let c = Common {
         kk: &kk,
+        b,
         proto,
         dt,
         iterations,
@@ -206,7 +134,7 @@ pub fn step(
             let a = a_np(&v);
             pcisph(&c, x, v, &a)
         }
-        Solver::Dfsph => dfsph(&c, walls, x, v, &rho, &a_np),
+        Solver::Dfsph => dfsph(&c, x, v, &rho, &a_np),
         Solver::Pbf => {
             let a = a_np(&v);
             pbf(&c, f, x, v, &a)
@@ -214,29 +142,39 @@ pub fn step(
     }
 }
 
-/// What every solver's step shares: kernels, the prototype's gradient sum, dt, iterations.
+/// What every solver's step shares: kernels, the boundary, the prototype's gradient sum,
+/// dt, iterations.
 struct Common<'a> {
     kk: &'a K,
+    b: &'a Boundary,
     proto: f64,
     dt: f64,
     iterations: u32,
 }
 
-/// PCISPH: pressures predicted and corrected on the predicted positions.
+/// PCISPH: pressures predicted and corrected on the predicted positions (collided); delta
+/// from the fluid's gradients alone.
 fn pcisph(c: &Common, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3>, Vec<V3>) {
-    let (kk, dt, n) = (c.kk, c.dt, x.len());
+    let (kk, b, dt, n) = (c.kk, c.b, c.dt, x.len());
+    let at = |x: V3| b.solid(kk.h, x, [0.0; 3]);
     let delta: Vec<f64> = (0..n)
-        .map(|i| 0.5 / (2.0 * dt * dt * kk.grad2(&x, i).max(1e-3 * c.proto)))
+        .map(|i| 0.5 / (2.0 * dt * dt * kk.grad2(&x, i, [0.0; 3]).max(1e-3 * c.proto)))
         .collect();
     let cap = 0.2 / (2.0 * dt * dt * c.proto);
     let mut p = vec![0.0; n];
     let mut ap = vec![[0.0; 3]; n];
     for _ in 0..c.iterations {
         let xs: Vec<V3> = (0..n)
-            .map(|i| axpy(dt, axpy(dt, axpy(1.0, a[i], ap[i]), v[i]), x[i]))
+            .map(|i| {
+                let vi = axpy(dt, axpy(1.0, a[i], ap[i]), v[i]);
+                let (mut y, mut vy) = (axpy(dt, vi, x[i]), vi);
+                b.collide(&mut y, &mut vy);
+                y
+            })
             .collect();
+        let solid: Vec<Solid> = xs.iter().map(|y| at(*y)).collect();
         for i in 0..n {
-            let err = kk.density(&xs, i) / kk.rho0 - 1.0;
+            let err = kk.density(&xs, i) / kk.rho0 + solid[i].rho - 1.0;
             p[i] = (p[i] + delta[i] * err).clamp(0.0, cap);
         }
         for i in 0..n {
@@ -246,33 +184,32 @@ fn pcisph(c: &Common, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3>, Vec<V3>) {
                     s = axpy(-(p[i] + p[j]), kk.vg(sub(xs[i], xs[j])), s);
                 }
             }
-            ap[i] = s;
+            ap[i] = axpy(-p[i], solid[i].g, s);
         }
     }
-    let v: Vec<V3> = (0..n)
+    let mut v: Vec<V3> = (0..n)
         .map(|i| axpy(dt, axpy(1.0, a[i], ap[i]), v[i]))
         .collect();
-    let x = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+    let mut x: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
+    for i in 0..n {
+        b.collide(&mut x[i], &mut v[i]);
+    }
     (x, v)
 }
 
 /// DFSPH: the divergence solve, non-pressure forces, the density solve, then the move.
 fn dfsph(
     c: &Common,
-    walls: &Walls,
     x: Vec<V3>,
     mut v: Vec<V3>,
     rho: &[f64],
     a_np: &dyn Fn(&[V3]) -> Vec<V3>,
 ) -> (Vec<V3>, Vec<V3>) {
-    let (kk, dt, n) = (c.kk, c.dt, x.len());
-    let solid: Vec<(f64, V3)> = x.iter().map(|xi| walls.solid(kk.h, *xi)).collect();
+    let (kk, walls, dt, n) = (c.kk, c.b, c.dt, x.len());
+    let solid = |i: usize, v: V3| walls.solid(kk.h, x[i], v);
     let alpha: Vec<f64> = (0..n)
         .map(|i| {
-            // The walls add to the gradient sum (not to the sum of squares).
-            let (sg, s2) = kk.grad_sums(&x, i);
-            let sg = axpy(1.0, solid[i].1, sg);
-            let d = dot(sg, sg) + s2;
+            let d = kk.grad2(&x, i, solid(i, [0.0; 3]).g);
             if d > 1e-3 * c.proto {
                 1.0 / d
             } else {
@@ -281,7 +218,7 @@ fn dfsph(
         })
         .collect();
     let rate = |v: &[V3], i: usize| -> f64 {
-        dot(v[i], solid[i].1)
+        solid(i, v[i]).rate
             + (0..n)
                 .filter(|&j| j != i)
                 .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
@@ -298,7 +235,7 @@ fn dfsph(
                     if divergence {
                         rate(v, i).max(0.0)
                     } else {
-                        (rho[i] / kk.rho0 + solid[i].0 + dt * rate(v, i) - 1.0).max(0.0)
+                        (rho[i] / kk.rho0 + dt * rate(v, i) - 1.0).max(0.0)
                     }
                 })
                 .collect()
@@ -309,7 +246,7 @@ fn dfsph(
             let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
             let old = v.clone();
             for i in 0..n {
-                let mut vi = axpy(-dt * k[i], solid[i].1, old[i]);
+                let mut vi = axpy(-dt * k[i], solid(i, [0.0; 3]).g, old[i]);
                 for j in 0..n {
                     if j != i {
                         vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);
@@ -333,24 +270,31 @@ fn dfsph(
     (x, v)
 }
 
-/// PBF: density constraints solved on predicted positions, then XSPH and vorticity.
+/// PBF: density constraints solved on predicted positions (collided), then XSPH and
+/// vorticity.
 fn pbf(c: &Common, f: &FluidParams, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3>, Vec<V3>) {
-    let (kk, dt, n) = (c.kk, c.dt, x.len());
+    let (kk, b, dt, n) = (c.kk, c.b, c.dt, x.len());
+    let collided = |mut y: V3| {
+        let mut vy = [0.0; 3];
+        b.collide(&mut y, &mut vy);
+        y
+    };
     let mut xs: Vec<V3> = (0..n)
-        .map(|i| axpy(dt, axpy(dt, a[i], v[i]), x[i]))
+        .map(|i| collided(axpy(dt, axpy(dt, a[i], v[i]), x[i])))
         .collect();
     let dq = f.pbf.scorr_dq as f64 * kk.h;
     let wdq = kk.w(dq * dq);
     for _ in 0..c.iterations {
+        let solid: Vec<Solid> = xs.iter().map(|y| b.solid(kk.h, *y, [0.0; 3])).collect();
         let lambda: Vec<f64> = (0..n)
             .map(|i| {
-                let cst = (kk.density(&xs, i) / kk.rho0 - 1.0).max(0.0);
-                -cst / (kk.grad2(&xs, i) + f.pbf.relaxation as f64 * c.proto)
+                let cst = (kk.density(&xs, i) / kk.rho0 + solid[i].rho - 1.0).max(0.0);
+                -cst / (kk.grad2(&xs, i, solid[i].g) + f.pbf.relaxation as f64 * c.proto)
             })
             .collect();
         let dx: Vec<V3> = (0..n)
             .map(|i| {
-                let mut s = [0.0; 3];
+                let mut s = axpy(lambda[i], solid[i].g, [0.0; 3]);
                 for j in 0..n {
                     let d = sub(xs[i], xs[j]);
                     if j != i && dot(d, d) < kk.h * kk.h {
@@ -364,7 +308,7 @@ fn pbf(c: &Common, f: &FluidParams, x: Vec<V3>, v: Vec<V3>, a: &[V3]) -> (Vec<V3
             })
             .collect();
         for i in 0..n {
-            xs[i] = axpy(1.0, dx[i], xs[i]);
+            xs[i] = collided(axpy(1.0, dx[i], xs[i]));
         }
     }
     let v: Vec<V3> = (0..n)

@@ -76,7 +76,11 @@ fn compare(ctx: &Context, solver: &mut SphSolver, scene: &Scene, parts: &Particl
     .unwrap();
     let d = st.read(ctx).unwrap();
     st.destroy(ctx);
-    let r = cpu::evaluate(&scene.fluid, &d.pos, &d.vel);
+    let b =
+        fluidform::sph::boundary::Boundary::new(&scene.fluid, scene.domain.min, scene.domain.max)
+            .with_colliders(&scene.colliders)
+            .unwrap();
+    let r = cpu::evaluate(&scene.fluid, &b, &d.pos, &d.vel);
     let n = d.pos.len();
     let mean_a = r
         .acc
@@ -113,8 +117,32 @@ fn gpu_density_and_acceleration_match_f64_reference() {
     };
     for (strategy, sort) in STRATEGIES {
         let mut solver = SphSolver::new(&ctx, strategy, Some(sort)).unwrap();
-        for (what, fluid) in [("kelager", ideal.clone()), ("tait", tait.clone())] {
-            let scene = block_scene(fluid);
+        // The walls and colliders count in the densities and push back (boundary.glsl).
+        let obstacles = vec![
+            Collider::Sphere {
+                center: [0.17, 0.1, 0.15],
+                radius: 0.04,
+                velocity: [0.0; 3],
+            },
+            Collider::Capsule {
+                a: [0.05, 0.17, 0.05],
+                b: [0.3, 0.19, 0.25],
+                radius: 0.02,
+                velocity: [0.1, 0.0, 0.0],
+            },
+            Collider::Plane {
+                normal: [0.3, 1.0, 0.0],
+                offset: 0.03,
+                velocity: [0.0; 3],
+            },
+        ];
+        for (what, fluid, colliders) in [
+            ("kelager", ideal.clone(), vec![]),
+            ("tait", tait.clone(), vec![]),
+            ("tait, colliders", tait.clone(), obstacles),
+        ] {
+            let mut scene = block_scene(fluid);
+            scene.colliders = colliders;
             let lattice = scene.particles(3);
             let random = random_particles(&scene, 1500, 9);
             for (kind, parts) in [("lattice", &lattice), ("random", &random)] {
