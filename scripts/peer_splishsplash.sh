@@ -35,7 +35,12 @@ fi
 glx=$(ldconfig -p | awk '/libGLdispatch\.so\.0 /{print $NF; exit}')
 out=out/peer
 mkdir -p "$out"
-frames=$(python3 -c "print(round($seconds / 0.02))")
+# Frames of the scene's own length (dt x substeps; scaling to N keeps it).
+frame=$("$bin" scene show dam-break | python3 -c "
+import sys, tomllib
+f = tomllib.loads(sys.stdin.read())['fluid']
+print(f['dt'] * f.get('substeps', 1))")
+frames=$(python3 -c "print(round($seconds / $frame))")
 target=$(python3 -c "print($error / 100)")
 
 # Ours: the dam break scaled to N, DFSPH at its own step, the solves to the target.
@@ -69,13 +74,22 @@ sim = st["simulated_seconds"]
 de = st["density_error"]
 ours = sim / (gpu_ms / 1000.0)
 p = json.load(open(f"{out}/splishsplash.json"))
+# SPlisHSPlasH's own totals at its exit: density and divergence iterations.
+tot = {}
+for line in open(f"{out}/splishsplash.log"):
+    for key in ("iterations", "iterationsV"):
+        if line.strip().startswith(f"Total number: DFSPH - {key}:"):
+            tot[key] = int(line.split(":")[-1])
+# Its totals count every step, the first included.
+its = (f'{tot["iterations"] / (p["steps"] + 1):.1f} + {tot["iterationsV"] / (p["steps"] + 1):.1f}'
+       if len(tot) == 2 else "")
 rows = [
     ("fluidform DFSPH", st["particles"], sim, gpu_ms / 1000.0, ours, st["steps"],
      gpu_ms / max(st["steps"], 1), 1000.0 * sim / max(st["steps"], 1),
      f'{de["iterations_mean"]:.1f} + {de["divergence_iterations_mean"]:.1f}',
      100.0 * de["mean"]),
     ("SPlisHSPlasH DFSPH", p["particles"], p["simulated_s"], p["wall_s"], p["sim_s_per_wall_s"],
-     p["steps"], p["ms_per_step"], p["mean_dt_ms"], "", 100.0 * p["mean_density_error"]),
+     p["steps"], p["ms_per_step"], p["mean_dt_ms"], its, 100.0 * p["mean_density_error"]),
 ]
 with open(md, "a") as f:
     f.write(f"\n## DFSPH beside SPlisHSPlasH ({datetime.date.today()})\n\n")
