@@ -8,6 +8,7 @@ pub mod dfsph;
 pub mod errors;
 pub mod health;
 pub mod hooks;
+pub mod paper_dfsph;
 pub mod params;
 pub mod pbf;
 pub mod pcisph;
