@@ -49,7 +49,9 @@ pub fn own(base: &FluidParams, solver: Solver) -> FluidParams {
 
 /// The candidates a matched-accuracy row tries, cheapest first: WCSPH raises the speed of
 /// sound (CFL 0.3 limits the step by it); the incompressible solvers take the target as
-/// their error target and halve their largest step.
+/// their error target at their largest step, half and a quarter of it, then half the
+/// target at each (a solve stops on its predicted error, which the next step's densities
+/// exceed).
 pub fn ladder(base: &FluidParams, solver: Solver, target: f64) -> Vec<FluidParams> {
     match solver {
         Solver::Wcsph => [10.0, 20.0, 40.0, 80.0, 160.0]
@@ -65,14 +67,16 @@ pub fn ladder(base: &FluidParams, solver: Solver, target: f64) -> Vec<FluidParam
             .collect(),
         _ => [1.0, 0.5, 0.25]
             .into_iter()
-            .map(|k| {
+            .map(|k| (k, 1.0))
+            .chain([1.0, 0.5, 0.25].map(|k| (k, 0.5)))
+            .map(|(k, e)| {
                 FluidParams {
                     solver,
                     cfl: Some(crate::sph::params::OWN_CFL),
                     dt_max: Some(own_dt_max(base, solver) * k),
                     ..base.clone()
                 }
-                .with_density_error(target as f32)
+                .with_density_error((target * e) as f32)
             })
             .collect(),
     }
