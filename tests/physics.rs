@@ -7,7 +7,7 @@
 mod common;
 use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
-use fluidform::scene::schema::{Block, Domain, Scene};
+use fluidform::scene::schema::{Block, Scene};
 use fluidform::sph::solver::StateDump;
 use fluidform::sph::{Eos, FluidParams, SphSolver, SphState};
 
@@ -46,24 +46,16 @@ fn water(solver: Solver, spacing: f32, dt: f32) -> FluidParams {
     f
 }
 
+/// A box from the origin to `domain` with water filling `block` from its floor corner.
 fn scene(fluid: FluidParams, domain: [f32; 3], block: [f32; 3]) -> Scene {
-    let mut s = Scene::built_in("dam-break").expect("built-in");
-    s.name = "physics test".into();
-    s.domain = Domain {
-        min: [0.0; 3],
-        max: domain,
-    };
-    s.fluid = fluid;
-    s.blocks = vec![Block {
+    let water = Block {
         min: [0.0; 3],
         max: block,
         group: 0,
         color: [0.2, 0.5, 1.0],
         velocity: [0.0; 3],
-    }];
-    s.balls.clear();
-    s.colliders.clear();
-    s
+    };
+    common::box_scene(fluid, domain, vec![water])
 }
 
 /// Steps `st` until `t` simulated seconds have passed (in command buffers of at most 50

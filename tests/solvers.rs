@@ -4,35 +4,10 @@
 mod common;
 use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
-use fluidform::scene::schema::{Block, Domain, Particles, Scene};
+use fluidform::scene::schema::Particles;
 use fluidform::sph::{cpu_pressure, FluidParams, SphSolver, SphState};
 
 const SOLVERS: [Solver; 3] = [Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
-
-fn scene(fluid: FluidParams, domain: [f32; 3], blocks: Vec<Block>) -> Scene {
-    let mut s = Scene::built_in("dam-break").expect("built-in");
-    s.name = "solver test".into();
-    s.domain = Domain {
-        min: [0.0; 3],
-        max: domain,
-    };
-    s.fluid = fluid;
-    // A scene needs some fluid; tests that bring their own particles pass none.
-    s.blocks = if blocks.is_empty() {
-        vec![Block {
-            min: [0.0; 3],
-            max: [0.1; 3],
-            group: 0,
-            color: [1.0; 3],
-            velocity: [0.0; 3],
-        }]
-    } else {
-        blocks
-    };
-    s.balls.clear();
-    s.colliders.clear();
-    s
-}
 
 /// Random points in a cube around `c` (no two closer than a third of the rest spacing),
 /// random velocities of up to `speed`.
@@ -118,7 +93,7 @@ fn one_step_of_each_solver_matches_the_f64_reference() {
     let cases = SOLVERS.iter().flat_map(|s| [(*s, false), (*s, true)]);
     for (s, corner) in cases {
         let f = fixed_iterations(s, 3);
-        let sc = scene(f.clone(), [0.4; 3], vec![]);
+        let sc = common::box_scene(f.clone(), [0.4; 3], vec![]);
         // Packed tighter than rest (up to 3x in places): every solve has work to do.
         let parts = if corner {
             // Packed a little, 2 mm off three walls, moving at up to 0.5 m/s: some into
@@ -178,7 +153,7 @@ fn dfsph_neighbor_lists_match_the_grid_search() {
     for list in [0u32, 4, 96] {
         let mut f = fixed_iterations(Solver::Dfsph, 3);
         f.dfsph.neighbor_list = list;
-        let sc = scene(f.clone(), [0.4; 3], vec![]);
+        let sc = common::box_scene(f.clone(), [0.4; 3], vec![]);
         let parts = tagged(random_particles(&f, 400, 0.2, 0.5, 7));
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
         let (_, _, after) = one_step(&ctx, &solver, &mut st);
@@ -234,7 +209,7 @@ fn momentum_is_conserved_without_walls() {
             ..Default::default()
         };
         f.pbf.vorticity = 0.0;
-        let sc = scene(f.clone(), [1.0; 3], vec![]);
+        let sc = common::box_scene(f.clone(), [1.0; 3], vec![]);
         let parts = random_particles(&f, 500, 0.5, 0.5, 11);
         let mut st = solver.state(&ctx, &sc, &parts).unwrap();
         let p0: [f64; 3] = std::array::from_fn(|k| parts.vel.iter().map(|v| v[k] as f64).sum());
@@ -318,7 +293,7 @@ fn dfsph_converges_to_the_papers_step() {
         ("random", sparse, false),
         ("lattice on a plane", lattice, true),
     ] {
-        let mut sc = scene(f.clone(), [0.4; 3], vec![]);
+        let mut sc = common::box_scene(f.clone(), [0.4; 3], vec![]);
         if plane {
             sc.colliders = vec![fluidform::sph::Collider::Plane {
                 normal: [0.0, 1.0, 0.0],

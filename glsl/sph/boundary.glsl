@@ -42,25 +42,9 @@ float boundary(vec3 x, vec3 v, out vec3 g, out float rate) {
     float bd = P.h;
     for (uint c = 0u; c < P.colliders; ++c) {
         Collider col = cols[c];
-        uint kind = uint(col.b.w);
-        if (kind != 0u && col.a.w < P.h) continue;
+        if (uint(col.b.w) != 0u && col.a.w < P.h) continue;
         vec3 n;
-        float d;
-        if (kind == 0u) {
-            n = col.a.xyz;
-            d = dot(n, x) - col.a.w;
-        } else {
-            vec3 q = col.a.xyz;
-            if (kind == 2u) {
-                vec3 ab = col.b.xyz - col.a.xyz;
-                float t = clamp(dot(x - col.a.xyz, ab) / max(dot(ab, ab), 1e-20), 0.0, 1.0);
-                q = col.a.xyz + t * ab;
-            }
-            vec3 r = x - q;
-            float len = length(r);
-            n = len > 1e-12 ? r / len : vec3(0.0, 1.0, 0.0);
-            d = len - col.a.w;
-        }
+        float d = collider_distance(col, x, n);
         if (d < bd) {
             bd = d;
             bn = n;

@@ -79,28 +79,31 @@ vec3 respond(vec3 v, vec3 n, vec3 wall_v) {
 // elsewhere) answered with restitution and friction; a final clamp, so no particle ever
 // leaves the domain.
 float rest_margin() { return 0.5 * pow(P.mass / P.rest_density, 1.0 / 3.0); }
+// A collider's signed distance at x (negative inside the solid) and its surface normal
+// there, pointing into the fluid.
+float collider_distance(Collider col, vec3 x, out vec3 n) {
+    uint kind = uint(col.b.w);
+    if (kind == 0u) {
+        n = col.a.xyz;
+        return dot(n, x) - col.a.w;
+    }
+    vec3 q = col.a.xyz;
+    if (kind == 2u) {
+        vec3 ab = col.b.xyz - col.a.xyz;
+        float t = clamp(dot(x - col.a.xyz, ab) / max(dot(ab, ab), 1e-20), 0.0, 1.0);
+        q = col.a.xyz + t * ab;
+    }
+    vec3 d = x - q;
+    float len = length(d);
+    n = len > 1e-12 ? d / len : vec3(0.0, 1.0, 0.0);
+    return len - col.a.w;
+}
 void collide(inout vec3 x, inout vec3 va, inout vec3 vb) {
     float r = rest_margin();
     for (uint c = 0u; c < P.colliders; ++c) {
         Collider col = cols[c];
-        uint kind = uint(col.b.w);
         vec3 n;
-        float depth;
-        if (kind == 0u) {
-            n = col.a.xyz;
-            depth = col.a.w + r - dot(n, x);
-        } else {
-            vec3 q = col.a.xyz;
-            if (kind == 2u) {
-                vec3 ab = col.b.xyz - col.a.xyz;
-                float t = clamp(dot(x - col.a.xyz, ab) / max(dot(ab, ab), 1e-20), 0.0, 1.0);
-                q = col.a.xyz + t * ab;
-            }
-            vec3 d = x - q;
-            float len = length(d);
-            n = len > 1e-12 ? d / len : vec3(0.0, 1.0, 0.0);
-            depth = col.a.w + r - len;
-        }
+        float depth = r - collider_distance(col, x, n);
         if (depth > 0.0) {
             x += depth * n;
             va = respond(va, n, col.vel.xyz);

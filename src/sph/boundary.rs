@@ -5,14 +5,9 @@ use super::collider::{Collider, GpuCollider};
 use super::params::FluidParams;
 use crate::error::Result;
 
-pub type V3 = [f64; 3];
+pub use super::v3::V3;
+use super::v3::{axpy, dot};
 
-fn axpy(a: f64, x: V3, y: V3) -> V3 {
-    [y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 fn v3(a: [f32; 4]) -> V3 {
     [a[0] as f64, a[1] as f64, a[2] as f64]
 }

@@ -5,25 +5,8 @@
 //! (a scene's first step).
 use super::boundary::{Boundary, Solid};
 use super::params::{Eos, FluidParams, Kernels};
+use super::v3::{axpy, cross, dot, sub, V3};
 use crate::kinds::Solver;
-
-type V3 = [f64; 3];
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn axpy(a: f64, x: V3, y: V3) -> V3 {
-    [y[0] + a * x[0], y[1] + a * x[1], y[2] + a * x[2]]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 
 struct K {
     h: f64,
@@ -207,9 +190,11 @@ fn dfsph(
 ) -> (Vec<V3>, Vec<V3>) {
     let (kk, walls, dt, n) = (c.kk, c.b, c.dt, x.len());
     let solid = |i: usize, v: V3| walls.solid(kk.h, x[i], v);
+    // The boundary's sum V grad W (positions stay put through both solves).
+    let gb: Vec<V3> = (0..n).map(|i| solid(i, [0.0; 3]).g).collect();
     let alpha: Vec<f64> = (0..n)
         .map(|i| {
-            let d = kk.grad2(&x, i, solid(i, [0.0; 3]).g);
+            let d = kk.grad2(&x, i, gb[i]);
             if d > 1e-3 * c.proto {
                 1.0 / d
             } else {
@@ -246,7 +231,7 @@ fn dfsph(
             let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
             let old = v.clone();
             for i in 0..n {
-                let mut vi = axpy(-dt * k[i], solid(i, [0.0; 3]).g, old[i]);
+                let mut vi = axpy(-dt * k[i], gb[i], old[i]);
                 for j in 0..n {
                     if j != i {
                         vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);

@@ -17,6 +17,7 @@ pub mod run;
 pub mod setup;
 pub mod solver;
 pub mod spacing;
+pub mod v3;
 pub mod wcsph;
 
 pub use params::{Collider, Eos, FluidParams};

@@ -14,18 +14,9 @@
 //! end at this step's start): divergence solve, non-pressure forces, predicted velocities,
 //! density solve, positions. The kernels are fluidform's (poly6 densities, spiky
 //! gradients): the paper leaves W to the user.
-use super::boundary::{Boundary, V3};
+use super::boundary::Boundary;
 use super::params::{Eos, FluidParams, Kernels};
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn add(a: V3, s: f64, b: V3) -> V3 {
-    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
-}
+use super::v3::{axpy, dot, sub, V3};
 
 /// What one step did: positions, velocities, and each solve's iterations.
 pub struct PaperStep {
@@ -82,7 +73,7 @@ pub fn step(
             let (mut s, mut s2) = (psi_grad(i), 0.0);
             for j in (0..n).filter(|&j| j != i) {
                 let g = grad(sub(x[i], x[j])).map(|c| c * m);
-                s = add(s, 1.0, g);
+                s = axpy(1.0, g, s);
                 s2 += dot(g, g);
             }
             let d = dot(s, s) + s2;
@@ -125,10 +116,10 @@ pub fn step(
                 .collect();
             let old = v.clone();
             for i in 0..n {
-                let mut vi = add(old[i], -dt * kappa[i] / rho[i], psi_grad(i));
+                let mut vi = axpy(-dt * kappa[i] / rho[i], psi_grad(i), old[i]);
                 for j in (0..n).filter(|&j| j != i) {
                     let c = m * (kappa[i] / rho[i] + kappa[j] / rho[j]);
-                    vi = add(vi, -dt * c, grad(sub(x[i], x[j])));
+                    vi = axpy(-dt * c, grad(sub(x[i], x[j])), vi);
                 }
                 v[i] = vi;
             }
@@ -146,10 +137,10 @@ pub fn step(
         .collect();
     let a = super::cpu::evaluate(&fnp, b, pos, &v4).acc;
     for i in 0..n {
-        v[i] = add(v[i], dt, a[i]);
+        v[i] = axpy(dt, a[i], v[i]);
     }
     let density_iters = solve(&mut v, false);
-    let pos = (0..n).map(|i| add(x[i], dt, v[i])).collect();
+    let pos = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
     PaperStep {
         pos,
         vel: v,

@@ -120,3 +120,35 @@ pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
 /// Distance from `p` to triangle (a, b, c) (the library's, Ericson 5.1.5).
 #[allow(unused_imports)]
 pub use fluidform::control::surface::tri_distance;
+
+/// The dam break's scene with `fluid` in a box from the origin to `domain`, filled with
+/// `blocks` (with none, a 10 cm cube: a scene needs some fluid; tests that bring their
+/// own particles pass none), no balls, no colliders.
+pub fn box_scene(
+    fluid: fluidform::sph::FluidParams,
+    domain: [f32; 3],
+    blocks: Vec<fluidform::scene::schema::Block>,
+) -> fluidform::scene::schema::Scene {
+    use fluidform::scene::schema::{Block, Domain, Scene};
+    let mut s = Scene::built_in("dam-break").expect("built-in");
+    s.name = "solver test".into();
+    s.domain = Domain {
+        min: [0.0; 3],
+        max: domain,
+    };
+    s.fluid = fluid;
+    s.blocks = if blocks.is_empty() {
+        vec![Block {
+            min: [0.0; 3],
+            max: [0.1; 3],
+            group: 0,
+            color: [1.0; 3],
+            velocity: [0.0; 3],
+        }]
+    } else {
+        blocks
+    };
+    s.balls.clear();
+    s.colliders.clear();
+    s
+}
