@@ -143,25 +143,31 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         "{}",
         w.describe_step()
     );
-    for (s, own) in [
-        (Solver::Pcisph, f.pcisph.dt_max),
-        (Solver::Dfsph, f.dfsph.dt_max),
-        (Solver::Pbf, f.pbf.dt_max),
+    for (s, cfl, own) in [
+        (Solver::Pcisph, f.pcisph.cfl, f.pcisph.dt_max),
+        (Solver::Dfsph, f.dfsph.cfl, f.dfsph.dt_max),
+        (Solver::Pbf, f.pbf.cfl, f.pbf.dt_max),
     ] {
+        // PCISPH's own CFL number is 0.2, the others' 0.4.
+        let want = if s == Solver::Pcisph { 0.2 } else { 0.4 };
+        assert_eq!(cfl, want, "{s:?}");
         let g = o(&[], Some(s));
-        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(own)), "{s:?}");
+        assert_eq!((g.cfl, g.dt_max), (Some(cfl), Some(own)), "{s:?}");
         let line = g.describe_step();
-        assert!(line.contains("CFL 0.4") && line.contains("0.1%"), "{line}");
+        assert!(
+            line.contains(&format!("CFL {cfl}")) && line.contains("0.1%"),
+            "{line}"
+        );
         // The table's values, then explicit ones, each on its own.
         let g = o(
             &[&format!("{}.dt_max=0.003", format!("{s:?}").to_lowercase())],
             Some(s),
         );
-        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(0.003)), "{s:?}");
-        let g = o(&["cfl=0.2"], Some(s));
-        assert_eq!((g.cfl, g.dt_max), (Some(0.2), Some(own)), "{s:?}");
+        assert_eq!((g.cfl, g.dt_max), (Some(cfl), Some(0.003)), "{s:?}");
+        let g = o(&["cfl=0.3"], Some(s));
+        assert_eq!((g.cfl, g.dt_max), (Some(0.3), Some(own)), "{s:?}");
         let g = o(&["dt_max=0.001"], Some(s));
-        assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(0.001)), "{s:?}");
+        assert_eq!((g.cfl, g.dt_max), (Some(cfl), Some(0.001)), "{s:?}");
     }
     // cfl 0 in the table: fixed steps.
     let g = o(&["dfsph.cfl=0"], Some(Solver::Dfsph));

@@ -337,3 +337,125 @@ fn dfsph_converges_to_the_papers_step() {
     solver.destroy(&ctx);
     common::finish(&ctx);
 }
+
+/// GPU step against a paper reference: the largest componentwise difference of positions
+/// and velocities, and of the reference's own velocity change (what the pressure did).
+fn differences(
+    (vel, after): (&[[f32; 4]], &fluidform::sph::solver::StateDump),
+    (x, v): (&[[f64; 3]], &[[f64; 3]]),
+    free_fall: [f64; 3],
+) -> (f64, f64, f64) {
+    let (mut ex, mut ev, mut dv) = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..x.len() {
+        for k in 0..3 {
+            ex = ex.max((after.pos[i][k] as f64 - x[i][k]).abs());
+            ev = ev.max((after.vel[i][k] as f64 - v[i][k]).abs());
+            dv = dv.max((v[i][k] - vel[i][k] as f64 - free_fall[k]).abs());
+        }
+    }
+    (ex, ev, dv)
+}
+
+/// 7 x 7 x 7 particles at 0.99 rest spacings around (0.2, 0.2, 0.2), each moved by up to
+/// 0.02 spacings, moving at up to `speed`: compressed everywhere but at the surface, with
+/// corrections far below a spacing.
+fn jittered_lattice(s: f32, speed: f32, seed: u64) -> Particles {
+    let mut rng = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((rng >> 33) as f32 / (1u64 << 31) as f32) * 2.0 - 1.0
+    };
+    let (mut pos, mut vel) = (Vec::new(), Vec::new());
+    for k in 0..7 * 7 * 7 {
+        let q = |c: i32| 0.2 + 0.99 * s * (c - 3) as f32;
+        let c = [q(k % 7), q(k / 7 % 7), q(k / 49)];
+        pos.push([
+            c[0] + 0.02 * s * next(),
+            c[1] + 0.02 * s * next(),
+            c[2] + 0.02 * s * next(),
+            0.0,
+        ]);
+        vel.push([speed * next(), speed * next(), speed * next(), 0.0]);
+    }
+    Particles {
+        attr: vec![[0.0, 0.0, 0.0, f32::from_bits(0)]; pos.len()],
+        pos,
+        vel,
+    }
+}
+
+/// PCISPH and PBF against sph::paper_pcisph and sph::paper_pbf (Solenthaler & Pajarola
+/// 2009 and Macklin & Mueller 2013 as the papers write them, not the shaders' formulas):
+/// a jittered lattice at 0.99 spacings moving at up to 0.3 m/s, away from the walls, with
+/// gravity the only other force (at 0.95 spacings, 5% mean compression, the paper's PCISPH
+/// iterations wander at 7% error, its delta halved too). PCISPH converged (to 1e-6): whatever the
+/// iteration details (the GPU's own per-particle delta, relaxed by half, against the
+/// paper's prototype), both reach the same step. PBF after 4 iterations: the paper's
+/// Jacobi rounds are fixed, so the GPU must take the same path. The GPU searches its grid
+/// from the moving positions every iteration, the paper keeps the prediction's neighbours:
+/// the reference does both (here they agree; at 0.95 spacings the paper's lists were 0.7%
+/// off, a search every iteration 1e-5). No s_corr, XSPH or vorticity (not compared).
+#[test]
+fn pcisph_and_pbf_match_the_papers_steps() {
+    let ctx = common::ctx();
+    let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
+    let tol = 1e-6f32;
+    let mut bad = Vec::new();
+    for s in [Solver::Pcisph, Solver::Pbf] {
+        let mut f = fixed_iterations(s, 4);
+        (f.viscosity, f.surface_tension) = (0.0, 0.0);
+        (f.pbf.scorr_k, f.pbf.xsph, f.pbf.vorticity) = (0.0, 0.0, 0.0);
+        if s == Solver::Pcisph {
+            (f.pcisph.min_iterations, f.pcisph.max_iterations) = (3, 500);
+            f.pcisph.density_error = tol;
+        }
+        let parts = jittered_lattice(f.spacing(), 0.3, 7);
+        let sc = common::box_scene(f.clone(), [0.4; 3], vec![]);
+        let mut st = solver.state(&ctx, &sc, &tagged(parts)).unwrap();
+        let (pos, vel, after) = one_step(&ctx, &solver, &mut st);
+        st.destroy(&ctx);
+        let (dt, g) = (f.dt as f64, f.gravity.map(|c| c as f64));
+        let (x, v, what) = match s {
+            Solver::Pcisph => {
+                let paper = |omega| {
+                    fluidform::sph::paper_pcisph::step(&f, dt, g, &pos, &vel, tol as f64, omega)
+                };
+                let (x1, v1, it1) = paper(1.0);
+                let (ex, ev, _) = differences((&vel, &after), (&x1, &v1), g);
+                eprintln!("Pcisph, the paper's delta: {it1} iterations, |dx| {ex:.3e} m, |dv| {ev:.3e} m/s");
+                let (x, v, it) = paper(0.5);
+                (x, v, format!("the paper's delta halved: {it} iterations"))
+            }
+            _ => {
+                let paper = fluidform::sph::paper_pbf::step(&f, dt, g, &pos, &vel, 4, false);
+                let (ex, ev, _) = differences((&vel, &after), (&paper.0, &paper.1), g);
+                eprintln!("Pbf, the paper's neighbours (once, at the prediction): |dx| {ex:.3e} m, |dv| {ev:.3e} m/s");
+                let (x, v) = fluidform::sph::paper_pbf::step(&f, dt, g, &pos, &vel, 4, true);
+                (
+                    x,
+                    v,
+                    "4 iterations, neighbours found every iteration".to_string(),
+                )
+            }
+        };
+        let (ex, ev, dv) = differences((&vel, &after), (&x, &v), g.map(|c| c * dt));
+        eprintln!(
+            "{s:?} ({what}): |dx| {ex:.3e} m, |dv| {ev:.3e} m/s of pressure velocity changes up to {dv:.3e} m/s"
+        );
+        // Measured: PCISPH 5.6e-4 of the velocity change (it shrinks with tol: 3e-3 at
+        // 1e-5), PBF 8e-5 (float noise; with the paper's neighbours 8e-5 too here).
+        let rel = if s == Solver::Pcisph { 2e-3 } else { 1e-3 };
+        bad.push((s, dv, ev, ex, dt, rel));
+    }
+    for (s, dv, ev, ex, dt, rel) in bad {
+        assert!(dv > 1e-2, "{s:?}: the solves changed nothing");
+        assert!(ev <= rel * dv, "{s:?}: velocities off by {ev:.3e} m/s");
+        assert!(ex <= rel * dv * dt, "{s:?}: positions off by {ex:.3e} m");
+    }
+    solver.destroy(&ctx);
+    common::finish(&ctx);
+}

@@ -5,7 +5,7 @@
 //! (a scene's first step).
 use super::boundary::{Boundary, Solid};
 use super::params::{Eos, FluidParams, Kernels};
-use super::v3::{axpy, cross, dot, sub, V3};
+use super::v3::{axpy, cross, dot, sub, xyz, V3};
 use crate::kinds::Solver;
 
 struct K {
@@ -80,14 +80,8 @@ pub fn step(
         m: f.mass as f64,
     };
     let proto = super::params::proto_grad2(f);
-    let x: Vec<V3> = pos
-        .iter()
-        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        .collect();
-    let v: Vec<V3> = vel
-        .iter()
-        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        .collect();
+    let x = xyz(pos);
+    let v = xyz(vel);
     let rho: Vec<f64> = (0..n)
         .map(|i| kk.density(&x, i) + kk.rho0 * b.solid(kk.h, x[i], [0.0; 3]).rho)
         .collect();

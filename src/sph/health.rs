@@ -42,6 +42,8 @@ pub struct Health {
     readbacks: Vec<Buffer>,
     /// Per slot: the h / dt of the frame recorded into it.
     limits: Vec<f32>,
+    /// Per slot: the CFL number its steps were sized by (None: fixed steps).
+    cfls: Vec<Option<f32>>,
 }
 
 impl Health {
@@ -68,12 +70,14 @@ impl Health {
             out: out.take(),
             readbacks: readbacks.take(),
             limits: vec![f32::INFINITY; slots],
+            cfls: vec![None; slots],
         })
     }
 
     /// Record the health of the state after a frame of steps of `dt` into `slot`.
     pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState, slot: usize) {
         self.limits[slot] = st.fluid.h / st.dt;
+        self.cfls[slot] = st.fluid.cfl;
         ctx.fill(cmd, &self.out, 0);
         let bufs = HealthBufs {
             vel: st.vel(),
@@ -89,7 +93,10 @@ impl Health {
     pub fn check(&self, slot: usize, frame: u64, rest_density: f32) -> Result<GpuHealth> {
         let h: GpuHealth =
             bytemuck::pod_read_unaligned(self.readbacks[slot].mapped().expect("mapped"));
-        let fix = "lower --fluid dt or set --fluid cfl=0.4";
+        let fix = match self.cfls[slot] {
+            Some(c) => format!("lower --fluid cfl={c} or --fluid dt_max"),
+            None => "lower --fluid dt or set --fluid cfl=0.4".to_string(),
+        };
         if h.nonfinite > 0 {
             return Err(Error::Unstable(format!(
                 "frame {frame}: {} particle(s) with a non-finite velocity or density ({fix})",

@@ -9,6 +9,8 @@ pub mod errors;
 pub mod health;
 pub mod hooks;
 pub mod paper_dfsph;
+pub mod paper_pbf;
+pub mod paper_pcisph;
 pub mod params;
 pub mod pbf;
 pub mod pcisph;

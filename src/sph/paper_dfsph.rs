@@ -15,8 +15,8 @@
 //! density solve, positions. The kernels are fluidform's (poly6 densities, spiky
 //! gradients): the paper leaves W to the user.
 use super::boundary::Boundary;
-use super::params::{Eos, FluidParams, Kernels};
-use super::v3::{axpy, dot, sub, V3};
+use super::params::{Eos, FluidParams};
+use super::v3::{axpy, dot, sub, xyz, Smoothing, V3};
 
 /// What one step did: positions, velocities, and each solve's iterations.
 pub struct PaperStep {
@@ -37,31 +37,10 @@ pub fn step(
 ) -> PaperStep {
     let n = pos.len();
     let (h, m, rho0) = (f.h as f64, f.mass as f64, f.rest_density as f64);
-    let k = Kernels::new(h);
-    let w = |d: V3| {
-        let q = h * h - dot(d, d);
-        if q > 0.0 {
-            k.poly6 * q * q * q
-        } else {
-            0.0
-        }
-    };
-    let grad = |d: V3| -> V3 {
-        let r = dot(d, d).sqrt();
-        if r >= h || r <= 1e-6 * h {
-            return [0.0; 3];
-        }
-        let s = k.spiky_grad * (h - r) * (h - r) / r;
-        [s * d[0], s * d[1], s * d[2]]
-    };
-    let x: Vec<V3> = pos
-        .iter()
-        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        .collect();
-    let mut v: Vec<V3> = vel
-        .iter()
-        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        .collect();
+    let sm = Smoothing::new(h);
+    let (w, grad) = (|d: V3| sm.w(d), |d: V3| sm.grad(d));
+    let x = xyz(pos);
+    let mut v = xyz(vel);
     // Boundary particles' sums: psi W = rho0 V_b W, psi grad W (V_b: boundary.rs's volume).
     let solid: Vec<_> = x.iter().map(|xi| b.solid(h, *xi, [0.0; 3])).collect();
     let psi_grad = |i: usize| -> V3 { solid[i].g.map(|c| c * rho0) };

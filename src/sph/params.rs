@@ -10,8 +10,8 @@ pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
 pub use super::pressure::Convergence;
 
-/// The incompressible solvers' own CFL number (with each table's `dt_max`: the setup
-/// `bench solvers` found stable on the dam break).
+/// DFSPH's and PBF's own CFL number (with each table's `dt_max`: the setup `bench
+/// solvers` found stable on the dam break; PCISPH's is its own).
 pub const OWN_CFL: f32 = 0.4;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -62,8 +62,9 @@ pub struct FluidParams {
     pub dt: f32,
     /// Steps per frame: a frame advances dt * substeps
     pub substeps: u32,
-    /// CFL number: when set, a step never exceeds cfl * h / max(c, v_max) (v_max from the
-    /// previous frame, c the speed of sound) and the frame takes more steps to keep its time
+    /// CFL number: when set, a step never exceeds cfl * h / max(c, v_max, v_fall) (v_max
+    /// from the previous frame, c the speed of sound, v_fall = sqrt(2 |g| H) for the
+    /// domain's height H: `run::Stepper`) and the frame takes more steps to keep its time
     pub cfl: Option<f32>,
     pub gravity: [f32; 3],
     /// Normal velocity kept (reversed) at a wall, 0..1

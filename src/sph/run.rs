@@ -10,8 +10,13 @@ use ash::vk;
 use serde::{Deserialize, Serialize};
 
 /// Chooses steps per frame and watches the state's health. With `cfl`, a step never
-/// exceeds cfl * h / max(c, v_max) (c: wcsph's speed of sound; 0 for the incompressible
-/// solvers) nor `dt_max` (default `dt`), v_max read back from the latest finished frame.
+/// exceeds cfl * h / max(c, v_max, v_fall) (c: wcsph's speed of sound; 0 for the
+/// incompressible solvers) nor `dt_max` (default `dt`), v_max read back from the latest
+/// finished frame and, where it grows, carried on at that rate over the frames in flight.
+/// v_fall = sqrt(2 |g| H), the speed of a fall through the domain's height
+/// H: v_max lags a frame and is 0 at the start, and a step sized for a fluid at rest broke
+/// the incompressible solves once it moved (DFSPH at 6.7 ms on the 64K dam break: densities
+/// to 1.7 rho0 within 0.1 s; at 3 ms, the floor's step there, 1.05).
 pub struct Stepper {
     health: Health,
     errors: StepErrors,
@@ -27,6 +32,10 @@ pub struct Stepper {
     pub steps_taken: u64,
     pub sim_time: f64,
     v_max: f32,
+    /// The largest speed of the frame retired before v_max's.
+    v_prev: f32,
+    /// The floor of the CFL's speed (see the type).
+    v_fall: f32,
     rest_density: f32,
     /// The fluid's (min, max) iterations.
     iterations: (u32, u32),
@@ -52,6 +61,8 @@ impl Stepper {
             steps_taken: 0,
             sim_time: 0.0,
             v_max: 0.0,
+            v_prev: 0.0,
+            v_fall: fall_speed(st),
             rest_density: st.fluid.rest_density,
             iterations: {
                 let c = st.fluid.convergence();
@@ -66,7 +77,12 @@ impl Stepper {
         match f.cfl {
             None => (f.substeps, f.dt),
             Some(cfl) => {
-                let limit = cfl * f.h / f.sound().max(self.v_max).max(1e-6);
+                // v_max is as old as the frames in flight: where it grows, it is carried
+                // on at its last frame's rate over them.
+                let lag = self.pending.len() as f32;
+                let v_est = self.v_max + (self.v_max - self.v_prev).max(0.0) * lag;
+                let v = f.sound().max(v_est).max(self.v_fall);
+                let limit = cfl * f.h / v.max(1e-6);
                 let dt = f.dt_max.unwrap_or(f.dt).min(limit);
                 let steps = (self.frame_time / dt as f64)
                     .ceil()
@@ -120,14 +136,16 @@ impl Stepper {
     /// iterations the next frame records.
     ///
     /// Iterations past convergence cost empty indirect dispatches, which are not free
-    /// (on lavapipe about 0.2 ms each, against 5 to 20 ms for a real one). So a frame
-    /// records the most iterations the last finished frame took, plus 4 and a half (with
-    /// a quarter, a dam break's growing solves hit the bound in a quarter of their steps
-    /// and stopped above target), up to max_iter; a step that used every
+    /// (on lavapipe about 0.2 ms each, against 5 to 20 ms for a real one; on an H200
+    /// about 0.01 against 0.15 at 1M). So a frame records twice the most iterations the
+    /// last finished frame took, plus 4, up to max_iter (with half again, the 1M dam
+    /// break's DFSPH hit the bound in 7% of its steps and flung a particle at 1.3 s; with
+    /// a quarter, the 64K one's in a quarter of its steps); a step that used every
     /// iteration recorded (it may have stopped above its target) is counted in
     /// `bounded_steps`, and the next frame records twice as many.
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
         let h = self.health.check(slot, frame, self.rest_density)?;
+        self.v_prev = self.v_max;
         self.v_max = h.max_speed();
         let (steps, mut t, recorded) = self.pending[slot];
         let (_, max_iter) = self.iterations;
@@ -149,9 +167,14 @@ impl Stepper {
         }
         self.bound = match hit {
             true => recorded.map(|r| (2 * cap(r)).min(max_iter)),
-            false => most.map(|m| (m + 4 + m / 2).min(max_iter)),
+            false => most.map(|m| (2 * m + 4).min(max_iter)),
         };
         Ok(())
+    }
+
+    /// The floor of the CFL's speed, m/s.
+    pub fn fall_speed(&self) -> f32 {
+        self.v_fall
     }
 
     /// `steps.csv`: one row per step.
@@ -206,6 +229,14 @@ pub struct PhysicsStats {
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.
 /// `rest_density`: the fluid's (densities are reported over it too).
+/// sqrt(2 |g| H): the speed a particle gains falling through the domain's height along g.
+fn fall_speed(st: &SphState) -> f32 {
+    let (lo, hi) = st.domain;
+    let g = st.fluid.gravity;
+    let drop: f32 = (0..3).map(|k| g[k].abs() * (hi[k] - lo[k]).abs()).sum();
+    (2.0 * drop).sqrt()
+}
+
 pub fn physics_stats(d: &StateDump, domain: &Domain, rest_density: f32) -> PhysicsStats {
     let n = d.pos.len();
     let (lo, hi) = (domain.min, domain.max);

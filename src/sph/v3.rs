@@ -1,5 +1,5 @@
-//! f64 vector arithmetic of the CPU references (cpu_pressure.rs, paper_dfsph.rs,
-//! boundary.rs).
+//! f64 vector arithmetic and kernels of the CPU references (cpu_pressure.rs, the
+//! paper_*.rs, boundary.rs).
 pub type V3 = [f64; 3];
 
 pub fn sub(a: V3, b: V3) -> V3 {
@@ -18,4 +18,46 @@ pub fn cross(a: V3, b: V3) -> V3 {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// xyz of each vec4, in f64.
+pub fn xyz(v: &[[f32; 4]]) -> Vec<V3> {
+    v.iter()
+        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        .collect()
+}
+
+/// Poly6 densities and spiky gradients at support h, in f64 (the paper references').
+pub struct Smoothing {
+    h: f64,
+    k: super::params::Kernels,
+}
+
+impl Smoothing {
+    pub fn new(h: f64) -> Self {
+        Self {
+            h,
+            k: super::params::Kernels::new(h),
+        }
+    }
+
+    /// W(d), poly6.
+    pub fn w(&self, d: V3) -> f64 {
+        let q = self.h * self.h - dot(d, d);
+        if q > 0.0 {
+            self.k.poly6 * q * q * q
+        } else {
+            0.0
+        }
+    }
+
+    /// grad W(d), spiky (0 at d = 0).
+    pub fn grad(&self, d: V3) -> V3 {
+        let r = dot(d, d).sqrt();
+        if r >= self.h || r <= 1e-6 * self.h {
+            return [0.0; 3];
+        }
+        let s = self.k.spiky_grad * (self.h - r) * (self.h - r) / r;
+        [s * d[0], s * d[1], s * d[2]]
+    }
 }
