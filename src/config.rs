@@ -1,6 +1,7 @@
 //! Command-line switches shared by `run` and `bench` (names fixed by DESIGN.md).
-//! Values are closed enums so an unknown value is rejected by the parser; a switch whose
-//! algorithm is not built yet is rejected by `reject_unused` with a clear message.
+//! Values are closed enums so an unknown value is rejected by the parser; a switch the
+//! chosen scene or benchmark does not use is rejected by `reject_unused` with a clear
+//! message naming what uses it.
 use crate::error::{Error, Result};
 use clap::Args;
 use serde::Serialize;
@@ -403,9 +404,8 @@ fn set_in<T: Serialize + Default>(g: &T) -> Vec<String> {
 }
 
 impl Switches {
-    /// Fail for every set switch of a group that `what` does not use, naming where it
-    /// applies, and for every control switch (not built yet), naming what brings it: a
-    /// switch never silently does nothing. The common and frame groups always apply.
+    /// Fail on the first set switch of a group that `what` does not use, naming what uses
+    /// it: a switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {
         let groups: [(Group, Vec<String>, &str); 11] = [
             (

@@ -117,9 +117,12 @@ impl PointsViewer {
         slots: usize,
         show: ShowMesh,
     ) -> Result<Self> {
+        let size = (sw.frame.width(), sw.frame.height());
+        // Colour, depth and a readback per slot; images, bound by no storage range.
+        check_frame(ctx, size, (8 + 4 * slots as u64, 0), sw.common.quiet)?;
         let view = Guard::new(ctx, PointsView::new(ctx)?);
         let mesh = Guard::new(ctx, mesh_view(ctx, cam, show)?);
-        let target = ColorTarget::new(ctx, sw.frame.width(), sw.frame.height(), slots)?;
+        let target = ColorTarget::new(ctx, size.0, size.1, slots)?;
         Ok(Self {
             view: view.take(),
             mesh: mesh.take(),
@@ -238,6 +241,13 @@ impl MetaballViewer {
         let mut settings = MetaballSettings::from_switches(sw)?;
         settings.tank = tank;
         settings.opaque = show != ShowMesh::Off || overlay;
+        let bytes = crate::render::metaball::buffers::pixel_bytes(&settings, slots);
+        check_frame(
+            ctx,
+            (settings.width, settings.height),
+            bytes,
+            sw.common.quiet,
+        )?;
         let mesh = Guard::new(ctx, mesh_view(ctx, &cam, show)?);
         let target = match settings.opaque {
             true => Some(ColorTarget::new(ctx, settings.width, settings.height, 0)?),
@@ -424,4 +434,70 @@ impl View for MetaballViewer {
         }
         self.renderer.destroy(ctx);
     }
+}
+
+/// Frames of at least this many pixels on a CPU device are announced at start.
+const LARGE_FRAME_PIXELS: f64 = 4.0 * 1024.0 * 1024.0;
+
+/// Refuse a `w` x `h` frame the device cannot hold, before anything is made for it: a side
+/// over the device's image limit, the largest pixel-sized buffer (`largest` bytes a pixel)
+/// over what one storage binding addresses, or all of them (`total` bytes a pixel) over
+/// half the device's memory. The error names the largest frame of the same shape that
+/// fits. A frame that fits but is large on a CPU device is announced unless `quiet`: its
+/// frames take long, and the progress is per frame.
+pub fn check_frame(
+    ctx: &Context,
+    (w, h): (u32, u32),
+    (total, largest): (u64, u64),
+    quiet: bool,
+) -> Result<()> {
+    const MIB: f64 = (1u64 << 20) as f64;
+    let px = w as f64 * h as f64;
+    let max_side = ctx.limits.max_image_dimension2_d;
+    let range = ctx.max_storage_range() as f64;
+    let memory = ctx.info.device_local_bytes as f64 / 2.0;
+    let mut limits = vec![(
+        max_side as f64 / w.max(h) as f64,
+        format!("its sides may be at most {max_side} pixels here"),
+    )];
+    limits.push((
+        (range / (largest as f64 * px)).sqrt(),
+        format!(
+            "one of its buffers would take {:.0} MiB, more than one storage binding addresses here ({:.0} MiB)",
+            largest as f64 * px / MIB,
+            range / MIB
+        ),
+    ));
+    if memory > 0.0 {
+        limits.push((
+            (memory / (total as f64 * px)).sqrt(),
+            format!(
+                "its buffers would take {:.0} MiB, more than half the device's memory ({:.0} MiB)",
+                total as f64 * px / MIB,
+                2.0 * memory / MIB
+            ),
+        ));
+    }
+    let (scale, why) = limits
+        .into_iter()
+        .fold((1.0f64, None), |(s, why), (l, text)| match l < s {
+            true => (l, Some(text)),
+            false => (s, why),
+        });
+    if let Some(why) = why {
+        let fit = |side: u32| ((side as f64 * scale).floor() as u32).max(1);
+        return Err(crate::error::Error::Memory(format!(
+            "a {w} x {h} frame is too large: {why}; the largest frame of its shape that fits is --width {} --height {}",
+            fit(w),
+            fit(h)
+        )));
+    }
+    if !quiet && px >= LARGE_FRAME_PIXELS && ctx.info.kind == "cpu" {
+        eprintln!(
+            "a {w} x {h} frame ({:.1} Mpx, {:.0} MiB of frame buffers) on a CPU device: each frame takes long; progress is per frame",
+            px / 1e6,
+            total as f64 * px / MIB
+        );
+    }
+    Ok(())
 }

@@ -246,3 +246,51 @@ fn run_pass_times_agree_with_bench() {
         );
     }
 }
+
+/// A frame the device cannot hold is refused at start, naming the largest frame of its
+/// shape that fits (a new user's --width 16384 --height 16384 on the demo ran minutes in
+/// silence).
+#[test]
+fn a_frame_too_large_is_refused_with_the_size_that_fits() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let run = |w: &str, h: &str| {
+        let t = std::time::Instant::now();
+        let o = fluidform(&[
+            "run",
+            "--scene",
+            "demo",
+            "--out",
+            d,
+            "--frames",
+            "1",
+            "--save-every",
+            "0",
+            "--width",
+            w,
+            "--height",
+            h,
+        ]);
+        (o, t.elapsed().as_secs_f64())
+    };
+    let (o, secs) = run("16384", "8192");
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert!(t.contains("a 16384 x 8192 frame is too large"), "{t}");
+    assert!(secs < 20.0, "took {secs} s");
+    // "... --width W --height H" at the end of the one error line.
+    let line = t.lines().find(|l| l.contains("too large")).unwrap();
+    let nums: Vec<u32> = line
+        .split("--width ")
+        .nth(1)
+        .unwrap()
+        .split(" --height ")
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    let (w, h) = (nums[0], nums[1]);
+    assert!(w < 16384 && h < 8192 && w >= 64, "{w} x {h}");
+    assert!(
+        (w as f64 / h as f64 - 2.0).abs() < 0.01,
+        "shape kept: {w} x {h}"
+    );
+}

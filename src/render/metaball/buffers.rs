@@ -47,6 +47,29 @@ pub fn entry_bytes(list: ListKind) -> u64 {
     }
 }
 
+/// Bytes per pixel of a frame of `s` with `slots` in flight (as `with_capacity` makes
+/// them): all its pixel-sized buffers together, the list at its first capacity (4 entries
+/// a pixel; it is capped at one binding's range) and the opaque layer's colour target
+/// included; and the largest one alone, which one storage binding must address.
+pub fn pixel_bytes(s: &MetaballSettings, slots: usize) -> (u64, u64) {
+    let (sbuf, abuf) = (s.list == ListKind::Sbuffer, s.list == ListKind::Abuffer);
+    let list = 4 * entry_bytes(s.list);
+    // The picture and its readbacks.
+    let mut total = 4 + 4 * slots as u64;
+    let mut largest = 4;
+    if sbuf {
+        total += 4 + 4 + list; // offsets, scan scratch, list
+    }
+    if abuf {
+        total += 4 + list; // heads, nodes
+    }
+    if s.opaque {
+        total += 8 + 4 + 4 + 4; // opaque layer, scene depth, the target's colour and depth
+        largest = 8;
+    }
+    (total, largest)
+}
+
 fn load_sky(path: &str) -> Result<(u32, u32, Vec<u32>)> {
     let img = image::open(path).map_err(|e| Error::Image {
         path: path.into(),
