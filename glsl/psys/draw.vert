@@ -2,6 +2,8 @@
 // One particle per VERTS vertices: MODE 0 points (one vertex, right.w pixels), 1 streaks (a
 // line from a frame ago to now), 2 camera-facing sprites (a quad). Attributes over life (size, colour,
 // opacity) are keyframe curves of age / life.
+// Opaque and blended draws test one depth buffer: bit-equal positions.
+invariant gl_Position;
 #include "draw.glsl"
 #include "closed.glsl"
 #if MODE != 0

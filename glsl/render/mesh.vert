@@ -1,6 +1,8 @@
 #version 450
 // A skinned mesh (src/render/mesh.rs): vertices pulled from the skinning pass's output by
 // the index buffer, three per triangle, with the corner's barycentric for the wireframe.
+// Drawn in more than one pass against the same depth: the same inputs give bit-equal positions.
+invariant gl_Position;
 layout(std430, binding = MESH_B_POS) readonly buffer Pos { vec4 pos[]; };
 layout(std430, binding = MESH_B_NRM) readonly buffer Nrm { vec4 nrm[]; };
 layout(std430, binding = MESH_B_INDICES) readonly buffer Indices { uint indices[]; };

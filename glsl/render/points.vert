@@ -1,5 +1,7 @@
 #version 450
 // Particle view: one camera-facing quad per particle (6 vertices, no vertex buffer).
+// Depth-tested against the mesh and overlays drawn in other passes: bit-equal positions.
+invariant gl_Position;
 layout(std430, binding = PTS_B_POS) readonly buffer Pos { vec4 pos[]; };  // xyz, w = radius or 0
 layout(std430, binding = PTS_B_COLOR) readonly buffer Color { vec4 color[]; };  // rgba
 layout(push_constant) uniform Push {

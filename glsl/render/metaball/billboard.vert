@@ -3,6 +3,8 @@
 // sphere of radius R (tangent lines from the eye per axis), widened by one pixel so the
 // pixel containing the projection of any point inside the sphere gets a fragment.
 // Spheres crossing the near plane cover the screen; spheres behind it none.
+// Every list pass draws these quads against the same depth: bit-equal positions.
+invariant gl_Position;
 #include "common.glsl"
 layout(location = 0) flat out uint v_id;
 const vec2 corners[6] = vec2[](vec2(0, 0), vec2(1, 0), vec2(1, 1), vec2(0, 0), vec2(1, 1), vec2(0, 1));
