@@ -425,14 +425,15 @@ fn pcisph_and_pbf_match_the_papers_steps() {
                     fluidform::sph::paper_pcisph::step(&f, dt, g, &pos, &vel, tol as f64, omega)
                 };
                 let (x1, v1, it1) = paper(1.0);
-                let (ex, ev, _) = differences((&vel, &after), (&x1, &v1), g);
+                let (ex, ev, _) = differences((&vel, &after), (&x1, &v1), g.map(|c| c * dt));
                 eprintln!("Pcisph, the paper's delta: {it1} iterations, |dx| {ex:.3e} m, |dv| {ev:.3e} m/s");
                 let (x, v, it) = paper(0.5);
                 (x, v, format!("the paper's delta halved: {it} iterations"))
             }
             _ => {
                 let paper = fluidform::sph::paper_pbf::step(&f, dt, g, &pos, &vel, 4, false);
-                let (ex, ev, _) = differences((&vel, &after), (&paper.0, &paper.1), g);
+                let (ex, ev, _) =
+                    differences((&vel, &after), (&paper.0, &paper.1), g.map(|c| c * dt));
                 eprintln!("Pbf, the paper's neighbours (once, at the prediction): |dx| {ex:.3e} m, |dv| {ev:.3e} m/s");
                 let (x, v) = fluidform::sph::paper_pbf::step(&f, dt, g, &pos, &vel, 4, true);
                 (

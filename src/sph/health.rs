@@ -94,7 +94,7 @@ impl Health {
         let h: GpuHealth =
             bytemuck::pod_read_unaligned(self.readbacks[slot].mapped().expect("mapped"));
         let fix = match self.cfls[slot] {
-            Some(c) => format!("lower --fluid cfl={c} or --fluid dt_max"),
+            Some(c) => format!("lower --fluid cfl (now {c}) or --fluid dt_max"),
             None => "lower --fluid dt or set --fluid cfl=0.4".to_string(),
         };
         if h.nonfinite > 0 {

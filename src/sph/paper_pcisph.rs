@@ -9,8 +9,10 @@
 //! velocities and positions then take the last F_p. delta is the paper's, from one
 //! prototype particle with a filled neighbourhood (a simple cubic lattice at the rest
 //! spacing, `params::proto_grad2`): delta = -1 / (beta (-|sum grad W|^2 - sum |grad W|^2)),
-//! beta = 2 (dt m / rho0)^2. Two choices the paper leaves open: pressures stay at least 0
-//! (a free surface is not pulled in; the error counts compression only), and the pressure
+//! beta = 2 (dt m / rho0)^2. Three choices the paper leaves open: the loop stops on the
+//! mean density error (our solvers' rule; the paper tests rho*_err against eta, which may
+//! be read per particle), pressures stay at least 0 (a free surface is not pulled in; the
+//! error counts compression only), and the pressure
 //! force's gradients are taken at the predicted positions, where the loop has just put the
 //! particles. Kernels are fluidform's (poly6 densities, spiky gradients): the paper leaves
 //! W to the user. No boundary: a comparison keeps the particles off the walls.

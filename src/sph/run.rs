@@ -227,9 +227,8 @@ pub struct PhysicsStats {
     pub max_speed: f64,
 }
 
-/// Physics checks of a state: NaNs, particles outside the domain, density statistics.
-/// `rest_density`: the fluid's (densities are reported over it too).
-/// sqrt(2 |g| H): the speed a particle gains falling through the domain's height along g.
+/// sqrt(2 |g| H): the speed a particle gains falling through the domain's height along g
+/// (the fluid's gravity; a hook's extra acceleration is not counted).
 fn fall_speed(st: &SphState) -> f32 {
     let (lo, hi) = st.domain;
     let g = st.fluid.gravity;
@@ -237,6 +236,8 @@ fn fall_speed(st: &SphState) -> f32 {
     (2.0 * drop).sqrt()
 }
 
+/// Physics checks of a state: NaNs, particles outside the domain, density statistics.
+/// `rest_density`: the fluid's (densities are reported over it too).
 pub fn physics_stats(d: &StateDump, domain: &Domain, rest_density: f32) -> PhysicsStats {
     let n = d.pos.len();
     let (lo, hi) = (domain.min, domain.max);

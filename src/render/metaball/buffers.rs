@@ -47,10 +47,11 @@ pub fn entry_bytes(list: ListKind) -> u64 {
     }
 }
 
-/// Bytes per pixel of a frame of `s` with `slots` in flight (as `with_capacity` makes
-/// them): all its pixel-sized buffers together, the list at its first capacity (4 entries
-/// a pixel; it is capped at one binding's range) and the opaque layer's colour target
-/// included; and the largest one alone, which one storage binding must address.
+/// Bytes per pixel of a frame of `s` with `slots` in flight, an upper bound on what
+/// `with_capacity` makes: all its pixel-sized buffers together, the list at its first
+/// capacity of 4 entries a pixel (`with_capacity` caps it at one binding's range) and the
+/// opaque layer's colour target included; and the largest one alone, which one storage
+/// binding must address.
 pub fn pixel_bytes(s: &MetaballSettings, slots: usize) -> (u64, u64) {
     let (sbuf, abuf) = (s.list == ListKind::Sbuffer, s.list == ListKind::Abuffer);
     let list = 4 * entry_bytes(s.list);
@@ -58,7 +59,7 @@ pub fn pixel_bytes(s: &MetaballSettings, slots: usize) -> (u64, u64) {
     let mut total = 4 + 4 * slots as u64;
     let mut largest = 4;
     if sbuf {
-        total += 4 + 4 + list; // offsets, scan scratch, list
+        total += 4 + list; // offsets, list (the scan's scratch is 1/16 of a byte)
     }
     if abuf {
         total += 4 + list; // heads, nodes
