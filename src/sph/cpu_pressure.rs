@@ -4,13 +4,13 @@
 //! response where the shaders apply it. Starts from a state with no warm-start stiffness
 //! (a scene's first step).
 use super::boundary::{Boundary, Solid};
-use super::params::{Eos, FluidParams, Kernels};
-use super::v3::{axpy, cross, dot, sub, xyz, V3};
+use super::params::{Eos, FluidParams};
+use super::v3::{axpy, cross, dot, sub, xyz, Smoothing, V3};
 use crate::kinds::Solver;
 
 struct K {
     h: f64,
-    k: Kernels,
+    sm: Smoothing,
     v: f64,
     rho0: f64,
     m: f64,
@@ -18,21 +18,11 @@ struct K {
 
 impl K {
     fn w(&self, r2: f64) -> f64 {
-        let q = self.h * self.h - r2;
-        if q <= 0.0 {
-            0.0
-        } else {
-            self.k.poly6 * q * q * q
-        }
+        self.sm.w_r2(r2)
     }
     /// V grad W_spiky (zero past h or at r ~ 0).
     fn vg(&self, d: V3) -> V3 {
-        let r = dot(d, d).sqrt();
-        if r >= self.h || r <= 1e-6 * self.h {
-            return [0.0; 3];
-        }
-        let s = self.v * self.k.spiky_grad * (self.h - r).powi(2) / r;
-        [s * d[0], s * d[1], s * d[2]]
+        self.sm.grad(d).map(|c| self.v * c)
     }
     /// The fluid's density at x_i (the boundary's is added by the callers).
     fn density(&self, x: &[V3], i: usize) -> f64 {
@@ -74,7 +64,7 @@ pub fn step(
     let n = pos.len();
     let kk = K {
         h: f.h as f64,
-        k: Kernels::new(f.h as f64),
+        sm: Smoothing::new(f.h as f64),
         v: f.mass as f64 / f.rest_density as f64,
         rho0: f.rest_density as f64,
         m: f.mass as f64,

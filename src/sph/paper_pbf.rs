@@ -15,7 +15,7 @@
 //! s_corr, collisions, XSPH and vorticity confinement are not part of it (a comparison
 //! sets them to 0 and keeps the particles off the walls).
 use super::params::FluidParams;
-use super::v3::{axpy, dot, sub, xyz, Smoothing, V3};
+use super::v3::{axpy, dot, neighbours, sub, xyz, Smoothing, V3};
 
 /// One PBF step of `pos`, `vel` (xyz) under `accel` (the external acceleration): the
 /// positions and velocities after it, in f64. `requery`: neighbours found again before
@@ -43,20 +43,11 @@ pub fn step(
         .map(|p| axpy(dt, accel, [p[0] as f64, p[1] as f64, p[2] as f64]))
         .collect();
     let mut p: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();
-    let find = |p: &[V3]| -> Vec<Vec<usize>> {
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| j != i && dot(sub(p[i], p[j]), sub(p[i], p[j])) < h * h)
-                    .collect()
-            })
-            .collect()
-    };
     // N_i(p_i), once (the paper), or before every iteration (`requery`).
-    let mut nb = find(&p);
+    let mut nb = neighbours(&p, h);
     for it in 0..iterations {
         if requery && it > 0 {
-            nb = find(&p);
+            nb = neighbours(&p, h);
         }
         let lambda: Vec<f64> = (0..n)
             .map(|i| {

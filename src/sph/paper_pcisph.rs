@@ -17,7 +17,7 @@
 //! particles. Kernels are fluidform's (poly6 densities, spiky gradients): the paper leaves
 //! W to the user. No boundary: a comparison keeps the particles off the walls.
 use super::params::FluidParams;
-use super::v3::{axpy, dot, sub, xyz, Smoothing, V3};
+use super::v3::{axpy, neighbours, sub, xyz, Smoothing, V3};
 
 /// One PCISPH step of `pos`, `vel` (xyz) under `accel` (F_ext / m) iterated to a mean
 /// relative density error below `tol` (at most 1000 iterations): the positions and
@@ -45,13 +45,7 @@ pub fn step(
     let delta = omega / (beta * grad2);
     let x = xyz(pos);
     let v = xyz(vel);
-    let nb: Vec<Vec<usize>> = (0..n)
-        .map(|i| {
-            (0..n)
-                .filter(|&j| j != i && dot(sub(x[i], x[j]), sub(x[i], x[j])) < h * h)
-                .collect()
-        })
-        .collect();
+    let nb = neighbours(&x, h);
     let predict = |a_p: &[V3]| -> (Vec<V3>, Vec<V3>) {
         let vs: Vec<V3> = (0..n)
             .map(|i| axpy(dt, axpy(1.0, a_p[i], accel), v[i]))

@@ -172,11 +172,6 @@ impl Stepper {
         Ok(())
     }
 
-    /// The floor of the CFL's speed, m/s.
-    pub fn fall_speed(&self) -> f32 {
-        self.v_fall
-    }
-
     /// `steps.csv`: one row per step.
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
         let mut out = String::from(

@@ -43,7 +43,12 @@ impl Smoothing {
 
     /// W(d), poly6.
     pub fn w(&self, d: V3) -> f64 {
-        let q = self.h * self.h - dot(d, d);
+        self.w_r2(dot(d, d))
+    }
+
+    /// W at squared distance r2, poly6.
+    pub fn w_r2(&self, r2: f64) -> f64 {
+        let q = self.h * self.h - r2;
         if q > 0.0 {
             self.k.poly6 * q * q * q
         } else {
@@ -60,4 +65,15 @@ impl Smoothing {
         let s = self.k.spiky_grad * (self.h - r) * (self.h - r) / r;
         [s * d[0], s * d[1], s * d[2]]
     }
+}
+
+/// For each point, the others within h of it (brute force).
+pub fn neighbours(p: &[V3], h: f64) -> Vec<Vec<usize>> {
+    (0..p.len())
+        .map(|i| {
+            (0..p.len())
+                .filter(|&j| j != i && dot(sub(p[i], p[j]), sub(p[i], p[j])) < h * h)
+                .collect()
+        })
+        .collect()
 }
