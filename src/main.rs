@@ -417,6 +417,7 @@ fn real_main() -> Result<()> {
                 let ctx = fluidform::gpu::Context::new(&fluidform::gpu::ContextOptions {
                     device,
                     validation: false,
+                    present: None,
                 })?;
                 println!("{}", ctx.info.slug());
                 return Ok(());

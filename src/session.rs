@@ -12,6 +12,7 @@ pub fn open(sw: &Switches) -> Result<Context> {
     Context::new(&ContextOptions {
         device: sw.common.device.clone(),
         validation: sw.common.validation,
+        present: None,
     })
 }
 

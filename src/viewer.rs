@@ -61,6 +61,8 @@ pub trait View {
         overlay: Option<&dyn Overlay>,
     ) -> Result<Option<Picture<'_>>>;
     fn stats(&self) -> RenderSummary;
+    /// Draw from `cam` from the next recorded frame on (the viewer's camera).
+    fn set_camera(&mut self, cam: &Camera);
     fn destroy(&mut self, ctx: &Context);
 }
 
@@ -197,6 +199,13 @@ impl View for PointsViewer {
         RenderSummary {
             renderer: "points".into(),
             ..Default::default()
+        }
+    }
+
+    fn set_camera(&mut self, cam: &Camera) {
+        self.push = PointsPush::from_camera(cam, self.push.right[3]);
+        if let Some(m) = &mut self.mesh {
+            m.set_camera(cam);
         }
     }
 
@@ -419,6 +428,13 @@ impl View for MetaballViewer {
 
     fn stats(&self) -> RenderSummary {
         self.totals.clone()
+    }
+
+    fn set_camera(&mut self, cam: &Camera) {
+        self.cam = *cam;
+        if let Some(m) = &mut self.mesh {
+            m.set_camera(cam);
+        }
     }
 
     fn destroy(&mut self, ctx: &Context) {

@@ -106,6 +106,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     let ctx = Context::new(&ContextOptions {
         device: sw.common.device.clone(),
         validation: sw.common.validation,
+        present: None,
     })?;
     let rows = match opts.what.as_str() {
         "scan" => {

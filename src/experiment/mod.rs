@@ -304,6 +304,7 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
     let ctx = Context::new(&ContextOptions {
         device: sw.common.device.clone(),
         validation: sw.common.validation,
+        present: None,
     })?;
     let out = opts
         .out

@@ -20,6 +20,9 @@ pub struct ContextOptions {
     pub device: Option<String>,
     /// Enable the Khronos validation layer and count its messages.
     pub validation: bool,
+    /// The display a window will show frames on (`fluidform view`): enables the surface
+    /// extensions it needs and VK_KHR_swapchain. None: headless.
+    pub present: Option<raw_window_handle::RawDisplayHandle>,
 }
 
 /// Validation messages seen so far; tests fail on any error.
@@ -139,7 +142,13 @@ impl Context {
     /// instance) on its own path.
     pub fn new(opts: &ContextOptions) -> Result<Self> {
         let entry = load_entry()?;
-        let (instance, has_debug) = create_instance(&entry, opts.validation)?;
+        let surface_exts = match opts.present {
+            Some(d) => ash_window::enumerate_required_extensions(d)
+                .map_err(|e| Error::Unsupported(format!("this display has no Vulkan surface: {e}")))?
+                .to_vec(),
+            None => Vec::new(),
+        };
+        let (instance, has_debug) = create_instance(&entry, opts.validation, &surface_exts)?;
         let messages = Box::<MessageCounts>::default();
         let (debug_instance, messenger) =
             create_messenger(&entry, &instance, has_debug, opts.validation, &messages)?;
@@ -159,7 +168,7 @@ impl Context {
                 return Err(e);
             }
         };
-        let opened = open_device(&instance, physical, &info);
+        let opened = open_device(&instance, physical, &info, opts.present.is_some());
         let (device, queue_family) = match opened {
             Ok(d) => d,
             Err(e) => {
@@ -351,6 +360,7 @@ fn open_device(
     instance: &ash::Instance,
     physical: vk::PhysicalDevice,
     info: &DeviceInfo,
+    present: bool,
 ) -> Result<(ash::Device, u32)> {
     let family = info.queue_family.ok_or_else(|| Error::MissingFeature {
         device: info.name.clone(),
@@ -360,7 +370,20 @@ fn open_device(
     let queues = [vk::DeviceQueueCreateInfo::default()
         .queue_family_index(family)
         .queue_priorities(&priorities)];
-    let exts = [ash::khr::push_descriptor::NAME.as_ptr()];
+    let mut exts = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+    if present {
+        let has = unsafe { instance.enumerate_device_extension_properties(physical) }
+            .unwrap_or_default()
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::swapchain::NAME));
+        if !has {
+            return Err(Error::MissingFeature {
+                device: info.name.clone(),
+                feature: "VK_KHR_swapchain (a window)".into(),
+            });
+        }
+        exts.push(ash::khr::swapchain::NAME.as_ptr());
+    }
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .synchronization2(true)

@@ -211,7 +211,7 @@ fn enumerate(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, Device
 /// Every Vulkan device with its properties (for `fluidform devices`).
 pub fn list_devices() -> Result<Vec<DeviceInfo>> {
     let entry = load_entry()?;
-    let (instance, _) = create_instance(&entry, false)?;
+    let (instance, _) = create_instance(&entry, false, &[])?;
     let r = enumerate(&instance);
     unsafe { instance.destroy_instance(None) };
     Ok(r?.into_iter().map(|(_, i)| i).collect())

@@ -95,44 +95,56 @@ impl FrameLoop {
     /// Record, submit and retire `frames` frames of `work`.
     pub fn run(&mut self, ctx: &Context, frames: u64, work: &mut dyn FrameWork) -> Result<()> {
         for frame in 0..frames {
-            let slot = (frame % self.slots.len() as u64) as usize;
-            self.retire(ctx, slot, work)?;
-            let (cmd, fence, _) = self.slots[slot];
-            unsafe {
-                ctx.device
-                    .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
-                    .ctx("reset frame command")?;
-                let begin = vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-                ctx.device
-                    .begin_command_buffer(cmd, &begin)
-                    .ctx("begin frame")?;
-            }
-            ctx.trackers.lock().unwrap().begin(cmd);
-            // Frame boundary: the previous frames' writes are visible to this one's passes,
-            // so a frame's work needs no barrier before its first reads.
-            ctx.barrier(
-                cmd,
-                sync::COMPUTE_WRITE | sync::TRANSFER_WRITE | sync::FRAGMENT_WRITE,
-                sync::COMPUTE_READ
-                    | sync::TRANSFER_READ
-                    | sync::GRAPHICS_READ
-                    | sync::INDIRECT_READ,
-            );
-            self.profiler.begin_frame(ctx, cmd, slot, frame);
-            let recorded = work.record(ctx, cmd, &mut self.profiler, frame, slot);
-            self.profiler.end_frame(ctx, cmd);
-            unsafe { ctx.device.end_command_buffer(cmd) }.ctx("end frame")?;
-            if let Err(e) = recorded {
-                self.profiler.forget(slot);
-                return Err(e);
-            }
-            ctx.submit(cmd, fence)?;
-            self.slots[slot].2 = Some(frame);
+            self.step(ctx, frame, work)?;
         }
-        for slot in 0..self.slots.len() {
-            let next = (frames as usize + slot) % self.slots.len();
-            self.retire(ctx, next, work)?;
+        self.drain(ctx, work)
+    }
+
+    /// Frame `frame` of `work`: retire the frame that last used its slot, then record and
+    /// submit it. `run` plays frames 0.. with it; the viewer one per window frame.
+    pub fn step(&mut self, ctx: &Context, frame: u64, work: &mut dyn FrameWork) -> Result<()> {
+        let slot = (frame % self.slots.len() as u64) as usize;
+        self.retire(ctx, slot, work)?;
+        let (cmd, fence, _) = self.slots[slot];
+        unsafe {
+            ctx.device
+                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .ctx("reset frame command")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            ctx.device
+                .begin_command_buffer(cmd, &begin)
+                .ctx("begin frame")?;
+        }
+        ctx.trackers.lock().unwrap().begin(cmd);
+        // Frame boundary: the previous frames' writes are visible to this one's passes,
+        // so a frame's work needs no barrier before its first reads.
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE | sync::TRANSFER_WRITE | sync::FRAGMENT_WRITE,
+            sync::COMPUTE_READ | sync::TRANSFER_READ | sync::GRAPHICS_READ | sync::INDIRECT_READ,
+        );
+        self.profiler.begin_frame(ctx, cmd, slot, frame);
+        let recorded = work.record(ctx, cmd, &mut self.profiler, frame, slot);
+        self.profiler.end_frame(ctx, cmd);
+        unsafe { ctx.device.end_command_buffer(cmd) }.ctx("end frame")?;
+        if let Err(e) = recorded {
+            self.profiler.forget(slot);
+            return Err(e);
+        }
+        ctx.submit(cmd, fence)?;
+        self.slots[slot].2 = Some(frame);
+        Ok(())
+    }
+
+    /// Retire every frame still in flight, oldest first.
+    pub fn drain(&mut self, ctx: &Context, work: &mut dyn FrameWork) -> Result<()> {
+        let mut pending: Vec<(u64, usize)> = (self.slots.iter().enumerate())
+            .filter_map(|(i, s)| s.2.map(|f| (f, i)))
+            .collect();
+        pending.sort();
+        for (_, slot) in pending {
+            self.retire(ctx, slot, work)?;
         }
         Ok(())
     }

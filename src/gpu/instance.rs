@@ -15,6 +15,7 @@ pub(crate) fn load_entry() -> Result<ash::Entry> {
 pub(crate) fn create_instance(
     entry: &ash::Entry,
     validation: bool,
+    surface_exts: &[*const std::ffi::c_char],
 ) -> Result<(ash::Instance, bool)> {
     let layers = unsafe { entry.enumerate_instance_layer_properties() }.ctx("list layers")?;
     let has_layer = layers
@@ -55,6 +56,7 @@ pub(crate) fn create_instance(
     } else {
         vec![]
     };
+    ext_ptrs.extend_from_slice(surface_exts);
     if validation {
         // VkValidationFeaturesEXT is read only with this extension, which the layer provides.
         let layer_exts =

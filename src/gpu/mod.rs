@@ -9,6 +9,7 @@ pub mod instance;
 pub mod interface;
 pub mod memory;
 pub mod pipeline;
+pub mod present;
 pub mod profiler;
 pub mod shader;
 pub mod sync;

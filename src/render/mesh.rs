@@ -76,6 +76,13 @@ impl MeshView {
         })
     }
 
+    /// Draw from `cam` from now on (the viewer's camera moves).
+    pub fn set_camera(&mut self, cam: &Camera) {
+        let e = cam.eye;
+        self.push.view_proj = cam.view_proj().to_cols_array_2d();
+        self.push.eye = [e.x, e.y, e.z, 1.0];
+    }
+
     /// Declare the draw of `m` in the next rendering scope (before it begins).
     pub fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, m: &MeshDraw) {
         self.pipeline.prepare(ctx, cmd, &Self::bufs(m));

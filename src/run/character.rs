@@ -18,13 +18,13 @@ fn scene_character(
 }
 
 /// A character alone: skinned each frame at 30 frames per second of scene time.
-struct CharacterWork<'a> {
+struct CharacterWork {
     character: SceneCharacter,
     view: PointsViewer,
-    frames: Frames<'a>,
+    frames: Frames,
 }
 
-impl FrameWork for CharacterWork<'_> {
+impl FrameWork for CharacterWork {
     fn record(
         &mut self,
         ctx: &Context,

@@ -118,34 +118,56 @@ pub struct RunResult {
 /// Frames per second the animation plays at.
 pub const ANIMATION_FPS: u16 = 30;
 
-/// Where saved frames go: frame_NNNN.png each, and animation.png (APNG) of them all.
-pub(crate) struct Frames<'a> {
-    out: &'a Path,
+/// Where saved frames go: frame_NNNN.png each, and animation.png (APNG) of them all; in
+/// a window, every frame's picture is also kept for the swapchain.
+pub(crate) struct Frames {
+    out: PathBuf,
     every: u64,
     /// Frames the run plays.
     total: u64,
     pngs: Vec<PathBuf>,
     animation: Option<Animation>,
+    /// The newest picture (RGBA8, width, height), when every frame is kept.
+    pub(crate) latest: Option<(Vec<u8>, u32, u32)>,
+    keep: bool,
 }
 
-impl<'a> Frames<'a> {
-    pub(crate) fn new(out: &'a Path, every: u64, total: u64) -> Self {
+impl Frames {
+    pub(crate) fn new(out: &Path, every: u64, total: u64) -> Self {
         Self {
-            out,
+            out: out.to_path_buf(),
             every,
             total,
             pngs: Vec::new(),
             animation: None,
+            latest: None,
+            keep: false,
         }
     }
 
-    pub(crate) fn save(&self, f: u64) -> bool {
-        self.every > 0 && f.is_multiple_of(self.every)
+    /// Keep every frame's picture (a window shows it) and write none.
+    pub(crate) fn kept() -> Self {
+        Self {
+            keep: true,
+            ..Self::new(Path::new(""), 0, 1)
+        }
     }
 
-    /// Write frame `f`'s picture as a PNG and as the animation's next frame.
+    /// Whether frame `f`'s picture is read back.
+    pub(crate) fn save(&self, f: u64) -> bool {
+        self.keep || (self.every > 0 && f.is_multiple_of(self.every))
+    }
+
+    /// Write frame `f`'s picture as a PNG and as the animation's next frame (or keep it).
     pub(crate) fn store(&mut self, f: u64, pic: Option<Picture>) -> Result<()> {
         let Some(pic) = pic else { return Ok(()) };
+        if self.keep {
+            let l = self.latest.get_or_insert_with(|| (Vec::new(), 0, 0));
+            l.0.clear();
+            l.0.extend_from_slice(pic.rgba);
+            (l.1, l.2) = (pic.width, pic.height);
+            return Ok(());
+        }
         let path = self.out.join(format!("frame_{f:04}.png"));
         save_rgba(&path, pic.width, pic.height, pic.rgba)?;
         self.pngs.push(path);

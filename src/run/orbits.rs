@@ -3,14 +3,14 @@ use super::*;
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
 
 /// The orbits scene: a gravity step and the point view per frame.
-struct OrbitsWork<'a> {
+struct OrbitsWork {
     pass: OrbitsPass,
     view: PointsViewer,
     scene: Orbits,
-    frames: Frames<'a>,
+    frames: Frames,
 }
 
-impl FrameWork for OrbitsWork<'_> {
+impl FrameWork for OrbitsWork {
     fn record(
         &mut self,
         ctx: &Context,
@@ -44,7 +44,7 @@ impl FrameWork for OrbitsWork<'_> {
     }
 }
 
-impl OrbitsWork<'_> {
+impl OrbitsWork {
     fn destroy(&mut self, ctx: &Context) {
         self.scene.destroy(ctx);
         self.view.destroy(ctx);

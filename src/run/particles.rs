@@ -228,15 +228,15 @@ impl Body {
 }
 crate::impl_destroy!(Body);
 
-struct ParticleWork<'a> {
+struct ParticleWork {
     body: Option<Body>,
     scene: SceneSystems,
     target: ColorTarget,
     background: [f32; 3],
-    frames: Frames<'a>,
+    frames: Frames,
 }
 
-impl FrameWork for ParticleWork<'_> {
+impl FrameWork for ParticleWork {
     fn record(
         &mut self,
         ctx: &Context,

@@ -3,20 +3,85 @@
 use super::*;
 
 /// An SPH scene: steps per frame and the view.
-struct SphWork<'a> {
+struct SphWork {
     solver: crate::sph::SphSolver,
     st: crate::sph::SphState,
     stepper: crate::sph::run::Stepper,
     view: Box<dyn crate::viewer::View>,
-    frames: Frames<'a>,
+    frames: Frames,
     export: Option<crate::export::ParticleExport>,
     targets: crate::scene::targets::SceneTargets,
     /// The scene's particle systems, stepped once per frame after the fluid.
     systems: Option<crate::run::particles::SceneSystems>,
+    /// The viewer's switches of the next frame: simulate it (false: paused, the picture
+    /// redrawn) and draw it (false: re-simulating up to a scrubbed time). `run`: both on.
+    pub(super) simulate: bool,
+    pub(super) draw: bool,
+    /// Per slot: whether its frame in flight simulated and drew.
+    did: Vec<(bool, bool)>,
 }
 
-impl FrameWork for SphWork<'_> {
+impl FrameWork for SphWork {
     fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        prof: &mut Profiler,
+        frame: u64,
+        slot: usize,
+    ) -> Result<()> {
+        self.did[slot] = (self.simulate, self.draw);
+        if self.simulate {
+            self.record_simulation(ctx, cmd, prof, frame, slot)?;
+        }
+        if !self.draw {
+            return Ok(());
+        }
+        let save = self.frames.save(frame);
+        let st = &self.st;
+        let mesh = self.targets.draw();
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let layers = crate::viewer::Layers {
+            mesh: mesh.as_ref(),
+            overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
+        };
+        self.view.record(
+            ctx,
+            cmd,
+            prof,
+            st.pos(),
+            st.attr(),
+            st.n,
+            layers,
+            slot,
+            save,
+        )
+    }
+
+    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
+        let (simulated, drawn) = self.did[slot];
+        if simulated {
+            self.stepper.retire_slot(slot, frame)?;
+            self.targets.retire(slot, frame, &self.st.fluid)?;
+            if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+                e.retire(frame, slot)?;
+            }
+        }
+        if !drawn {
+            return Ok(());
+        }
+        let save = self.frames.save(frame);
+        let overlay = self.systems.as_ref().map(|s| s.at(frame));
+        let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
+        let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
+        self.frames.store(frame, pic)
+    }
+}
+
+impl SphWork {
+    /// The frame's steps with the scene's characters, control, emission, export and
+    /// particle systems.
+    fn record_simulation(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
@@ -43,42 +108,9 @@ impl FrameWork for SphWork<'_> {
         if let Some(s) = &mut self.systems {
             s.record_simulation(ctx, cmd, prof, frame, None)?;
         }
-        let save = self.frames.save(frame);
-        let st = &self.st;
-        let mesh = self.targets.draw();
-        let overlay = self.systems.as_ref().map(|s| s.at(frame));
-        let layers = crate::viewer::Layers {
-            mesh: mesh.as_ref(),
-            overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
-        };
-        self.view.record(
-            ctx,
-            cmd,
-            prof,
-            st.pos(),
-            st.attr(),
-            st.n,
-            layers,
-            slot,
-            save,
-        )
+        Ok(())
     }
 
-    fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
-        self.stepper.retire_slot(slot, frame)?;
-        self.targets.retire(slot, frame, &self.st.fluid)?;
-        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
-            e.retire(frame, slot)?;
-        }
-        let save = self.frames.save(frame);
-        let overlay = self.systems.as_ref().map(|s| s.at(frame));
-        let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
-        let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
-        self.frames.store(frame, pic)
-    }
-}
-
-impl SphWork<'_> {
     fn destroy(&mut self, ctx: &Context) {
         self.stepper.destroy(ctx);
         if let Some(e) = &mut self.export {
@@ -110,14 +142,15 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
     let per_particle = bytes_per_particle(&scene.fluid);
     scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
     let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
-    let mut work = SphWork::new(&ctx, opts, &scene, sw, render, neighbors, frame_count)?;
+    let frames = Frames::new(&opts.out, opts.save_every, frame_count);
+    let mut work = SphWork::new(&ctx, (&opts.out, frames), &scene, sw, render, neighbors)?;
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let how = (sw, render, neighbors);
     work.finish(&ctx, opts, &scene, how, frame_count, timings)
 }
 
 /// Refuse switches that an SPH scene drawn this way would not use.
-fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) -> Result<()> {
+pub(super) fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) -> Result<()> {
     use crate::config::Group;
     let mut uses = vec![
         Group::Sort,
@@ -148,7 +181,7 @@ fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) 
 /// The scene as it will play and the switches with its look applied: fluid overrides,
 /// the character's fit, the metaball radius from the spacing; validated and size-checked
 /// before any particle or buffer is made (the count is estimated, not built).
-fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::Scene, Switches)> {
+pub(super) fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::Scene, Switches)> {
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
@@ -182,8 +215,41 @@ fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::S
     Ok((scene, sw))
 }
 
+/// The view of `scene`'s particles, drawn from `cam`, as `run` makes it.
+pub(super) fn make_view(
+    ctx: &Context,
+    scene: &crate::scene::Scene,
+    sw: &Switches,
+    render: RenderKind,
+    cam: &Camera,
+    n: u32,
+    show: ShowMesh,
+) -> Result<Box<dyn View>> {
+    use crate::viewer::MetaballViewer;
+    Ok(match render {
+        RenderKind::Metaballs => {
+            let tank = (scene.look.tank)
+                .unwrap_or(true)
+                .then_some([scene.domain.min, scene.domain.max]);
+            let overlay = !scene.system.is_empty();
+            Box::new(MetaballViewer::new(
+                ctx, sw, *cam, n, SLOTS, tank, show, overlay,
+            )?)
+        }
+        // Spheres of half the rest spacing.
+        RenderKind::Points => Box::new(PointsViewer::new(
+            ctx,
+            sw,
+            cam,
+            0.5 * scene.fluid.spacing(),
+            SLOTS,
+            show,
+        )?),
+    })
+}
+
 /// The scene's camera, else one looking at the domain from the front and above.
-fn scene_camera(scene: &crate::scene::Scene, sw: &Switches) -> Camera {
+pub(super) fn scene_camera(scene: &crate::scene::Scene, sw: &Switches) -> Camera {
     let aspect = sw.frame.width() as f32 / sw.frame.height() as f32;
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
@@ -204,20 +270,19 @@ fn scene_camera(scene: &crate::scene::Scene, sw: &Switches) -> Camera {
     camera_with_switches(cam, sw)
 }
 
-impl<'a> SphWork<'a> {
-    /// Solver, state, targets, view, stepper, particle systems and export of a scene.
-    fn new(
+impl SphWork {
+    /// Solver, state, targets, view, stepper, particle systems and export of a scene;
+    /// export files go to `out`, pictures to `frames`.
+    pub(super) fn new(
         ctx: &Context,
-        opts: &'a RunOptions,
+        (out, frames): (&Path, Frames),
         scene: &crate::scene::Scene,
         sw: &Switches,
         render: RenderKind,
         neighbors: Neighbors,
-        frame_count: u64,
     ) -> Result<Self> {
         use crate::sph::run::Stepper;
         use crate::sph::SphSolver;
-        use crate::viewer::{MetaballViewer, PointsViewer, View};
         let mut solver = Guard::new(ctx, SphSolver::new(ctx, neighbors, sw.sorting.sort)?);
         let parts = scene.particles(sw.common.seed);
         let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
@@ -226,29 +291,7 @@ impl<'a> SphWork<'a> {
             ctx, scene, sw, &solver, &mut st, &parts.pos, SLOTS,
         )?;
         let targets = Guard::new(ctx, targets);
-        let show = targets.show();
-        let view: Box<dyn View> = match render {
-            RenderKind::Metaballs => {
-                let tank = scene
-                    .look
-                    .tank
-                    .unwrap_or(true)
-                    .then_some([scene.domain.min, scene.domain.max]);
-                let overlay = !scene.system.is_empty();
-                Box::new(MetaballViewer::new(
-                    ctx, sw, cam, st.n, SLOTS, tank, show, overlay,
-                )?)
-            }
-            // Spheres of half the rest spacing.
-            RenderKind::Points => Box::new(PointsViewer::new(
-                ctx,
-                sw,
-                &cam,
-                0.5 * scene.fluid.spacing(),
-                SLOTS,
-                show,
-            )?),
-        };
+        let view = make_view(ctx, scene, sw, render, &cam, st.n, targets.show())?;
         let view = Guard::new(ctx, view);
         let stepper = Guard::new(ctx, Stepper::new(ctx, &st, SLOTS)?);
         let systems = match scene.system.is_empty() {
@@ -268,17 +311,20 @@ impl<'a> SphWork<'a> {
         let export = sw
             .export
             .export
-            .map(|f| crate::export::ParticleExport::new(ctx, f, every, &opts.out, &st, SLOTS))
+            .map(|f| crate::export::ParticleExport::new(ctx, f, every, out, &st, SLOTS))
             .transpose()?;
         Ok(SphWork {
             solver: solver.take(),
             st: st.take(),
             stepper: stepper.take(),
             view: view.take(),
-            frames: Frames::new(&opts.out, opts.save_every, frame_count),
+            frames,
             export,
             targets: targets.take(),
             systems: systems.take(),
+            simulate: true,
+            draw: true,
+            did: vec![(false, false); SLOTS],
         })
     }
 

@@ -424,6 +424,19 @@ impl SceneTargets {
         Ok(())
     }
 
+    /// The timeline's events as (time, what), for the viewer's list.
+    pub fn events(&self) -> Vec<(f32, String)> {
+        let t = self.timeline.events().iter();
+        t.map(|e| (e.time, e.describe())).collect()
+    }
+
+    /// Each control target's newest metrics row (fill, iou, ...), for the viewer.
+    pub fn latest_metrics(&self) -> Vec<crate::control::metrics::ControlRow> {
+        let rows = self.controlled.iter().map(|&i| &self.live[i].control);
+        rows.filter_map(|c| c.as_ref().and_then(|(_, m)| m.rows.last().cloned()))
+            .collect()
+    }
+
     /// `stats.character`: the first character's.
     pub fn character_stats(&self) -> Result<Option<CharacterStats>> {
         self.live.first().map(|l| l.character.stats()).transpose()

@@ -7,6 +7,7 @@ pub fn ctx() -> Context {
     Context::new(&ContextOptions {
         device: std::env::var("FLUIDFORM_TEST_DEVICE").ok(),
         validation: true,
+        present: None,
     })
     .expect("open a Vulkan device with validation (run scripts/setup.sh)")
 }
