@@ -12,6 +12,8 @@ PACKAGES=(
   build-essential pkg-config
   # DejaVu Sans for the benchmark plots
   fonts-dejavu-core
+  # `fluidform view`: X11 libraries winit loads at run time, and Xvfb for its tests
+  libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb xauth
 )
 
 missing=()

@@ -23,5 +23,6 @@ pub mod session;
 pub mod shaders;
 pub mod sph;
 pub mod viewer;
+pub mod window;
 
 pub use error::{Error, Result};

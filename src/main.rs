@@ -5,7 +5,6 @@ use fluidform::config::{
     CameraArgs, CharacterArgs, CommonArgs, FluidArgs, FrameArgs, MetaballArgs, NeighborArgs,
     SortArgs, Switches,
 };
-use fluidform::gpu::list_devices;
 use fluidform::run::{run, RunOptions, DEFAULT_SCENE};
 use std::path::PathBuf;
 
@@ -50,6 +49,10 @@ enum Command {
         #[command(flatten)]
         switches: Switches,
     },
+    /// Open a scene in a window: camera, live switches, GPU timings, timeline (keys
+    /// below; without a display, run headless with `run`)
+    #[command(after_help = fluidform::window::command::keys_help())]
+    View(fluidform::window::ViewArgs),
     /// Benchmark an algorithm. Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
         #[command(subcommand)]
@@ -422,7 +425,7 @@ fn real_main() -> Result<()> {
                 println!("{}", ctx.info.slug());
                 return Ok(());
             }
-            devices(json)
+            Ok(fluidform::gpu::device::print_devices(json)?)
         }
         Command::Run {
             scene,
@@ -437,6 +440,7 @@ fn real_main() -> Result<()> {
             save_every,
             switches,
         }),
+        Command::View(args) => Ok(fluidform::window::view(args.into())?),
         Command::Bench {
             what,
             out,
@@ -552,35 +556,6 @@ fn bench_command(
     })?;
     print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
     eprintln!("{} configurations; wrote {}", rows.len(), out.display());
-    Ok(())
-}
-
-fn devices(json: bool) -> Result<()> {
-    let list = list_devices()?;
-    if json {
-        println!("{}", serde_json::to_string_pretty(&list)?);
-        return Ok(());
-    }
-    if list.is_empty() {
-        bail!("no Vulkan device found (run scripts/setup.sh for Mesa lavapipe)");
-    }
-    for d in &list {
-        println!("[{}] {} ({})", d.index, d.name, d.kind);
-        println!("    driver: {}  api: {}", d.driver, d.api);
-        println!(
-            "    timestampPeriod: {} ns  timestampValidBits: {}",
-            d.timestamp_period_ns, d.timestamp_valid_bits
-        );
-        println!(
-            "    subgroup size: {}  subgroup arithmetic: {}  maxStorageBufferRange: {}",
-            d.subgroup_size, d.subgroup_arithmetic, d.max_storage_buffer_range
-        );
-        if d.missing.is_empty() {
-            println!("    fluidform: all required features present");
-        } else {
-            println!("    fluidform: UNUSABLE, missing {}", d.missing.join(", "));
-        }
-    }
     Ok(())
 }
 

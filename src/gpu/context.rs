@@ -144,7 +144,9 @@ impl Context {
         let entry = load_entry()?;
         let surface_exts = match opts.present {
             Some(d) => ash_window::enumerate_required_extensions(d)
-                .map_err(|e| Error::Unsupported(format!("this display has no Vulkan surface: {e}")))?
+                .map_err(|e| {
+                    Error::Unsupported(format!("this display has no Vulkan surface: {e}"))
+                })?
                 .to_vec(),
             None => Vec::new(),
         };

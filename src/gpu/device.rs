@@ -270,3 +270,37 @@ pub fn pick(
     }
     Ok((pd, info))
 }
+
+/// `fluidform devices`: every device, its limits and whether fluidform can use it.
+pub fn print_devices(json: bool) -> Result<()> {
+    let list = list_devices()?;
+    if json {
+        let text = serde_json::to_string_pretty(&list)
+            .map_err(|e| crate::Error::Param(format!("devices as JSON: {e}")))?;
+        println!("{text}");
+        return Ok(());
+    }
+    if list.is_empty() {
+        return Err(crate::Error::Unsupported(
+            "no Vulkan device found (run scripts/setup.sh for Mesa lavapipe)".into(),
+        ));
+    }
+    for d in &list {
+        println!("[{}] {} ({})", d.index, d.name, d.kind);
+        println!("    driver: {}  api: {}", d.driver, d.api);
+        println!(
+            "    timestampPeriod: {} ns  timestampValidBits: {}",
+            d.timestamp_period_ns, d.timestamp_valid_bits
+        );
+        println!(
+            "    subgroup size: {}  subgroup arithmetic: {}  maxStorageBufferRange: {}",
+            d.subgroup_size, d.subgroup_arithmetic, d.max_storage_buffer_range
+        );
+        if d.missing.is_empty() {
+            println!("    fluidform: all required features present");
+        } else {
+            println!("    fluidform: UNUSABLE, missing {}", d.missing.join(", "));
+        }
+    }
+    Ok(())
+}

@@ -68,10 +68,9 @@ impl Presenter {
         size: (u32, u32),
     ) -> Result<Self> {
         let surface_fn = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
-        let surface = unsafe {
-            ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None)
-        }
-        .ctx("create window surface")?;
+        let surface =
+            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None) }
+                .ctx("create window surface")?;
         let mut me = Self {
             swapchain_fn: ash::khr::swapchain::Device::new(&ctx.instance, &ctx.device),
             surface_fn,
@@ -110,8 +109,11 @@ impl Presenter {
                 ctx.info.name
             )));
         }
-        let modes = unsafe { self.surface_fn.get_physical_device_surface_present_modes(pd, s) }
-            .ctx("present modes")?;
+        let modes = unsafe {
+            self.surface_fn
+                .get_physical_device_surface_present_modes(pd, s)
+        }
+        .ctx("present modes")?;
         if !modes.contains(&self.mode) {
             return Err(Error::Unsupported(format!(
                 "--present {mode:?}: {} offers only {modes:?} for this window",
@@ -125,7 +127,9 @@ impl Presenter {
             .into_iter()
             .find(|f| formats.iter().any(|sf| sf.format == *f))
             .ok_or_else(|| {
-                Error::Unsupported(format!("no 8-bit UNORM RGBA/BGRA surface format in {formats:?}"))
+                Error::Unsupported(format!(
+                    "no 8-bit UNORM RGBA/BGRA surface format in {formats:?}"
+                ))
             })?;
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
@@ -171,7 +175,9 @@ impl Presenter {
         .ctx("surface capabilities")?;
         let extent = match caps.current_extent.width {
             u32::MAX => vk::Extent2D {
-                width: size.0.clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                width: size
+                    .0
+                    .clamp(caps.min_image_extent.width, caps.max_image_extent.width),
                 height: size
                     .1
                     .clamp(caps.min_image_extent.height, caps.max_image_extent.height),
@@ -307,7 +313,12 @@ impl Presenter {
 
     /// The picture in slot `k`'s staging buffer, as the swapchain's byte order; the copy
     /// region (the part of the picture inside the window).
-    fn stage(&mut self, ctx: &Context, k: usize, (rgba, w, h): (&[u8], u32, u32)) -> Result<vk::Extent2D> {
+    fn stage(
+        &mut self,
+        ctx: &Context,
+        k: usize,
+        (rgba, w, h): (&[u8], u32, u32),
+    ) -> Result<vk::Extent2D> {
         let bytes = w as u64 * h as u64 * 4;
         let slot = &mut self.slots[k];
         if slot.staging.as_ref().is_none_or(|b| b.size != bytes) {
@@ -365,14 +376,30 @@ impl Presenter {
                 A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
             );
             // The acquire's wait covers every stage, so the first barrier starts there.
-            layout(d, cmd, image, (S::ALL_COMMANDS, A::NONE), transfer, L::UNDEFINED, L::TRANSFER_DST_OPTIMAL);
+            layout(
+                d,
+                cmd,
+                image,
+                (S::ALL_COMMANDS, A::NONE),
+                transfer,
+                L::UNDEFINED,
+                L::TRANSFER_DST_OPTIMAL,
+            );
             let range = [super::memory::subresource(vk::ImageAspectFlags::COLOR)];
             let clear = vk::ClearColorValue {
                 float32: [0.02, 0.02, 0.04, 1.0],
             };
             d.cmd_clear_color_image(cmd, image, L::TRANSFER_DST_OPTIMAL, &clear, &range);
             if let (Some((region, row)), Some(buf)) = (copy, self.slots[k].staging.as_ref()) {
-                layout(d, cmd, image, transfer, transfer, L::TRANSFER_DST_OPTIMAL, L::TRANSFER_DST_OPTIMAL);
+                layout(
+                    d,
+                    cmd,
+                    image,
+                    transfer,
+                    transfer,
+                    L::TRANSFER_DST_OPTIMAL,
+                    L::TRANSFER_DST_OPTIMAL,
+                );
                 // Rows of the picture's own width; only the part inside the window.
                 let copy = vk::BufferImageCopy::default()
                     .buffer_row_length(row)
@@ -389,7 +416,15 @@ impl Presenter {
                     });
                 d.cmd_copy_buffer_to_image(cmd, buf.raw, image, L::TRANSFER_DST_OPTIMAL, &[copy]);
             }
-            layout(d, cmd, image, transfer, attachment, L::TRANSFER_DST_OPTIMAL, L::COLOR_ATTACHMENT_OPTIMAL);
+            layout(
+                d,
+                cmd,
+                image,
+                transfer,
+                attachment,
+                L::TRANSFER_DST_OPTIMAL,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+            );
             let color = [vk::RenderingAttachmentInfo::default()
                 .image_view(self.views[index])
                 .image_layout(L::COLOR_ATTACHMENT_OPTIMAL)
@@ -405,7 +440,15 @@ impl Presenter {
             d.cmd_begin_rendering(cmd, &info);
             let drawn = overlay(cmd, self.extent);
             d.cmd_end_rendering(cmd);
-            layout(d, cmd, image, attachment, (S::NONE, A::NONE), L::COLOR_ATTACHMENT_OPTIMAL, L::PRESENT_SRC_KHR);
+            layout(
+                d,
+                cmd,
+                image,
+                attachment,
+                (S::NONE, A::NONE),
+                L::COLOR_ATTACHMENT_OPTIMAL,
+                L::PRESENT_SRC_KHR,
+            );
             d.end_command_buffer(cmd).ctx("end present")?;
             drawn
         }
@@ -474,5 +517,8 @@ unsafe fn layout(
         .new_layout(new)
         .image(image)
         .subresource_range(super::memory::subresource(vk::ImageAspectFlags::COLOR))];
-    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&b));
+    d.cmd_pipeline_barrier2(
+        cmd,
+        &vk::DependencyInfo::default().image_memory_barriers(&b),
+    );
 }

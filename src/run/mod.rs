@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod character;
+pub mod live;
 mod orbits;
 pub mod particles;
 mod sph;

@@ -3,12 +3,12 @@
 use super::*;
 
 /// An SPH scene: steps per frame and the view.
-struct SphWork {
+pub(super) struct SphWork {
     solver: crate::sph::SphSolver,
     st: crate::sph::SphState,
     stepper: crate::sph::run::Stepper,
     view: Box<dyn crate::viewer::View>,
-    frames: Frames,
+    pub(super) frames: Frames,
     export: Option<crate::export::ParticleExport>,
     targets: crate::scene::targets::SceneTargets,
     /// The scene's particle systems, stepped once per frame after the fluid.
@@ -111,7 +111,55 @@ impl SphWork {
         Ok(())
     }
 
-    fn destroy(&mut self, ctx: &Context) {
+    pub(super) fn stepper(&self) -> &crate::sph::run::Stepper {
+        &self.stepper
+    }
+
+    pub(super) fn stepper_mut(&mut self) -> &mut crate::sph::run::Stepper {
+        &mut self.stepper
+    }
+
+    pub(super) fn set_camera(&mut self, cam: &Camera) {
+        self.view.set_camera(cam);
+        if let Some(s) = &mut self.systems {
+            s.cam = *cam;
+        }
+    }
+
+    pub(super) fn particles(&self) -> u32 {
+        self.st.n
+    }
+
+    pub(super) fn show(&self) -> ShowMesh {
+        self.targets.show()
+    }
+
+    /// Use `view` from the next frame on (no frame may be in flight).
+    pub(super) fn replace_view(&mut self, ctx: &Context, view: Box<dyn crate::viewer::View>) {
+        self.view.destroy(ctx);
+        self.view = view;
+        self.frames.latest = None;
+    }
+
+    /// (particles, simulated seconds, steps taken).
+    pub(super) fn progress(&self) -> (u32, f64, u64) {
+        let s = &self.stepper;
+        (self.st.n, s.sim_time, s.steps_taken)
+    }
+
+    pub(super) fn render_stats(&self) -> crate::viewer::RenderSummary {
+        self.view.stats()
+    }
+
+    pub(super) fn control_rows(&self) -> Vec<crate::control::metrics::ControlRow> {
+        self.targets.latest_metrics()
+    }
+
+    pub(super) fn events(&self) -> Vec<(f32, String)> {
+        self.targets.events()
+    }
+
+    pub(super) fn destroy(&mut self, ctx: &Context) {
         self.stepper.destroy(ctx);
         if let Some(e) = &mut self.export {
             e.destroy(ctx);
@@ -150,7 +198,11 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
 }
 
 /// Refuse switches that an SPH scene drawn this way would not use.
-pub(super) fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) -> Result<()> {
+pub(super) fn check_groups(
+    sw: &Switches,
+    render: RenderKind,
+    scene: &crate::scene::Scene,
+) -> Result<()> {
     use crate::config::Group;
     let mut uses = vec![
         Group::Sort,
@@ -181,7 +233,10 @@ pub(super) fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::sce
 /// The scene as it will play and the switches with its look applied: fluid overrides,
 /// the character's fit, the metaball radius from the spacing; validated and size-checked
 /// before any particle or buffer is made (the count is estimated, not built).
-pub(super) fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::Scene, Switches)> {
+pub(super) fn prepare(
+    scene: crate::scene::Scene,
+    sw: &Switches,
+) -> Result<(crate::scene::Scene, Switches)> {
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.

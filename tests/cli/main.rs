@@ -5,6 +5,7 @@ use common::{fluidform, summary, text};
 
 mod limits;
 mod scenes;
+mod view;
 
 #[test]
 fn devices_lists_lavapipe_with_features() {
