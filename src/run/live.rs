@@ -20,6 +20,8 @@ pub struct LiveScene {
     pub frames: FrameLoop,
     /// The next frame's number.
     pub frame: u64,
+    /// Why the simulation went unstable, found while settling (the window pauses).
+    pub unstable: Option<String>,
 }
 
 /// What the overlay shows of the scene.
@@ -79,6 +81,7 @@ impl LiveScene {
             cam: home,
             frames,
             frame: 0,
+            unstable: None,
         })
     }
 
@@ -97,9 +100,17 @@ impl LiveScene {
         Ok(())
     }
 
-    /// Wait for every frame in flight, so the newest picture is the newest frame's.
+    /// Wait for every frame in flight, so the newest picture is the newest frame's. A
+    /// frame found unstable is kept in `unstable` (the others still retire).
     pub fn settle(&mut self, ctx: &Context) -> Result<()> {
-        self.frames.drain(ctx, &mut self.work)
+        loop {
+            match self.frames.drain(ctx, &mut self.work) {
+                Err(Error::Unstable(m)) => {
+                    self.unstable.get_or_insert(m);
+                }
+                r => return r,
+            }
+        }
     }
 
     /// The newest picture (RGBA8, width, height).
@@ -138,6 +149,17 @@ impl LiveScene {
         self.sw = sw;
         self.cam = cam;
         Ok(self.home)
+    }
+
+    /// Control switches that change only per-frame values, applied from the next frame
+    /// (the simulation goes on); false when they need a rebuilt scene.
+    pub fn set_control(&mut self, sw: &Switches) -> Result<bool> {
+        let sw = self.scene.look.apply(sw);
+        let ok = self.work.set_control(&sw, &self.scene.fluid)?;
+        if ok {
+            self.sw.control = sw.control;
+        }
+        Ok(ok)
     }
 
     pub fn stats(&self, ctx: &Context) -> LiveStats {

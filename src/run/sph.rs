@@ -60,21 +60,21 @@ impl FrameWork for SphWork {
 
     fn retire(&mut self, ctx: &Context, frame: u64, slot: usize) -> Result<()> {
         let (simulated, drawn) = self.did[slot];
-        if simulated {
-            self.stepper.retire_slot(slot, frame)?;
-            self.targets.retire(slot, frame, &self.st.fluid)?;
-            if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
-                e.retire(frame, slot)?;
-            }
-        }
+        // An unstable frame's picture is still kept (the window shows it), then the
+        // error goes on.
+        let checked = match simulated {
+            true => self.retire_simulation(frame, slot),
+            false => Ok(()),
+        };
         if !drawn {
-            return Ok(());
+            return checked;
         }
         let save = self.frames.save(frame);
         let overlay = self.systems.as_ref().map(|s| s.at(frame));
         let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
         let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
-        self.frames.store(frame, pic)
+        self.frames.store(frame, pic)?;
+        checked
     }
 }
 
@@ -107,6 +107,15 @@ impl SphWork {
         }
         if let Some(s) = &mut self.systems {
             s.record_simulation(ctx, cmd, prof, frame, None)?;
+        }
+        Ok(())
+    }
+
+    fn retire_simulation(&mut self, frame: u64, slot: usize) -> Result<()> {
+        self.stepper.retire_slot(slot, frame)?;
+        self.targets.retire(slot, frame, &self.st.fluid)?;
+        if let Some(e) = self.export.as_mut().filter(|e| e.due(frame)) {
+            e.retire(frame, slot)?;
         }
         Ok(())
     }
@@ -153,6 +162,14 @@ impl SphWork {
 
     pub(super) fn control_rows(&self) -> Vec<crate::control::metrics::ControlRow> {
         self.targets.latest_metrics()
+    }
+
+    pub(super) fn set_control(
+        &mut self,
+        sw: &Switches,
+        fluid: &crate::sph::FluidParams,
+    ) -> Result<bool> {
+        self.targets.set_control(sw, fluid)
     }
 
     pub(super) fn events(&self) -> Vec<(f32, String)> {

@@ -125,7 +125,8 @@ fn numbers(ui: &mut egui::Ui, v: &PanelView) {
 }
 
 fn timings(ui: &mut egui::Ui, v: &PanelView) {
-    ui.collapsing("GPU timings (ms, mean of the last 30 frames)", |ui| {
+    let head = egui::CollapsingHeader::new("GPU timings (ms, mean of the last 30 frames)");
+    head.default_open(true).show(ui, |ui| {
         let last: Vec<&FrameTiming> = v.timings.iter().rev().take(30).collect();
         let mut sums: BTreeMap<String, f64> = BTreeMap::new();
         for t in &last {
@@ -156,7 +157,7 @@ fn timings(ui: &mut egui::Ui, v: &PanelView) {
         };
         let peak = recent.iter().map(|t| t.frame_ms).fold(1e-6, f64::max);
         let (rect, _) =
-            ui.allocate_exact_size(egui::vec2(ui.available_width(), 90.0), egui::Sense::hover());
+            ui.allocate_exact_size(egui::vec2(300.0, 90.0), egui::Sense::hover());
         let p = ui.painter_at(rect);
         p.rect_filled(rect, 2.0, egui::Color32::from_gray(20));
         let w = rect.width() / 120.0;
@@ -270,10 +271,10 @@ fn switches(ui: &mut egui::Ui, st: &mut PanelState, v: &PanelView, out: &mut Vec
         if matches!(g, "CommonArgs" | "FrameArgs" | "ExportArgs") {
             continue;
         }
-        let how = if flags::view_only(g) {
-            "live"
-        } else {
-            "rebuilds the scene"
+        let how = match g {
+            g if flags::view_only(g) => "live",
+            "ControlArgs" => "c_cp, thresholds, factors, velocity, attraction, damping live",
+            _ => "rebuilds the scene",
         };
         let title = format!("{} ({how})", g.trim_end_matches("Args"));
         ui.collapsing(title, |ui| {

@@ -58,7 +58,20 @@ impl Session {
         let aspect = self.size.0 as f32 / self.size.1 as f32;
         self.live.set_camera(self.orbit.camera(aspect));
         let paused = self.paused && !std::mem::take(&mut self.step_once);
-        self.live.step(ctx, paused, false)
+        let stepped = match self.live.unstable.take() {
+            Some(m) => Err(Error::Unstable(m)),
+            None => self.live.step(ctx, paused, false),
+        };
+        match stepped {
+            // Shown, not fatal: the picture stays, paused, for a reset or other switches.
+            Err(Error::Unstable(m)) => {
+                self.paused = true;
+                self.message = format!("unstable, paused (R resets): {m}");
+                eprintln!("view: {}", self.message);
+                Ok(())
+            }
+            r => r,
+        }
     }
 
     /// Carry out `cmd`; a command that cannot be done leaves the scene as it was and says
@@ -138,7 +151,12 @@ impl Session {
             }
         };
         match said {
-            Ok(m) => self.message = m,
+            Ok(m) => {
+                if !m.is_empty() && !self.live.sw.common.quiet {
+                    eprintln!("view: frame {}: {m}", self.live.frame);
+                }
+                self.message = m;
+            }
             Err(e @ (Error::Vulkan { .. } | Error::Memory(_))) => return Err(e),
             Err(e) => {
                 self.message = format!("error: {e}");
@@ -175,6 +193,12 @@ impl Session {
             self.args = args;
             return Ok(format!(
                 "--{name} {shown}: view rebuilt, simulation goes on"
+            ));
+        }
+        if group == "ControlArgs" && self.live.set_control(&sw)? {
+            self.args = args;
+            return Ok(format!(
+                "--{name} {shown}: control changed, simulation goes on"
             ));
         }
         self.rebuild(ctx, args)?;
@@ -229,7 +253,10 @@ impl Session {
         self.live.settle(ctx)?;
         let saved = match self.live.picture() {
             Some((rgba, w, h)) => crate::gpu::target::save_rgba(&path, w, h, rgba).map(|_| (w, h)),
-            None => Err(Error::Param("no picture yet".into())),
+            None => Err(Error::Param(match &self.live.unstable {
+                Some(m) => format!("no picture: the simulation went unstable: {m}"),
+                None => "no picture yet".into(),
+            })),
         };
         if size.is_some() {
             self.live.rebuild_view(ctx, &sized(&sw, self.size))?;

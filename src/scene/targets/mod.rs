@@ -23,6 +23,8 @@ use ash::vk;
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
+mod viewer;
+
 /// `stats.control` of summary.json: each control target's metrics and the fired events.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ControlSummary {
@@ -37,6 +39,8 @@ struct Live {
     name: String,
     character: SceneCharacter,
     control: Option<(ControlTarget, ControlMetrics)>,
+    /// The scene's own control description, before the switches (the viewer's flips).
+    desc: Option<ControlDesc>,
     /// Per slot: the placed joint matrices of the frame and of a moment before it (the
     /// skin's speed), and the scene time, when attached.
     poses: Vec<Option<FramePose>>,
@@ -113,6 +117,7 @@ impl SceneTargets {
                 None => ShowMesh::Shaded,
             });
             let character = Guard::new(ctx, SceneCharacter::new(ctx, cdesc, method, show)?);
+            let scene_desc = control.cloned();
             let control = match control {
                 Some(d) => {
                     let t = ControlTarget::new(
@@ -133,6 +138,7 @@ impl SceneTargets {
                 None => None,
             };
             out.live.push(Live {
+                desc: scene_desc,
                 name,
                 character: character.take(),
                 control,
@@ -422,19 +428,6 @@ impl SceneTargets {
             )?;
         }
         Ok(())
-    }
-
-    /// The timeline's events as (time, what), for the viewer's list.
-    pub fn events(&self) -> Vec<(f32, String)> {
-        let t = self.timeline.events().iter();
-        t.map(|e| (e.time, e.describe())).collect()
-    }
-
-    /// Each control target's newest metrics row (fill, iou, ...), for the viewer.
-    pub fn latest_metrics(&self) -> Vec<crate::control::metrics::ControlRow> {
-        let rows = self.controlled.iter().map(|&i| &self.live[i].control);
-        rows.filter_map(|c| c.as_ref().and_then(|(_, m)| m.rows.last().cloned()))
-            .collect()
     }
 
     /// `stats.character`: the first character's.
