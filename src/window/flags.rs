@@ -181,18 +181,43 @@ mod tests {
         assert_eq!(group_of("control-pressure"), "ControlArgs");
         assert_eq!(group_of("eye"), "CameraArgs");
         assert_eq!(group_of("nonsense"), "");
-        let args: Vec<String> = ["--list", "abuffer", "--fluid", "viscosity=2", "--fluid", "eos=tait"]
-            .map(String::from)
-            .into();
-        let args = [args, ["--eye", "1,2,3", "--validation", "--uv-size", "64x32"].map(String::from).into()].concat();
+        let args: Vec<String> = [
+            "--list",
+            "abuffer",
+            "--fluid",
+            "viscosity=2",
+            "--fluid",
+            "eos=tait",
+        ]
+        .map(String::from)
+        .into();
+        let args = [
+            args,
+            ["--eye", "1,2,3", "--validation", "--uv-size", "64x32"]
+                .map(String::from)
+                .into(),
+        ]
+        .concat();
         let sw = parse(&args).unwrap();
         let back = parse(&args_of(&sw)).unwrap();
-        assert_eq!(serde_json::to_value(&sw).unwrap(), serde_json::to_value(&back).unwrap());
+        assert_eq!(
+            serde_json::to_value(&sw).unwrap(),
+            serde_json::to_value(&back).unwrap()
+        );
         let flipped = with(&args_of(&sw), "list", Some("sbuffer"));
-        assert_eq!(value_in(&parse(&flipped).unwrap(), "list").as_deref(), Some("sbuffer"));
+        assert_eq!(
+            value_in(&parse(&flipped).unwrap(), "list").as_deref(),
+            Some("sbuffer")
+        );
         let unset = with(&flipped, "validation", None);
-        assert_eq!(value_in(&parse(&unset).unwrap(), "validation").as_deref(), Some("false"));
+        assert_eq!(
+            value_in(&parse(&unset).unwrap(), "validation").as_deref(),
+            Some("false")
+        );
         assert!(parse(&with(&args, "list", Some("cbuffer"))).is_err());
-        assert_eq!(value_in(&sw, "fluid").as_deref(), Some("viscosity=2,eos=tait"));
+        assert_eq!(
+            value_in(&sw, "fluid").as_deref(),
+            Some("viscosity=2,eos=tait")
+        );
     }
 }

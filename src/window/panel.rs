@@ -156,8 +156,7 @@ fn timings(ui: &mut egui::Ui, v: &PanelView) {
             s
         };
         let peak = recent.iter().map(|t| t.frame_ms).fold(1e-6, f64::max);
-        let (rect, _) =
-            ui.allocate_exact_size(egui::vec2(300.0, 90.0), egui::Sense::hover());
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(300.0, 90.0), egui::Sense::hover());
         let p = ui.painter_at(rect);
         p.rect_filled(rect, 2.0, egui::Color32::from_gray(20));
         let w = rect.width() / 120.0;

@@ -132,11 +132,15 @@ impl Session {
                 Ok(format!("fly mode {}", if on { "on" } else { "off" }))
             }
             Command::Resize(w, h) => {
-                let _ = window.map(|w2| w2.request_inner_size(winit::dpi::PhysicalSize::new(w, h)));
+                if let Some(win) = window {
+                    let _ = win.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+                }
                 Ok(format!("asked the window for {w}x{h}"))
             }
             Command::Minimize(on) => {
-                window.map(|w| w.set_minimized(on));
+                if let Some(w) = window {
+                    w.set_minimized(on);
+                }
                 Ok(if on { "minimised" } else { "restored" }.into())
             }
             Command::Copy => {
