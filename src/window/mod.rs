@@ -291,11 +291,6 @@ fn play(
         let out = input
             .egui_ctx
             .run(raw, |c| panel::ui(c, &mut panel_state, &view, &mut asked));
-        if asked.contains(&Command::Copy) {
-            input
-                .egui_ctx
-                .copy_text(flags::command_line(&s.scene, &s.args));
-        }
         egui_state.handle_platform_output(window, out.platform_output.clone());
         input.commands.extend(asked);
         overlay.prepare(ctx, presenter.command_pool(), &input.egui_ctx, out)?;

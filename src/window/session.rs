@@ -25,6 +25,7 @@ pub struct Session {
     /// The picture's size: the window's inner size.
     pub size: (u32, u32),
     pub quit: bool,
+    clipboard: Option<arboard::Clipboard>,
 }
 
 /// `sw` drawing frames of `size`.
@@ -50,6 +51,7 @@ impl Session {
             recording: None,
             size,
             quit: false,
+            clipboard: None,
         })
     }
 
@@ -146,7 +148,15 @@ impl Session {
             Command::Copy => {
                 let line = flags::command_line(&self.scene, &self.args);
                 println!("{line}");
-                Ok(format!("copied: {line}"))
+                // X11 serves the selection while the clipboard lives: it stays open.
+                if self.clipboard.is_none() {
+                    self.clipboard = arboard::Clipboard::new().ok();
+                }
+                let copied = self.clipboard.as_mut().map(|c| c.set_text(line.clone()));
+                Ok(match copied {
+                    Some(Ok(())) => format!("copied: {line}"),
+                    _ => format!("printed (no clipboard): {line}"),
+                })
             }
             Command::TogglePanel => Ok(String::new()),
             Command::Quit => {

@@ -231,6 +231,19 @@ vec3 sky_color(vec3 d) {
     return c + vec3(1.0, 0.9, 0.7) * (pow(s, 400.0) * 8.0 + pow(s, 8.0) * 0.2);
 }
 
+// The exact unpolarised reflectance of a dielectric interface, from index n1 into n2 at
+// incidence cosine cos_i (Hecht, Optics, 4.6): 1 past the critical angle. (Schlick's
+// approximation taken with cos_i inside the denser medium misses the rise towards total
+// internal reflection.)
+float fresnel_dielectric(float cos_i, float n1, float n2) {
+    float sin_t = n1 / n2 * sqrt(max(1.0 - cos_i * cos_i, 0.0));
+    if (sin_t >= 1.0) return 1.0;
+    float cos_t = sqrt(1.0 - sin_t * sin_t);
+    float rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
+    float rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
 vec3 phong(vec3 n, vec3 v) {
     vec3 l = P.sun.xyz;
     float diff = max(dot(n, l), 0.0);
@@ -326,18 +339,18 @@ void main() {
         vec3 nn = r.inside ? -n : n;  // facing the incoming ray
         float cos_i = clamp(-dot(r.d, nn), 0.0, 1.0);
         vec3 rd = reflect(r.d, nn);
-        float eps = 0.05 * radius();
+        // Just past the refined hit's error (step / 2^I): the new path starts on its side
+        // of the surface. A fixed share of R was up to a quarter of a small sphere's radius.
+        float eps = 1.5 * P.sun.w / float(1u << min(P.refine, 20u));
 #if MATERIAL == MATERIAL_METAL
         vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
         Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
         if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd);
         else stack[sp++] = refl;
 #else
-        float eta = r.inside ? P.absorb.w : 1.0 / P.absorb.w;
-        vec3 td = refract(r.d, nn, eta);
-        float f0 = (P.absorb.w - 1.0) / (P.absorb.w + 1.0);
-        f0 *= f0;
-        float F = dot(td, td) == 0.0 ? 1.0 : f0 + (1.0 - f0) * pow(1.0 - cos_i, 5.0);
+        float n1 = r.inside ? P.absorb.w : 1.0, n2 = r.inside ? 1.0 : P.absorb.w;
+        vec3 td = refract(r.d, nn, n1 / n2);
+        float F = dot(td, td) == 0.0 ? 1.0 : fresnel_dielectric(cos_i, n1, n2);
         Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
         Path refr = Path(x - nn * eps, normalize(td), w * (1.0 - F), r.depth + 1u, !r.inside);
         bool deep = r.depth + 1u > P.depth;

@@ -52,7 +52,7 @@ pub const MAX_DEPTH: u32 = 6;
 pub const MAX_REFINE: u32 = 32;
 
 /// Complex index of refraction (n, k) per RGB channel (about 650, 550, 450 nm).
-fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
+pub fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
     match m {
         Material::Gold => Some(([0.143, 0.374, 1.442], [3.983, 2.385, 1.603])),
         Material::Copper => Some(([0.200, 0.924, 1.102], [3.912, 2.452, 2.142])),
