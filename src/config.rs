@@ -151,6 +151,7 @@ pub struct CameraArgs {
 }
 
 switch_enum!(ExportFormat { Ply, Vtk });
+switch_enum!(MeshFormat { Obj, Ply });
 
 /// Particle files for ParaView, Blender and splashsurf (SPH runs).
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
@@ -158,6 +159,10 @@ pub struct ExportArgs {
     /// Write the particles as binary PLY or legacy VTK files, with particles.csv
     #[arg(long, value_enum)]
     pub export: Option<ExportFormat>,
+    /// Write the fluid's surface per exported frame as a mesh: marching cubes over the SPH
+    /// density (half the particle spacing, iso 0.5 rho_0), OBJ or binary PLY with normals
+    #[arg(long, value_enum)]
+    pub export_mesh: Option<MeshFormat>,
     /// Export every K-th frame (default 1)
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub export_every: Option<u64>,

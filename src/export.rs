@@ -48,7 +48,11 @@ impl Snapshot<'_> {
 }
 
 pub struct ParticleExport {
-    format: ExportFormat,
+    /// Particle files, and surface meshes, per exported frame.
+    format: Option<ExportFormat>,
+    mesh: Option<crate::config::MeshFormat>,
+    /// Smoothing length, rest density and spacing of the surface's density grid.
+    fluid: (f32, f32, f32),
     every: u64,
     out: PathBuf,
     mass: f32,
@@ -70,7 +74,7 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
 impl ParticleExport {
     pub fn new(
         ctx: &Context,
-        format: ExportFormat,
+        (format, mesh): (Option<ExportFormat>, Option<crate::config::MeshFormat>),
         every: u64,
         out: &Path,
         st: &SphState,
@@ -105,8 +109,11 @@ impl ParticleExport {
             "frame,time,count,com_x,com_y,com_z,min_x,min_y,min_z,max_x,max_y,max_z,front_x,kinetic_energy"
         )
         .map_err(io(&path))?;
+        let f = &st.fluid;
         Ok(Self {
             format,
+            mesh,
+            fluid: (f.h, f.rest_density, f.spacing()),
             every: every.max(1),
             out: out.to_path_buf(),
             mass: st.fluid.mass,
@@ -169,13 +176,21 @@ impl ParticleExport {
             rho_p: &rho_p,
             attr: &attr,
         };
-        let (name, bytes) = match self.format {
-            ExportFormat::Ply => (format!("particles_{frame:04}.ply"), ply(&snap)),
-            ExportFormat::Vtk => (format!("particles_{frame:04}.vtk"), vtk(&snap, frame)),
+        let file = match self.format {
+            Some(ExportFormat::Ply) => Some((format!("particles_{frame:04}.ply"), ply(&snap))),
+            Some(ExportFormat::Vtk) => {
+                Some((format!("particles_{frame:04}.vtk"), vtk(&snap, frame)))
+            }
+            None => None,
         };
-        let path = self.out.join(name);
-        std::fs::write(&path, bytes).map_err(io(&path))?;
-        self.files.push(path);
+        if let Some((name, bytes)) = file {
+            let path = self.out.join(name);
+            std::fs::write(&path, bytes).map_err(io(&path))?;
+            self.files.push(path);
+        }
+        if let Some(m) = self.mesh {
+            self.files.push(self.surface(&snap, frame, m)?);
+        }
         let row = aggregates(&snap, self.mass);
         let csv_path = self.out.join("particles.csv");
         writeln!(
@@ -196,6 +211,30 @@ impl ParticleExport {
         )
         .map_err(io(&csv_path))?;
         self.csv.flush().map_err(io(&csv_path))
+    }
+
+    /// The frame's surface (marching cubes over the SPH density at half the spacing, iso
+    /// half the rest density) as surface_NNNN.obj or .ply.
+    fn surface(
+        &self,
+        snap: &Snapshot,
+        frame: u64,
+        f: crate::config::MeshFormat,
+    ) -> Result<PathBuf> {
+        use crate::config::MeshFormat;
+        use crate::surface::{density_grid, files, march};
+        let (h, rest, spacing) = self.fluid;
+        let pos: Vec<[f32; 3]> = snap.pos.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let mesh = march(&density_grid(&pos, h, self.mass, rest, 0.5 * spacing), 0.5);
+        let path = self.out.join(match f {
+            MeshFormat::Obj => format!("surface_{frame:04}.obj"),
+            MeshFormat::Ply => format!("surface_{frame:04}.ply"),
+        });
+        match f {
+            MeshFormat::Obj => files::write_obj(&path, &mesh)?,
+            MeshFormat::Ply => files::write_ply(&path, &mesh)?,
+        }
+        Ok(path)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

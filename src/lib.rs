@@ -22,6 +22,7 @@ pub mod scene;
 pub mod session;
 pub mod shaders;
 pub mod sph;
+pub mod surface;
 pub mod viewer;
 pub mod window;
 

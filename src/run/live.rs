@@ -42,7 +42,7 @@ impl LiveScene {
                 "view plays SPH scenes; '{name}' is a particle-system scene: use `fluidform run --scene {name}`"
             )));
         }
-        if sw.export.export.is_some() {
+        if sw.export.export.is_some() || sw.export.export_mesh.is_some() {
             return Err(Error::Param(
                 "view does not export particle files: use `fluidform run --export`".into(),
             ));

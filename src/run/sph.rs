@@ -380,11 +380,13 @@ impl SphWork {
         };
         let systems = Guard::new(ctx, systems);
         let every = sw.export.export_every.unwrap_or(1);
-        let export = sw
-            .export
-            .export
-            .map(|f| crate::export::ParticleExport::new(ctx, f, every, out, &st, SLOTS))
-            .transpose()?;
+        let formats = (sw.export.export, sw.export.export_mesh);
+        let export = match formats {
+            (None, None) => None,
+            f => Some(crate::export::ParticleExport::new(
+                ctx, f, every, out, &st, SLOTS,
+            )?),
+        };
         Ok(SphWork {
             solver: solver.take(),
             st: st.take(),

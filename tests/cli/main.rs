@@ -5,6 +5,7 @@ use common::{fluidform, summary, text};
 
 mod limits;
 mod scenes;
+mod surface;
 mod view;
 
 #[test]

@@ -1,0 +1,9 @@
+//! Polygon surfaces of the fluid: marching cubes over a density grid (`cubes`, with its
+//! case table built from the cube's faces in `table`), and the mesh files other tools read
+//! (`files`: OBJ, binary PLY). The CPU version here is the reference a GPU pass is checked
+//! against.
+pub mod cubes;
+pub mod files;
+pub mod table;
+
+pub use cubes::{density_grid, march, Grid, Mesh};
