@@ -52,7 +52,7 @@ enum Command {
     /// Open a scene in a window: camera, live switches, GPU timings, timeline (keys
     /// below; without a display, run headless with `run`)
     #[command(after_help = fluidform::window::command::keys_help())]
-    View(fluidform::window::ViewArgs),
+    View(fluidform::window::WindowArgs),
     /// Benchmark an algorithm. Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
         #[command(subcommand)]

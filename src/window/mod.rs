@@ -22,7 +22,7 @@ use winit::platform::pump_events::{EventLoopExtPumpEvents, PumpStatus};
 
 /// `fluidform view`'s command line.
 #[derive(clap::Args)]
-pub struct ViewArgs {
+pub struct WindowArgs {
     /// A built-in scene (SPH scenes) or a TOML scene file
     #[arg(long, default_value = crate::run::DEFAULT_SCENE)]
     pub scene: String,
@@ -53,8 +53,8 @@ pub enum PresentArg {
     Immediate,
 }
 
-impl From<ViewArgs> for ViewOptions {
-    fn from(a: ViewArgs) -> Self {
+impl From<WindowArgs> for ViewOptions {
+    fn from(a: WindowArgs) -> Self {
         Self {
             scene: a.scene,
             present: match a.present {

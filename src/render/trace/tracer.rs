@@ -3,7 +3,7 @@
 //! that would go deeper reads the environment instead). Output: RGBA8, gamma 2.2.
 use super::env::{sun, Env};
 use super::optics::{conductor_f0, fresnel_dielectric, reflect, refract, schlick};
-use crate::config::DensityFn;
+use crate::kinds::DensityFn;
 use crate::render::Camera;
 use glam::DVec3;
 
