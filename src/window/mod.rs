@@ -185,15 +185,19 @@ impl Walls {
     fn describe(mut self) -> String {
         let median = |v: &mut Vec<f64>| {
             v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+            v.get(v.len() / 2).copied()
         };
-        format!(
-            "view: {} frames; median {:.2} ms a window frame, GPU frame median {:.2} ms \
-             (frames 4 on)",
-            self.played,
-            median(&mut self.wall_ms),
-            median(&mut self.gpu_ms)
-        )
+        match (median(&mut self.wall_ms), median(&mut self.gpu_ms)) {
+            (Some(w), Some(g)) => format!(
+                "view: {} frames; median {w:.2} ms a window frame, GPU frame median {g:.2} ms \
+                 (frames 4 on)",
+                self.played
+            ),
+            _ => format!(
+                "view: {} frames (too few after the first 3 for medians)",
+                self.played
+            ),
+        }
     }
 }
 
