@@ -2,7 +2,7 @@
 //! made from the same scene file and switches by the same functions, its every picture
 //! kept for the swapchain instead of written. The window pauses, steps, moves the
 //! camera and swaps the view; anything else it changes rebuilds the scene.
-use super::sph::{check_groups, make_view, prepare, scene_camera, SphWork};
+use super::sph::{fits, make_view, plan, scene_camera, SphWork};
 use super::*;
 use crate::gpu::FrameLoop;
 
@@ -53,14 +53,8 @@ impl LiveScene {
                 "view plays SPH scenes; '{name}' has no fluid: use `fluidform run --scene {name}`"
             )));
         }
-        let render = sw.view.render.or(scene.look.render);
-        let render = render.unwrap_or(RenderKind::Metaballs);
-        check_groups(sw, render, &scene)?;
-        let (scene, sw) = prepare(scene, sw)?;
-        let per_particle = crate::sph::solver::bytes_per_particle(&scene.fluid);
-        let max = crate::sph::solver::MAX_PARTICLES;
-        scene.check_size(max, per_particle, ctx.info.device_local_bytes)?;
-        let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+        let (scene, sw, render, neighbors) = plan(scene, sw)?;
+        fits(ctx, &scene)?;
         let out = Path::new("");
         let mut work = SphWork::new(ctx, (out, Frames::kept()), &scene, &sw, render, neighbors)?;
         let frames = match FrameLoop::new(ctx, SLOTS) {
@@ -111,6 +105,11 @@ impl LiveScene {
                 r => return r,
             }
         }
+    }
+
+    /// Simulated seconds so far.
+    pub fn sim_time(&self) -> f64 {
+        self.work.stepper().sim_time
     }
 
     /// The newest picture (RGBA8, width, height).

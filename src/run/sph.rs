@@ -192,21 +192,11 @@ impl SphWork {
 }
 
 pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<RunResult> {
-    use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
-    let render = opts
-        .switches
-        .view
-        .render
-        .or(scene.look.render)
-        .unwrap_or(RenderKind::Metaballs);
-    check_groups(&opts.switches, render, &scene)?;
-    let (scene, sw) = prepare(scene, &opts.switches)?;
+    let (scene, sw, render, neighbors) = plan(scene, &opts.switches)?;
     let sw = &sw;
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
-    let per_particle = bytes_per_particle(&scene.fluid);
-    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)?;
-    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+    fits(&ctx, &scene)?;
     let frames = Frames::new(&opts.out, opts.save_every, frame_count);
     let mut work = SphWork::new(&ctx, (&opts.out, frames), &scene, sw, render, neighbors)?;
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
@@ -214,12 +204,28 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
     work.finish(&ctx, opts, &scene, how, frame_count, timings)
 }
 
-/// Refuse switches that an SPH scene drawn this way would not use.
-pub(super) fn check_groups(
+/// What `run` and the viewer settle before an SPH scene's work: how it is drawn, the
+/// switches it would not use refused, the scene prepared, the neighbour search.
+pub(super) fn plan(
+    scene: crate::scene::Scene,
     sw: &Switches,
-    render: RenderKind,
-    scene: &crate::scene::Scene,
-) -> Result<()> {
+) -> Result<(crate::scene::Scene, Switches, RenderKind, Neighbors)> {
+    let render = (sw.view.render.or(scene.look.render)).unwrap_or(RenderKind::Metaballs);
+    check_groups(sw, render, &scene)?;
+    let (scene, sw) = prepare(scene, sw)?;
+    let neighbors = sw.search.neighbors.unwrap_or(Neighbors::Grid);
+    Ok((scene, sw, render, neighbors))
+}
+
+/// Refuse a scene whose particles the device cannot hold.
+pub(super) fn fits(ctx: &Context, scene: &crate::scene::Scene) -> Result<()> {
+    use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
+    let per_particle = bytes_per_particle(&scene.fluid);
+    scene.check_size(MAX_PARTICLES, per_particle, ctx.info.device_local_bytes)
+}
+
+/// Refuse switches that an SPH scene drawn this way would not use.
+fn check_groups(sw: &Switches, render: RenderKind, scene: &crate::scene::Scene) -> Result<()> {
     use crate::config::Group;
     let mut uses = vec![
         Group::Sort,
@@ -250,10 +256,7 @@ pub(super) fn check_groups(
 /// The scene as it will play and the switches with its look applied: fluid overrides,
 /// the character's fit, the metaball radius from the spacing; validated and size-checked
 /// before any particle or buffer is made (the count is estimated, not built).
-pub(super) fn prepare(
-    scene: crate::scene::Scene,
-    sw: &Switches,
-) -> Result<(crate::scene::Scene, Switches)> {
+fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::Scene, Switches)> {
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.

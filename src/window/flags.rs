@@ -131,9 +131,12 @@ pub fn with(args: &[String], name: &str, value: Option<&str>) -> Vec<String> {
 
 /// The value `sw` (the switches as the scene applied them) has for `name`, as written.
 pub fn value_in(sw: &Switches, name: &str) -> Option<String> {
-    let v = serde_json::to_value(sw).ok()?;
-    let v = v.get(name.replace('-', "_"))?;
-    match v {
+    value_at(&serde_json::to_value(sw).ok()?, name)
+}
+
+/// The same, from the switches serialised once (the panel reads every flag a frame).
+pub fn value_at(switches: &serde_json::Value, name: &str) -> Option<String> {
+    match switches.get(name.replace('-', "_"))? {
         serde_json::Value::Null => None,
         serde_json::Value::Array(items) => {
             Some(items.iter().map(plain).collect::<Vec<_>>().join(","))

@@ -247,13 +247,7 @@ fn play(
         }
         if let Some(new) = input.resized.take() {
             presenter.resize(ctx, new)?;
-            if new.0 > 0 && new.1 > 0 && new != s.size {
-                s.size = new;
-                let sw = flags::parse(&s.args).map_err(Error::Param)?;
-                let mut sw2 = sw.clone();
-                (sw2.frame.width, sw2.frame.height) = (Some(new.0), Some(new.1));
-                s.live.rebuild_view(ctx, &sw2)?;
-            }
+            s.resize(ctx, new)?;
         }
         if presenter.stale() {
             // Minimised (no area) or out of date: try again shortly, play nothing.
@@ -271,6 +265,7 @@ fn play(
         walls.played = played;
         let stats = s.live.stats(ctx);
         let events = s.live.events();
+        let values = serde_json::to_value(&s.live.sw).unwrap_or_default();
         let view = panel::PanelView {
             scene: &s.scene,
             frame: s.live.frame,
@@ -283,7 +278,7 @@ fn play(
             timings: &s.live.frames.profiler.results,
             events: &events,
             flags: &all_flags,
-            sw: &s.live.sw,
+            sw: &values,
             args: &s.args,
             message: &s.message,
         };

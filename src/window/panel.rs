@@ -3,7 +3,6 @@
 //! flag. Controls only emit commands; the session carries them out.
 use super::command::{Command, KEYS};
 use super::flags::{self, Flag};
-use crate::config::Switches;
 use crate::gpu::FrameTiming;
 use crate::run::live::LiveStats;
 use std::collections::BTreeMap;
@@ -42,8 +41,9 @@ pub struct PanelView<'a> {
     pub timings: &'a [FrameTiming],
     pub events: &'a [(f32, String)],
     pub flags: &'a [Flag],
-    /// The switches as the scene applied them, and the flags the user set.
-    pub sw: &'a Switches,
+    /// The switches as the scene applied them (serialised once a frame), and the flags
+    /// the user set.
+    pub sw: &'a serde_json::Value,
     pub args: &'a [String],
     pub message: &'a str,
 }
@@ -300,7 +300,7 @@ fn flag_row(
     f: &Flag,
     out: &mut Vec<Command>,
 ) {
-    let now = flags::value_in(v.sw, &f.name);
+    let now = flags::value_at(v.sw, &f.name);
     ui.horizontal(|ui| {
         ui.label(format!("--{}", f.name)).on_hover_text(&f.help);
         let shown = now.clone().unwrap_or_else(|| "(default)".into());

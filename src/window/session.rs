@@ -84,7 +84,6 @@ impl Session {
         cmd: Command,
         window: Option<&winit::window::Window>,
     ) -> Result<()> {
-        let cmd_is_relative = matches!(cmd, Command::SpeedTimes(_));
         let said = match cmd {
             Command::Set(name, value) => self.flip(ctx, &name, Some(&value)),
             Command::Unset(name) => self.flip(ctx, &name, None),
@@ -112,15 +111,8 @@ impl Session {
             Command::Reset => self
                 .rebuild(ctx, self.args.clone())
                 .map(|_| "scene reset".into()),
-            Command::Speed(s) | Command::SpeedTimes(s) => {
-                let s = match cmd_is_relative {
-                    true => self.speed * s,
-                    false => s,
-                };
-                self.speed = s.clamp(0.125, 8.0);
-                self.live.set_speed(self.speed);
-                Ok(format!("speed x{}", self.speed))
-            }
+            Command::Speed(s) => Ok(self.set_speed(s)),
+            Command::SpeedTimes(k) => Ok(self.set_speed(self.speed * k)),
             Command::Seek(t) => self.seek(ctx, t),
             Command::Screenshot(path, size) => self.screenshot(ctx, &path, size),
             Command::Record(dir) => self.record(&dir),
@@ -180,6 +172,22 @@ impl Session {
         Ok(())
     }
 
+    fn set_speed(&mut self, s: f64) -> String {
+        self.speed = s.clamp(0.125, 8.0);
+        self.live.set_speed(self.speed);
+        format!("speed x{}", self.speed)
+    }
+
+    /// The window's inner size changed: the view follows it (the simulation goes on).
+    pub fn resize(&mut self, ctx: &Context, size: (u32, u32)) -> Result<()> {
+        if size.0 == 0 || size.1 == 0 || size == self.size {
+            return Ok(());
+        }
+        self.size = size;
+        let sw = flags::parse(&self.args).map_err(Error::Param)?;
+        self.live.rebuild_view(ctx, &sized(&sw, size)).map(|_| ())
+    }
+
     fn pause(&mut self, on: bool) -> String {
         self.paused = on;
         if on { "paused" } else { "playing" }.into()
@@ -236,14 +244,14 @@ impl Session {
     /// Jump to scene time `t`: from the start, re-simulated without pictures.
     fn seek(&mut self, ctx: &Context, t: f64) -> Result<String> {
         self.rebuild(ctx, self.args.clone())?;
-        while self.live.stats(ctx).sim_time + 1e-9 < t {
+        while self.live.sim_time() + 1e-9 < t {
             self.live.step(ctx, false, true)?;
         }
         self.live.step(ctx, true, false)?;
         self.paused = true;
         Ok(format!(
             "at t = {:.3} s (re-simulated from 0, paused)",
-            self.live.stats(ctx).sim_time
+            self.live.sim_time()
         ))
     }
 

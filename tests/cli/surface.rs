@@ -2,33 +2,7 @@
 //! OBJ reader (tobj) and a PLY header check: closed, facing out, and holding the particles'
 //! volume within 10%.
 use super::common::{fluidform, summary, text};
-use std::collections::HashMap;
-
-/// Directed edges without exactly one opposite partner (0: closed, consistently oriented).
-fn open_edges(idx: &[u32]) -> usize {
-    let mut d: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in idx.chunks(3) {
-        for k in 0..3 {
-            *d.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
-        }
-    }
-    d.iter()
-        .filter(|(&(a, b), &n)| n != 1 || d.get(&(b, a)) != Some(&1))
-        .count()
-}
-
-fn volume(pos: &[f32], idx: &[u32]) -> f64 {
-    let p = |i: u32| [0, 1, 2].map(|k| pos[3 * i as usize + k] as f64);
-    idx.chunks(3)
-        .map(|t| {
-            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-            (a[0] * (b[1] * c[2] - b[2] * c[1])
-                + a[1] * (b[2] * c[0] - b[0] * c[2])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                / 6.0
-        })
-        .sum()
-}
+use fluidform::surface::Mesh;
 
 #[test]
 fn exported_surfaces_are_closed_and_hold_the_fluids_volume() {
@@ -67,8 +41,14 @@ fn exported_surfaces_are_closed_and_hold_the_fluids_volume() {
         let (models, _) = tobj::load_obj(out.join(f), &opts).unwrap();
         let m = &models[0].mesh;
         assert!(m.indices.len() > 300 && !m.normals.is_empty(), "{f}");
-        assert_eq!(open_edges(&m.indices), 0, "{f} is not closed");
-        let v = volume(&m.positions, &m.indices);
+        // What tobj read, measured as a mesh.
+        let read = Mesh {
+            positions: m.positions.chunks(3).map(|p| [p[0], p[1], p[2]]).collect(),
+            normals: Vec::new(),
+            indices: m.indices.clone(),
+        };
+        assert_eq!(read.open_edges(), 0, "{f} is not closed");
+        let v = read.volume();
         assert!(
             (v / want - 1.0).abs() < 0.10,
             "{f}: volume {v} against the particles' {want}"
