@@ -134,6 +134,13 @@ pub struct MetaballArgs {
     /// its depth (default: on for glass and tinted; off: the thesis's unsorted S-buffer)
     #[arg(long, value_enum)]
     pub list_sort: Option<OnOff>,
+    /// The fluid's surface: ray-marched metaballs (default), screen-space fluid, or a
+    /// marching-cubes mesh over the SPH density, all shaded with --material
+    #[arg(long, value_enum)]
+    pub surface: Option<SurfaceKind>,
+    /// Marching-cubes cell of --surface mesh, in rest particle spacings (default 0.5)
+    #[arg(long, value_name = "F")]
+    pub mesh_cell: Option<f32>,
 }
 
 /// Camera of rendered scenes.

@@ -80,5 +80,14 @@ switch_enum!(Deficit { Rest, Shape });
 switch_enum!(BoneWeights { Eq8, Eq9, Skin });
 switch_enum!(Offscreen { All, End });
 switch_enum!(RenderKind { Metaballs, Points });
+switch_enum!(
+    /// The fluid's surface under `--render metaballs`: the ray-marched metaballs, screen-space
+    /// fluid (depth splats, bilateral smoothing, normals from depth) or a marching-cubes mesh.
+    SurfaceKind {
+        Metaballs,
+        ScreenSpace,
+        Mesh
+    }
+);
 switch_enum!(ShowMesh { Off, Shaded, Wire });
 pub(crate) use switch_enum;

@@ -8,6 +8,7 @@ use crate::error::Result;
 use crate::gpu::{Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
 use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FrameStats, MetaballBuffers, MetaballRenderer, MetaballSettings};
+use crate::render::surface::SurfaceFluid;
 use crate::render::{points::PointsPush, Camera, PointsView};
 use ash::vk;
 use serde::{Deserialize, Serialize};
@@ -234,8 +235,8 @@ pub struct MetaballViewer {
 }
 
 impl MetaballViewer {
-    /// `tank`: the container to draw around the fluid (min, max), if any; `overlay`:
-    /// frames come with an overlay.
+    /// `tank`: the container to draw around the fluid (min, max), if any; `fluid`: the
+    /// particles' (for the other surfaces); `overlay`: frames come with an overlay.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
@@ -243,12 +244,13 @@ impl MetaballViewer {
         cam: Camera,
         n: u32,
         slots: usize,
-        tank: Option<[[f32; 3]; 2]>,
+        (tank, fluid): (Option<[[f32; 3]; 2]>, SurfaceFluid),
         show: ShowMesh,
         overlay: bool,
     ) -> Result<Self> {
         let mut settings = MetaballSettings::from_switches(sw)?;
         settings.tank = tank;
+        settings.fluid = Some(fluid);
         settings.opaque = show != ShowMesh::Off || overlay;
         let bytes = crate::render::metaball::buffers::pixel_bytes(&settings, slots);
         check_frame(
@@ -270,7 +272,7 @@ impl MetaballViewer {
             centers.push(ctx.storage_buffer("metaball centers", n as u64 * 16)?);
         }
         let totals = RenderSummary {
-            renderer: "metaballs".into(),
+            renderer: renderer.settings.surface.as_str(),
             settings: Some(renderer.settings.clone()),
             ..Default::default()
         };
@@ -388,8 +390,7 @@ impl View for MetaballViewer {
         if st.overflow > 0 {
             // Buffers of frames still in flight are about to be replaced.
             ctx.wait_idle()?;
-            let list = self.renderer.settings.list;
-            self.buffers.grow(ctx, list, st.fragments)?;
+            self.renderer.grow(ctx, &mut self.buffers, &st)?;
             let (again, redos) = self.renderer.render_sync(
                 ctx,
                 &mut self.buffers,

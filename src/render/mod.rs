@@ -4,6 +4,7 @@ pub mod camera;
 pub mod mesh;
 pub mod metaball;
 pub mod points;
+pub mod surface;
 pub mod trace;
 
 pub use camera::Camera;

@@ -307,8 +307,20 @@ pub(super) fn make_view(
                 .unwrap_or(true)
                 .then_some([scene.domain.min, scene.domain.max]);
             let overlay = !scene.system.is_empty();
+            let fluid = crate::render::surface::SurfaceFluid {
+                spacing: scene.fluid.spacing(),
+                h: scene.fluid.h,
+                bounds: [scene.domain.min, scene.domain.max],
+            };
             Box::new(MetaballViewer::new(
-                ctx, sw, *cam, n, SLOTS, tank, show, overlay,
+                ctx,
+                sw,
+                *cam,
+                n,
+                SLOTS,
+                (tank, fluid),
+                show,
+                overlay,
             )?)
         }
         // Spheres of half the rest spacing.

@@ -36,6 +36,8 @@ pub struct MetaballBuffers {
     /// Entries of the S-buffer list or the A-buffer node pool.
     pub list_capacity: u64,
     pub debug_on: bool,
+    /// The other surfaces' buffers (none for the metaballs).
+    pub surface: Option<crate::render::surface::SurfaceBuffers>,
 }
 
 /// Bytes of one list entry: an S-buffer metaball index, an A-buffer (index, next) node.
@@ -68,6 +70,9 @@ pub fn pixel_bytes(s: &MetaballSettings, slots: usize) -> (u64, u64) {
         total += 8 + 4 + 4 + 4; // opaque layer, scene depth, the target's colour and depth
         largest = 8;
     }
+    let (surface, widest) = crate::render::surface::buffers::pixel_bytes(s.surface);
+    total += surface;
+    largest = largest.max(widest);
     (total, largest)
 }
 
@@ -109,6 +114,9 @@ impl MetaballBuffers {
         }
         self.bounds.destroy(ctx);
         self.scan.destroy(ctx);
+        if let Some(sb) = &mut self.surface {
+            sb.destroy(ctx);
+        }
     }
 
     /// RGBA8 pixels of the frame last rendered in `slot` (after its fence).
@@ -159,6 +167,26 @@ impl MetaballBuffers {
         )?;
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
+        let surface = match s.marches() {
+            true => None,
+            false => {
+                let fluid = s.fluid.as_ref().ok_or_else(|| {
+                    Error::Param(format!(
+                        "--surface {} needs the particles' fluid (spacing, h, bounds)",
+                        s.surface.as_str()
+                    ))
+                })?;
+                Some(crate::render::surface::SurfaceBuffers::new(
+                    ctx,
+                    s.surface,
+                    fluid,
+                    s.mesh_cell,
+                    (s.width, s.height),
+                    n_capacity,
+                )?)
+            }
+        };
+        let surface = Guard::new(ctx, surface);
         let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
         let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);
         let mut stats_readback = Guard::new(ctx, Vec::new());
@@ -199,6 +227,7 @@ impl MetaballBuffers {
                 pixels_readback: pixels_readback.take(),
                 list_capacity,
                 debug_on: debug,
+                surface: surface.take(),
             },
         );
         ctx.upload(&mut b.sky, 0, &sky_px)?;

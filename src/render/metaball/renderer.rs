@@ -8,6 +8,7 @@ use super::settings::{MetaballSettings, RenderParams};
 use super::stats::{FrameStats, GpuStats};
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::Destroy;
 use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
     Scopes,
@@ -15,6 +16,7 @@ use crate::gpu::{
 use crate::kinds::ListKind;
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
+use crate::render::surface::{Frame, Surface};
 use crate::render::Camera;
 use ash::vk;
 
@@ -36,7 +38,10 @@ pub struct MetaballRenderer {
     fill: Option<Graphics>,
     /// Sorted S-buffer: every metaball's view depth, then each pixel's range by it.
     sort: Option<(Compute, Compute)>,
-    march: Compute,
+    /// The metaballs' ray march (none for the other surfaces).
+    march: Option<Compute>,
+    /// Screen-space fluid or marching cubes instead of the metaballs.
+    surface: Option<Surface>,
     pub(super) scan: ScanPass,
     bounds: BoundsPass,
 }
@@ -68,6 +73,7 @@ impl MetaballRenderer {
             Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
         };
         let (count, fill) = match settings.list {
+            _ if !settings.marches() => (None, None),
             ListKind::None => (None, None),
             ListKind::Sbuffer => (Some(graphics("count", 0)?), Some(graphics("fill", 1)?)),
             ListKind::Abuffer => (None, Some(graphics("fill", 2)?)),
@@ -77,7 +83,15 @@ impl MetaballRenderer {
             let desc = ComputeDesc::plain(name, shader, &defines, 64);
             Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
         };
-        let march = compute("march", "render/metaball/march.comp")?;
+        let (march, surface) = match settings.marches() {
+            true => (
+                Some(compute("march", "render/metaball/march.comp")?.take()),
+                None,
+            ),
+            false => (None, Some(Surface::new(ctx, settings.surface, &defines)?)),
+        };
+        let march = Guard::new(ctx, march);
+        let surface = Guard::new(ctx, surface);
         let sort = match settings.sorts_lists() {
             true => Some((
                 compute("depths", "render/metaball/depths.comp")?,
@@ -93,6 +107,7 @@ impl MetaballRenderer {
             fill: fill.map(Guard::take),
             sort: sort.map(|(d, s)| (d.take(), s.take())),
             march: march.take(),
+            surface: surface.take(),
             scan: scan.take(),
             bounds,
         })
@@ -206,6 +221,22 @@ impl MetaballRenderer {
             ListKind::Abuffer => ctx.fill(cmd, &b.heads, u32::MAX),
             ListKind::None => {}
         }
+        if let (Some(surface), Some(sb)) = (&self.surface, &b.surface) {
+            let frame = Frame {
+                params: &b.params,
+                centers,
+                stats: &b.stats,
+                pixels: &b.pixels,
+                sky: &b.sky,
+                opaque: &b.opaque,
+                scene_depth: &b.scene_depth,
+            };
+            return surface.record(ctx, cmd, scopes, &frame, sb, n);
+        }
+        let march = self
+            .march
+            .as_ref()
+            .ok_or_else(|| Error::Param("a renderer without a surface was given a frame".into()))?;
         scopes.begin(ctx, cmd, "bounds");
         self.bounds.record(ctx, cmd, centers, n as u64, &b.bounds)?;
         scopes.end(ctx, cmd);
@@ -246,7 +277,7 @@ impl MetaballRenderer {
             draw(fill);
             scopes.end(ctx, cmd);
         }
-        let groups = px.div_ceil(self.march.local_size as u64);
+        let groups = px.div_ceil(march.local_size as u64);
         if let Some((depths, sort)) = &self.sort {
             scopes.begin(ctx, cmd, "sort");
             let metaball_groups = (n as u64).div_ceil(depths.local_size as u64);
@@ -255,7 +286,7 @@ impl MetaballRenderer {
             scopes.end(ctx, cmd);
         }
         scopes.begin(ctx, cmd, "march");
-        self.march.dispatch_groups(ctx, cmd, &bufs, &(), groups);
+        march.dispatch_groups(ctx, cmd, &bufs, &(), groups);
         scopes.end(ctx, cmd);
         Ok(())
     }
@@ -300,6 +331,7 @@ impl MetaballRenderer {
             offscreen_samples: st.offscreen_samples,
             budget_pixels: st.budget_pixels,
             list_bytes,
+            triangles: st.triangles as u64,
         }
     }
 
@@ -327,8 +359,16 @@ impl MetaballRenderer {
                     st.fragments
                 )));
             }
-            b.grow(ctx, self.settings.list, st.fragments)?;
+            self.grow(ctx, b, &st)?;
             redos += 1;
+        }
+    }
+
+    /// Room for what frame `st` overflowed: list entries, or the mesh's triangles.
+    pub fn grow(&self, ctx: &Context, b: &mut MetaballBuffers, st: &FrameStats) -> Result<()> {
+        match &mut b.surface {
+            Some(sb) => sb.grow(ctx, st.triangles),
+            None => b.grow(ctx, self.settings.list, st.fragments),
         }
     }
 
@@ -364,6 +404,7 @@ impl MetaballRenderer {
             p.destroy(ctx);
         }
         self.march.destroy(ctx);
+        self.surface.destroy(ctx);
         if let Some((d, s)) = &mut self.sort {
             d.destroy(ctx);
             s.destroy(ctx);

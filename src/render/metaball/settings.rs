@@ -2,7 +2,8 @@
 //! defaults, and their GPU mirror.
 use crate::config::Switches;
 use crate::error::{Error, Result};
-use crate::kinds::{DensityFn, ListKind, Material};
+use crate::kinds::{DensityFn, ListKind, Material, SurfaceKind};
+use crate::render::surface::SurfaceFluid;
 use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;
@@ -46,6 +47,24 @@ pub struct MetaballSettings {
     /// frame; primary rays stop at it and show it where no fluid is in front.
     #[serde(default)]
     pub opaque: bool,
+    /// The surface drawn: the metaballs, or screen-space fluid or a marching-cubes mesh
+    /// (which need `fluid`), shaded with the same materials.
+    #[serde(default = "metaballs")]
+    pub surface: SurfaceKind,
+    /// Marching-cubes cell in rest spacings (`--surface mesh`).
+    #[serde(default = "half")]
+    pub mesh_cell: f32,
+    /// The particles' fluid, for the other surfaces (set by the caller).
+    #[serde(default)]
+    pub fluid: Option<SurfaceFluid>,
+}
+
+fn metaballs() -> SurfaceKind {
+    SurfaceKind::Metaballs
+}
+
+fn half() -> f32 {
+    0.5
 }
 
 pub const MAX_DEPTH: u32 = 6;
@@ -90,7 +109,7 @@ impl MetaballSettings {
     /// overridden by the switches that are set.
     pub fn from_switches(sw: &Switches) -> Result<Self> {
         let radius = sw.metaball.radius.unwrap_or(0.04);
-        let s = Self {
+        let mut s = Self {
             list: sw.metaball.list.unwrap_or(ListKind::Sbuffer),
             density: sw.metaball.density.unwrap_or(DensityFn::Wyvill),
             material: sw.metaball.material.unwrap_or(Material::Phong),
@@ -121,7 +140,32 @@ impl MetaballSettings {
             tank: None,
             sky: sw.metaball.sky.clone(),
             opaque: false,
+            surface: sw.metaball.surface.unwrap_or(SurfaceKind::Metaballs),
+            mesh_cell: sw.metaball.mesh_cell.unwrap_or(0.5),
+            fluid: None,
         };
+        if s.surface != SurfaceKind::Metaballs {
+            let m = &sw.metaball;
+            let listed = [
+                ("--list", m.list.is_some()),
+                ("--density", m.density.is_some()),
+                ("--threshold", m.threshold.is_some()),
+                ("--refine", m.refine.is_some()),
+                ("--offscreen", m.offscreen.is_some()),
+                ("--list-sort", m.list_sort.is_some()),
+            ];
+            if let Some((name, _)) = listed.iter().find(|(_, set)| *set) {
+                return Err(Error::Param(format!(
+                    "{name} belongs to the metaball surface, not --surface {}",
+                    s.surface.as_str()
+                )));
+            }
+            // Nothing is listed or marched.
+            s.list = ListKind::None;
+            s.sorted = false;
+        } else if sw.metaball.mesh_cell.is_some() {
+            return Err(Error::Param("--mesh-cell belongs to --surface mesh".into()));
+        }
         if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
             return Err(Error::Param(format!(
                 "--list-sort applies to the S-buffer's contiguous ranges, not --list {}",
@@ -134,7 +178,12 @@ impl MetaballSettings {
 
     /// Whether the frame sorts its lists (an S-buffer with `sorted`).
     pub fn sorts_lists(&self) -> bool {
-        self.sorted && self.list == ListKind::Sbuffer
+        self.sorted && self.list == ListKind::Sbuffer && self.marches()
+    }
+
+    /// Whether the surface is the ray-marched metaballs (the lists are built).
+    pub fn marches(&self) -> bool {
+        self.surface == SurfaceKind::Metaballs
     }
 
     /// The list's name in tables: none, abuffer, sbuffer (the thesis's), sbuffer-sorted.
@@ -162,6 +211,12 @@ impl MetaballSettings {
             return Err(Error::Param(format!(
                 "--refine must be at most {MAX_REFINE}, got {}",
                 self.refine
+            )));
+        }
+        if !(self.mesh_cell >= 0.1 && self.mesh_cell <= 4.0) {
+            return Err(Error::Param(format!(
+                "--mesh-cell must be within [0.1, 4] rest spacings, got {}",
+                self.mesh_cell
             )));
         }
         if self.depth > MAX_DEPTH {

@@ -14,7 +14,8 @@ pub struct GpuStats {
     /// The S-buffer's total, copied from the end of its scanned offsets.
     pub sbuffer_fragments: u32,
     pub budget_pixels: u32,
-    pub pad0: u32,
+    /// Marching cubes: triangles the frame made.
+    pub triangles: u32,
     pub pad1: u32,
 }
 
@@ -42,4 +43,7 @@ pub struct FrameStats {
     /// Bytes the list structure needs for this frame (S: offsets + list, sorted: plus the
     /// metaball depths; A: heads + nodes + counter; none: 0).
     pub list_bytes: u64,
+    /// Marching cubes: the frame's triangles (else 0).
+    #[serde(default)]
+    pub triangles: u64,
 }

@@ -1,0 +1,43 @@
+// The renderer's parameters and counters, shared by the metaball passes
+// (render/metaball/common.glsl) and the other surfaces (render/surface/common.glsl).
+// RenderParams and RenderStats mirror src/render/metaball/settings.rs and stats.rs (field
+// offsets tested).
+#ifndef RENDER_PARAMS_GLSL
+#define RENDER_PARAMS_GLSL
+struct RenderParams {
+    mat4 view_proj;
+    mat4 inv_view_proj;
+    mat4 view;
+    vec4 proj;      // x: P00, y: P11, z: near plane distance
+    vec4 eye;       // xyz camera position, w = metaball radius R
+    vec4 sun;       // xyz unit direction towards the sun, w = march step
+    vec4 absorb;    // rgb absorption per unit length (tinted), w = index of refraction
+    vec4 f0;        // rgb Fresnel reflectance at normal incidence (metals)
+    vec4 base;      // rgb Phong colour, w = threshold T
+    vec4 tank_min;  // xyz container min, w = 1: draw it
+    vec4 tank_max;  // xyz container max
+    uint width;
+    uint height;
+    uint n;
+    uint refine;
+    uint depth;
+    uint max_steps;
+    uint list_capacity;  // S-buffer list or A-buffer pool entries
+    uint offscreen_end;  // secondary samples off screen: 1 end the path, 0 use all metaballs
+    uint sky_w;
+    uint sky_h;
+    uint debug;
+    uint opaque;  // 1: the opaque layer is drawn (march.comp)
+};
+const uint NIL = 0xFFFFFFFFu;
+struct RenderStats {
+    uint abuffer_nodes;      // A-buffer node counter
+    uint longest;            // longest list met by a primary ray
+    uint overflow;           // list entries that did not fit
+    uint offscreen_samples;  // secondary samples off screen
+    uint sbuffer_fragments;  // S-buffer total (copied from the scan)
+    uint budget_pixels;      // pixels whose loops were cut short
+    uint triangles;          // marching cubes: triangles made (surface/cells.comp)
+    uint pad1;
+};
+#endif

@@ -1,0 +1,99 @@
+//! Marching cubes on the GPU over the SPH density (as splashsurf meshes particle fluids):
+//! the particles' poly6 density on a grid over the fluid's bounds, every cell's triangles
+//! appended to a soup whose count drives an indirect draw, and the soup rasterised into
+//! the G-buffer in two passes (nearest depth and thickness, then the nearest fragment's
+//! interpolated normal). Checked against `crate::surface::march` on the same grid.
+use super::{SurfaceBuffers, SurfaceBufs, SurfaceIo, SurfacePush};
+use crate::error::Result;
+use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::track::BufferUse;
+use crate::gpu::{
+    ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
+};
+use ash::vk;
+
+type Graphics = GraphicsPipeline<SurfaceIo>;
+
+pub struct Cubes {
+    density: ComputePipeline<SurfaceIo>,
+    cells: ComputePipeline<SurfaceIo>,
+    /// PASS 0: depth and thickness; PASS 1: normals.
+    raster: [Graphics; 2],
+}
+
+impl Cubes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
+            let desc = ComputeDesc::plain(name, shader, &[], 64);
+            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
+        };
+        let density = compute("density", "render/surface/density.comp")?;
+        let cells = compute("cells", "render/surface/cells.comp")?;
+        let raster = |name, pass: u32| -> Result<Guard<Graphics>> {
+            let defines = [("PASS", pass.to_string())];
+            let desc = GraphicsDesc {
+                name,
+                vertex: "render/surface/mesh.vert",
+                fragment: "render/surface/mesh.frag",
+                defines: &defines,
+                color_format: None,
+                depth_format: None,
+                blend: false,
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            };
+            Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
+        };
+        let depth = raster("mesh depth", 0)?;
+        let normals = raster("mesh normals", 1)?;
+        Ok(Self {
+            density: density.take(),
+            cells: cells.take(),
+            raster: [depth.take(), normals.take()],
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        bufs: &SurfaceBufs,
+        push: &SurfacePush,
+        b: &SurfaceBuffers,
+        n: u32,
+    ) -> Result<()> {
+        scopes.begin(ctx, cmd, "density");
+        ctx.fill(cmd, &b.grid, 0);
+        self.density.dispatch(ctx, cmd, bufs, push, n as u64);
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "cells");
+        ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0]);
+        self.cells.dispatch(ctx, cmd, bufs, push, b.shape.cells());
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "raster");
+        ctx.fill(cmd, &b.zbits, u32::MAX);
+        ctx.fill(cmd, &b.thick, 0);
+        ctx.fill(cmd, &b.gbuf, 0);
+        let (w, h) = b.size;
+        for pass in &self.raster {
+            pass.prepare(ctx, cmd, bufs);
+            ctx.prepare_draws(cmd, &[BufferUse::indirect(b.args.raw)]);
+            begin_empty_rendering(ctx, cmd, w, h);
+            pass.bind(ctx, cmd, bufs, push);
+            ctx.draw_indirect(cmd, &b.args, 0);
+            ctx.end_rendering(cmd);
+        }
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.density.destroy(ctx);
+        self.cells.destroy(ctx);
+        for p in &mut self.raster {
+            p.destroy(ctx);
+        }
+    }
+}
+crate::impl_destroy!(Cubes);

@@ -1,0 +1,84 @@
+//! Screen-space fluid (van der Laan, Green & Sainz 2009): particles splatted as spheres
+//! into the nearest depth and an additive thickness, a separable bilateral filter of the
+//! depth (x, then y), and normals from the smoothed depth into the G-buffer.
+use super::{SurfaceBuffers, SurfaceBufs, SurfaceIo, SurfacePush};
+use crate::error::Result;
+use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::{
+    ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
+};
+use ash::vk;
+
+pub struct ScreenSpace {
+    splat: GraphicsPipeline<SurfaceIo>,
+    smooth: ComputePipeline<SurfaceIo>,
+    normals: ComputePipeline<SurfaceIo>,
+}
+
+impl ScreenSpace {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let splat = GraphicsDesc {
+            name: "splat",
+            vertex: "render/surface/splat.vert",
+            fragment: "render/surface/splat.frag",
+            defines: &[],
+            color_format: None,
+            depth_format: None,
+            blend: false,
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+        };
+        let splat = Guard::new(ctx, GraphicsPipeline::new(ctx, &splat)?);
+        let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
+            let desc = ComputeDesc::plain(name, shader, &[], 64);
+            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
+        };
+        let smooth = compute("smooth", "render/surface/smooth.comp")?;
+        let normals = compute("normals", "render/surface/normals.comp")?;
+        Ok(Self {
+            splat: splat.take(),
+            smooth: smooth.take(),
+            normals: normals.take(),
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        bufs: &SurfaceBufs,
+        push: &SurfacePush,
+        b: &SurfaceBuffers,
+        n: u32,
+    ) {
+        let px = b.pixels;
+        scopes.begin(ctx, cmd, "splat");
+        ctx.fill(cmd, &b.zbits, u32::MAX);
+        ctx.fill(cmd, &b.thick, 0);
+        self.splat.prepare(ctx, cmd, bufs);
+        let (width, height) = b.size;
+        begin_empty_rendering(ctx, cmd, width, height);
+        self.splat.bind(ctx, cmd, bufs, push);
+        ctx.draw(cmd, 6, n);
+        ctx.end_rendering(cmd);
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "smooth");
+        for axis in [0.0, 1.0] {
+            let mut p = *push;
+            p.look[1] = axis;
+            self.smooth.dispatch(ctx, cmd, bufs, &p, px);
+        }
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "normals");
+        self.normals.dispatch(ctx, cmd, bufs, push, px);
+        scopes.end(ctx, cmd);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.splat.destroy(ctx);
+        self.smooth.destroy(ctx);
+        self.normals.destroy(ctx);
+    }
+}
+crate::impl_destroy!(ScreenSpace);
