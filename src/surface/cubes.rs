@@ -139,6 +139,17 @@ pub fn density_grid(pos: &[[f32; 3]], h: f32, mass: f32, rest: f32, cell: f32) -
     let margin = h + cell;
     let origin = lo.map(|v| v - margin);
     let dims = [0, 1, 2].map(|k| ((hi[k] + margin - origin[k]) / cell).ceil() as usize + 1);
+    density_on(pos, (h, mass, rest), origin, cell, dims)
+}
+
+/// As `density_grid`, on the grid of `dims` nodes from `origin` (the GPU's, for instance).
+pub fn density_on(
+    pos: &[[f32; 3]],
+    (h, mass, rest): (f32, f32, f32),
+    origin: [f32; 3],
+    cell: f32,
+    dims: [usize; 3],
+) -> Grid {
     let mut values = vec![0.0f32; dims[0] * dims[1] * dims[2]];
     let (h2, k) = (h * h, 315.0 / (64.0 * std::f32::consts::PI * h.powi(9)));
     let reach = (h / cell).ceil() as isize;

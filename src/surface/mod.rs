@@ -6,4 +6,4 @@ pub mod cubes;
 pub mod files;
 pub mod table;
 
-pub use cubes::{density_grid, march, Grid, Mesh};
+pub use cubes::{density_grid, density_on, march, Grid, Mesh};

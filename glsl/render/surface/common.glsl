@@ -37,8 +37,10 @@ layout(push_constant) uniform Push {
     vec4 fluid;   // x: smoothing length h, y: particle volume m / rho0, z: poly6 constant, w: splat radius
     vec4 look;    // x: iso level, y: smoothing axis (0: x, 1: y), z: filter half-width cap (pixels)
 } pc;
-const float GRID_SCALE = 4194304.0;  // 2^22
-const float THICK_SCALE = 65536.0;
+// GRID_SCALE and THICK_SCALE: the fixed points, from src/render/surface/mod.rs.
+#if !defined(GRID_SCALE) || !defined(THICK_SCALE)
+#error "GRID_SCALE and THICK_SCALE come from src/render/surface/mod.rs"
+#endif
 const uint NO_DEPTH = 0xFFFFFFFFu;
 
 uint pixel_count() { return P.width * P.height; }

@@ -105,7 +105,7 @@ impl SurfaceBuffers {
                 "a marching-cubes grid of {:?} nodes ({} MiB) is more than one storage binding \
                  addresses here ({} MiB): use a larger --mesh-cell",
                 grid.dims,
-                grid.nodes() * 4 >> 20,
+                (grid.nodes() * 4) >> 20,
                 range >> 20
             )));
         }
@@ -189,7 +189,7 @@ impl SurfaceBuffers {
     /// The density grid of the frame last drawn (marching cubes; tests).
     pub fn density(&self, ctx: &Context) -> Result<Vec<f32>> {
         let raw: Vec<u32> = ctx.readback(&self.grid, 0, self.shape.nodes() as usize)?;
-        Ok(raw.iter().map(|&v| v as f32 / 4194304.0).collect())
+        Ok(raw.iter().map(|&v| v as f32 / super::GRID_SCALE).collect())
     }
 
     /// The triangle soup of the frame last drawn: (position, normal) per vertex.
@@ -197,6 +197,19 @@ impl SurfaceBuffers {
         let [count]: [u32; 1] = ctx.readback(&self.args, 0, 1)?.try_into().unwrap_or([0]);
         let count = (count as u64).min(self.capacity) as usize;
         ctx.readback(&self.verts, 0, count)
+    }
+
+    /// The splats of the frame last drawn, before smoothing (screen-space; tests): per
+    /// pixel the nearest view depth (0: none) and the thickness.
+    pub fn splats(&self, ctx: &Context) -> Result<(Vec<f32>, Vec<f32>)> {
+        let z: Vec<u32> = ctx.readback(&self.zbits, 0, self.pixels as usize)?;
+        let t: Vec<i32> = ctx.readback(&self.thick, 0, self.pixels as usize)?;
+        Ok((
+            z.iter()
+                .map(|&b| if b == u32::MAX { 0.0 } else { f32::from_bits(b) })
+                .collect(),
+            t.iter().map(|&v| v as f32 / super::THICK_SCALE).collect(),
+        ))
     }
 
     /// The G-buffer of the frame last drawn: per pixel (view depth, normal), (thickness).

@@ -24,13 +24,15 @@ pub struct Cubes {
 impl Cubes {
     pub fn new(ctx: &Context) -> Result<Self> {
         let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
-            let desc = ComputeDesc::plain(name, shader, &[], 64);
+            let defines = super::scale_defines();
+            let desc = ComputeDesc::plain(name, shader, &defines, 64);
             Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
         };
         let density = compute("density", "render/surface/density.comp")?;
         let cells = compute("cells", "render/surface/cells.comp")?;
         let raster = |name, pass: u32| -> Result<Guard<Graphics>> {
-            let defines = [("PASS", pass.to_string())];
+            let mut defines = super::scale_defines();
+            defines.push(("PASS", pass.to_string()));
             let desc = GraphicsDesc {
                 name,
                 vertex: "render/surface/mesh.vert",

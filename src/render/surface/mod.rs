@@ -53,6 +53,19 @@ pub struct SurfaceFluid {
 
 /// The marching cubes' iso level: half the rest density, as the mesh export's.
 pub const ISO: f32 = 0.5;
+/// Fixed point of the density grid (atomic adds of the density over the rest density).
+pub const GRID_SCALE: f32 = 4194304.0;
+/// Fixed point of the thickness (per metre).
+pub const THICK_SCALE: f32 = 65536.0;
+
+/// The defines every surface shader takes: the fixed-point scales.
+pub fn scale_defines() -> Vec<(&'static str, String)> {
+    vec![
+        ("GRID_SCALE", format!("{GRID_SCALE:.1}")),
+        ("THICK_SCALE", format!("{THICK_SCALE:.1}")),
+    ]
+}
+
 /// The screen-space filter's half-width cap in pixels.
 pub const FILTER_CAP: f32 = 16.0;
 
@@ -124,7 +137,9 @@ pub struct Surface {
 impl Surface {
     /// `defines`: the metaball renderer's (MATERIAL and its named values among them).
     pub fn new(ctx: &Context, kind: SurfaceKind, defines: &[(&str, String)]) -> Result<Self> {
-        let shade = ComputeDesc::plain("shade", "render/surface/shade.comp", defines, 64);
+        let mut defines = defines.to_vec();
+        defines.extend(scale_defines());
+        let shade = ComputeDesc::plain("shade", "render/surface/shade.comp", &defines, 64);
         let shade = Guard::new(ctx, ComputePipeline::new(ctx, &shade)?);
         let (screen, cubes) = match kind {
             SurfaceKind::ScreenSpace => (Some(screen::ScreenSpace::new(ctx)?), None),

@@ -21,7 +21,7 @@ impl ScreenSpace {
             name: "splat",
             vertex: "render/surface/splat.vert",
             fragment: "render/surface/splat.frag",
-            defines: &[],
+            defines: &super::scale_defines(),
             color_format: None,
             depth_format: None,
             blend: false,
@@ -29,7 +29,8 @@ impl ScreenSpace {
         };
         let splat = Guard::new(ctx, GraphicsPipeline::new(ctx, &splat)?);
         let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
-            let desc = ComputeDesc::plain(name, shader, &[], 64);
+            let defines = super::scale_defines();
+            let desc = ComputeDesc::plain(name, shader, &defines, 64);
             Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
         };
         let smooth = compute("smooth", "render/surface/smooth.comp")?;
