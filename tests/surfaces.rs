@@ -47,7 +47,9 @@ struct Frame {
 
 impl Frame {
     fn new(ctx: &Context, s: MetaballSettings, pts: &[[f32; 4]], cam: &Camera) -> Self {
-        let mut centers = ctx.storage_buffer("centers", pts.len() as u64 * 16).unwrap();
+        let mut centers = ctx
+            .storage_buffer("centers", pts.len() as u64 * 16)
+            .unwrap();
         ctx.upload(&mut centers, 0, pts).unwrap();
         let r = MetaballRenderer::new(ctx, s).unwrap();
         let mut b = r.buffers(ctx, pts.len() as u64, 1, true).unwrap();
@@ -61,8 +63,19 @@ impl Frame {
     /// Per pixel: does the surface cover it?
     fn coverage(&self, ctx: &Context) -> Vec<bool> {
         match &self.b.surface {
-            Some(sb) => sb.gbuffer(ctx).unwrap().iter().map(|g| g[0][0] > 0.0).collect(),
-            None => self.r.debug(ctx, &self.b).unwrap().iter().map(|d| d[0] >= 0.0).collect(),
+            Some(sb) => sb
+                .gbuffer(ctx)
+                .unwrap()
+                .iter()
+                .map(|g| g[0][0] > 0.0)
+                .collect(),
+            None => self
+                .r
+                .debug(ctx, &self.b)
+                .unwrap()
+                .iter()
+                .map(|d| d[0] >= 0.0)
+                .collect(),
         }
     }
 
@@ -109,7 +122,11 @@ fn gpu_marching_cubes_match_the_cpu_on_the_same_grid() {
     assert_eq!(mesh.open_edges(), 0);
     let soup = sb.soup(&ctx).unwrap();
     assert_eq!(soup.len() % 3, 0);
-    assert_eq!(soup.len(), mesh.indices.len(), "GPU vs CPU triangle corners");
+    assert_eq!(
+        soup.len(),
+        mesh.indices.len(),
+        "GPU vs CPU triangle corners"
+    );
     let volume: f64 = soup
         .chunks(3)
         .map(|t| {
@@ -144,7 +161,12 @@ fn screen_space_splats_are_the_spheres_ray_hits() {
         [0.05, 0.02, -0.03, 0.0],
         [-0.04, -0.01, 0.02, 0.0],
     ];
-    let cam = Camera::look_at(Vec3::new(0.0, 0.05, 0.3), Vec3::ZERO, 45.0, W as f32 / H as f32);
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 0.05, 0.3),
+        Vec3::ZERO,
+        45.0,
+        W as f32 / H as f32,
+    );
     let s = settings(SurfaceKind::ScreenSpace);
     let fluid = s.fluid.unwrap();
     let r = fluid.splat_radius();
@@ -173,12 +195,18 @@ fn screen_space_splats_are_the_spheres_ray_hits() {
         }
         // Pixels whose ray grazes a sphere within rounding are left out.
         if near == f32::MAX {
-            assert!(z == 0.0 || t < 1e-3, "pixel {i}: splat {z} where no sphere is");
+            assert!(
+                z == 0.0 || t < 1e-3,
+                "pixel {i}: splat {z} where no sphere is"
+            );
             continue;
         }
         hits += 1;
         assert!((z - near).abs() < 1e-4, "pixel {i}: depth {z} vs {near}");
-        assert!((t - chords).abs() < 2e-4 + 1e-3 * chords, "pixel {i}: {t} vs {chords}");
+        assert!(
+            (t - chords).abs() < 2e-4 + 1e-3 * chords,
+            "pixel {i}: {t} vs {chords}"
+        );
     }
     eprintln!("{hits} pixels hit");
     assert!(hits > 100, "only {hits} pixels hit");
@@ -202,7 +230,10 @@ fn every_surface_covers_what_the_metaballs_cover() {
         let either = want.iter().zip(&got).filter(|(a, b)| **a || **b).count();
         let iou = both as f64 / either as f64;
         eprintln!("{kind:?}: coverage IoU {iou:.3} with the metaballs'");
-        assert!(iou > 0.85, "{kind:?}: coverage IoU {iou:.3} with the metaballs'");
+        assert!(
+            iou > 0.85,
+            "{kind:?}: coverage IoU {iou:.3} with the metaballs'"
+        );
         // Every covered pixel has a unit normal facing the eye.
         let g = f.b.surface.as_ref().unwrap().gbuffer(&ctx).unwrap();
         for px in g.iter().filter(|g| g[0][0] > 0.0) {

@@ -82,3 +82,62 @@ fn exported_surfaces_are_closed_and_hold_the_fluids_volume() {
         "{head}"
     );
 }
+
+#[test]
+fn the_other_surfaces_draw_and_refuse_what_they_do_not_use() {
+    let dir = tempfile::tempdir().unwrap();
+    for (kind, passes) in [
+        ("screen-space", ["splat", "smooth", "normals", "shade"]),
+        ("mesh", ["density", "cells", "raster", "shade"]),
+    ] {
+        let out = dir.path().join(kind);
+        let o = fluidform(&[
+            "run",
+            "--scene",
+            "drop",
+            "--frames",
+            "2",
+            "--quiet",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--surface",
+            kind,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{kind}: {}", text(&o));
+        assert_eq!(summary(&out)["stats"]["render"]["renderer"], kind);
+        let timings = std::fs::read_to_string(out.join("timings.csv")).unwrap();
+        for p in passes {
+            assert!(
+                timings.contains(&format!("render/{p}")),
+                "{kind}: no {p} scope"
+            );
+        }
+        assert!(out.join("frame_0001.png").exists());
+    }
+    for (args, why) in [
+        (
+            &["--surface", "mesh", "--list", "abuffer"][..],
+            "--list belongs",
+        ),
+        (
+            &["--surface", "mesh", "--mesh-cell", "0"][..],
+            "--mesh-cell must be",
+        ),
+        (
+            &["--mesh-cell", "1"][..],
+            "--mesh-cell belongs to --surface mesh",
+        ),
+        (&["--render", "points", "--surface", "mesh"][..], "surface"),
+    ] {
+        let mut a = vec!["run", "--scene", "drop", "--frames", "1", "--quiet"];
+        a.extend_from_slice(args);
+        let o = fluidform(&a);
+        assert!(!o.status.success(), "{args:?} was accepted");
+        let t = text(&o);
+        assert!(t.contains(why) && t.lines().count() <= 3, "{args:?}: {t}");
+    }
+}

@@ -206,7 +206,13 @@ impl SurfaceBuffers {
         let t: Vec<i32> = ctx.readback(&self.thick, 0, self.pixels as usize)?;
         Ok((
             z.iter()
-                .map(|&b| if b == u32::MAX { 0.0 } else { f32::from_bits(b) })
+                .map(|&b| {
+                    if b == u32::MAX {
+                        0.0
+                    } else {
+                        f32::from_bits(b)
+                    }
+                })
                 .collect(),
             t.iter().map(|&v| v as f32 / super::THICK_SCALE).collect(),
         ))
