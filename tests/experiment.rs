@@ -167,6 +167,8 @@ fn quick_experiments_write_every_file_and_column() {
         findings::ADAPTIVE,
         findings::GRID_BEATS,
         findings::GRID_LINEAR,
+        fluidform::experiment::surfaces::SCREEN_FASTER,
+        fluidform::experiment::surfaces::CUBES_CHEAP,
         "cost rises with the radius R",
         "cost rises with the refinement steps I",
         "cost rises with the recursion depth",

@@ -6,6 +6,7 @@ pub mod adaptive;
 pub mod fidelity;
 pub mod findings;
 pub mod measure;
+pub mod surfaces;
 pub mod sweeps;
 pub mod tables;
 pub mod thesis;
@@ -22,7 +23,7 @@ use std::time::Instant;
 
 pub const NAMES: &[&str] = &[
     "table2", "table3", "table4", "table5", "table6", "table7", "table8", "fig9", "adaptive",
-    "scaling", "fidelity",
+    "scaling", "fidelity", "surfaces",
 ];
 
 pub struct ExperimentOptions {
@@ -342,6 +343,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>>
             "adaptive" => adaptive::adaptive(env)?,
             "scaling" => sweeps::scaling(ctx, env)?,
             "fidelity" => fidelity::fidelity(env)?,
+            "surfaces" => surfaces::surfaces(env)?,
             table => {
                 let def = tables::def(table).expect("a table name");
                 measure::table(ctx, env, def)?
