@@ -2,7 +2,7 @@
 //! default) at 512x512, every axis the tables vary from the switches: --list (all three
 //! when unset), --material, --density, --threshold, --radius, --refine, --depth.
 use super::{measure, BenchOptions, Row};
-use crate::config::ListKind;
+use crate::config::{ListKind, SurfaceKind};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
 use crate::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
@@ -19,7 +19,10 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     // (list, sorted): every list when --list is unset, the S-buffer both unsorted (the
     // thesis's) and sorted (ours) unless --list-sort picks one.
     let sorted = MetaballSettings::from_switches(sw)?.sorted;
+    let other = sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs);
     let lists = match (sw.metaball.list, sw.metaball.list_sort) {
+        // Another surface draws without lists.
+        _ if other.is_some() => vec![(ListKind::None, false)],
         (Some(l), _) => vec![(l, sorted)],
         (None, Some(_)) => vec![
             (ListKind::None, false),
@@ -39,7 +42,11 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let mut settings = MetaballSettings::from_switches(sw)?;
             settings.list = list;
             settings.sorted = sorted;
-            let name = settings.list_name();
+            settings.fluid = Some(blob_fluid(&pts, spacing));
+            let name = match other {
+                Some(k) => k.as_str(),
+                None => settings.list_name(),
+            };
             let cam = crate::session::camera_with_switches(
                 blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
                 sw,
@@ -90,4 +97,21 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     })();
     ctx.destroy_buffer(&mut centers);
     result.map(|_| rows)
+}
+
+/// The blob's fluid for the other surfaces: its spacing, the default smoothing length, its
+/// bounds.
+fn blob_fluid(pts: &[[f32; 4]], spacing: f32) -> crate::render::surface::SurfaceFluid {
+    let mut bounds = [[f32::MAX; 3], [f32::MIN; 3]];
+    for p in pts {
+        for k in 0..3 {
+            bounds[0][k] = bounds[0][k].min(p[k]);
+            bounds[1][k] = bounds[1][k].max(p[k]);
+        }
+    }
+    crate::render::surface::SurfaceFluid {
+        spacing,
+        h: FluidParams::default().h,
+        bounds,
+    }
 }

@@ -102,6 +102,47 @@ fn view_frames_match_run_after_switch_flips() {
 }
 
 #[test]
+fn view_switches_the_surface_live_as_run_draws_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("view.png");
+    let size = ["--width", "160", "--height", "120"];
+    let mut args = vec![
+        "--scene",
+        "drop",
+        "--frames",
+        "6",
+        "--validation",
+        "--hide-panel",
+    ];
+    args.extend(size);
+    args.extend([
+        "--at",
+        "2:set surface mesh",
+        "--screenshot",
+        shot.to_str().unwrap(),
+    ]);
+    let o = view(&args);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("--surface mesh: view rebuilt"), "{t}");
+    let out = dir.path().join("run");
+    let mut run = vec!["run", "--scene", "drop", "--frames", "6", "--quiet"];
+    run.extend(size);
+    run.extend(["--surface", "mesh", "--out", out.to_str().unwrap()]);
+    let o = fluidform(&run);
+    assert!(o.status.success(), "{}", text(&o));
+    let (a, b) = (rgba(&shot), rgba(&out.join("frame_0005.png")));
+    let close = (a.pixels().zip(b.pixels()))
+        .filter(|(p, q)| p.0.iter().zip(q.0).all(|(x, y)| x.abs_diff(y) <= 4))
+        .count();
+    let frac = close as f64 / (160.0 * 120.0);
+    assert!(
+        frac >= 0.99,
+        "only {frac:.4} of the pixels agree with run's mesh frame"
+    );
+}
+
+#[test]
 fn view_survives_resizing_to_1x1_and_minimising() {
     let dir = tempfile::tempdir().unwrap();
     let shot = dir.path().join("after.png");
