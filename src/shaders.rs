@@ -87,6 +87,7 @@ pub fn variants() -> Vec<Variant> {
         v.push(with::<RaysIo>("control/rays.frag", &d));
     }
     metaballs(&mut v);
+    surfaces(&mut v);
     v
 }
 
@@ -203,5 +204,40 @@ fn metaballs(v: &mut Vec<Variant>) {
                 }
             }
         }
+    }
+}
+
+/// Screen-space fluid and marching cubes: their passes, and the shade pass per material.
+fn surfaces(v: &mut Vec<Variant>) {
+    use crate::render::surface::{scale_defines, SurfaceIo};
+    let scales: Vec<(String, String)> = (scale_defines().into_iter())
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+    for f in [
+        "render/surface/splat.vert",
+        "render/surface/splat.frag",
+        "render/surface/smooth.comp",
+        "render/surface/normals.comp",
+        "render/surface/density.comp",
+        "render/surface/cells.comp",
+    ] {
+        v.push(with::<SurfaceIo>(f, &scales));
+    }
+    for pass in 0..2 {
+        let mut d = scales.clone();
+        d.push(kv("PASS", pass));
+        v.push(with::<SurfaceIo>("render/surface/mesh.vert", &d));
+        v.push(with::<SurfaceIo>("render/surface/mesh.frag", &d));
+    }
+    for material in [
+        Material::Phong,
+        Material::Glass,
+        Material::Tinted,
+        Material::Gold,
+    ] {
+        let mut d =
+            MetaballSettings::defines_for(ListKind::None, DensityFn::Wyvill, material, false);
+        d.extend(scales.iter().cloned());
+        v.push(with::<SurfaceIo>("render/surface/shade.comp", &d));
     }
 }

@@ -411,6 +411,8 @@ fn a_variant_switch_with_an_unknown_value_fails_to_compile() {
         ("render/metaball/march.comp", "LIST"),
         ("render/metaball/march.comp", "MATERIAL"),
         ("render/metaball/billboard.frag", "PASS"),
+        ("render/surface/shade.comp", "MATERIAL"),
+        ("render/surface/mesh.frag", "PASS"),
         ("primitives/nb_query.comp", "NB_STRATEGY"),
         ("primitives/nb_keys.comp", "NB_STRATEGY"),
         ("control/rays.frag", "PASS"),

@@ -442,6 +442,11 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             fields!(fluidform::scene::orbits::OrbitsPush; dt, strength, eps, n),
         ),
         (
+            "render/surface/cells.comp",
+            "Push",
+            fields!(fluidform::render::surface::SurfacePush; origin, dims, fluid, look),
+        ),
+        (
             "render/points.vert",
             "Push",
             fields!(fluidform::render::points::PointsPush; view_proj, right, up),

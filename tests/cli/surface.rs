@@ -81,6 +81,67 @@ fn exported_surfaces_are_closed_and_hold_the_fluids_volume() {
         head.contains("property list uchar int vertex_indices"),
         "{head}"
     );
+    // Read back as a PLY reader does, from the header's elements and properties: closed,
+    // and the particles' volume.
+    let read = read_ply(&bytes);
+    assert_eq!(read.open_edges(), 0, "the PLY surface is not closed");
+    let v = read.volume();
+    assert!(
+        (v / want - 1.0).abs() < 0.10,
+        "PLY volume {v} against {want}"
+    );
+}
+
+/// A binary little-endian PLY's vertices (x, y, z among float properties) and faces (a
+/// `list uchar int` property), laid out as its header declares.
+fn read_ply(bytes: &[u8]) -> Mesh {
+    let end = b"end_header\n";
+    let at = bytes
+        .windows(end.len())
+        .position(|w| w == end)
+        .expect("end_header")
+        + end.len();
+    let header = std::str::from_utf8(&bytes[..at]).unwrap();
+    let (mut vertices, mut faces, mut props) = (0usize, 0usize, Vec::new());
+    let mut element = "";
+    for line in header.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.as_slice() {
+            ["element", name, n] => {
+                element = if *name == "vertex" { "vertex" } else { "face" };
+                *(if *name == "vertex" {
+                    &mut vertices
+                } else {
+                    &mut faces
+                }) = n.parse().unwrap();
+            }
+            ["property", "float", name] if element == "vertex" => props.push(name.to_string()),
+            ["property", ty, ..] if element == "vertex" => panic!("vertex property of type {ty}"),
+            _ => {}
+        }
+    }
+    let f32_at = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    let xyz = ["x", "y", "z"].map(|a| props.iter().position(|p| p == a).expect(a));
+    let stride = 4 * props.len();
+    let positions = (0..vertices)
+        .map(|i| xyz.map(|k| f32_at(at + i * stride + 4 * k)))
+        .collect();
+    let mut o = at + vertices * stride;
+    let mut indices = Vec::new();
+    for _ in 0..faces {
+        assert_eq!(bytes[o], 3, "a face that is not a triangle");
+        for k in 0..3 {
+            let b = &bytes[o + 1 + 4 * k..o + 5 + 4 * k];
+            indices.push(i32::from_le_bytes(b.try_into().unwrap()) as u32);
+        }
+        o += 13;
+    }
+    assert_eq!(o, bytes.len(), "bytes left after the faces");
+    Mesh {
+        positions,
+        normals: Vec::new(),
+        indices,
+    }
 }
 
 #[test]

@@ -5,9 +5,6 @@
 // PASS 1: the fragment at the nearest depth writes its normal and the thickness along
 // its ray.
 #include "common.glsl"
-#ifndef PASS
-#define PASS 0
-#endif
 layout(location = 0) in vec3 world;
 layout(location = 1) in vec3 normal;
 layout(location = 2) flat in float facing;
@@ -16,7 +13,9 @@ void main() {
     uvec2 pix = uvec2(gl_FragCoord.xy);
     uint p = pix.y * P.width + pix.x;
     float z = max(view_depth(world), 0.0);
-#if PASS == 0
+#if !defined(PASS)
+#error "PASS is 0 (depth and thickness) or 1 (normals)"
+#elif PASS == 0
     atomicMin(zbits[p], floatBitsToUint(z));
     atomicAdd(thick[p], int(round(-facing * z * THICK_SCALE)));
 #elif PASS == 1
