@@ -1,6 +1,7 @@
 //! `bench render`: the thesis's rendering tables. A resting blob of N particles (2048 by
 //! default) at 512x512, every axis the tables vary from the switches: --list (all three
-//! when unset), --material, --density, --threshold, --radius, --refine, --depth.
+//! when unset), --material, --density, --threshold, --radius, --refine, --depth; or
+//! --surface screen-space|mesh (one row, no lists) on the same blob.
 use super::{measure, BenchOptions, Row};
 use crate::config::{ListKind, SurfaceKind};
 use crate::error::Result;

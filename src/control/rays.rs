@@ -110,16 +110,12 @@ impl RaysPlacer {
     pub fn new(ctx: &Context, grid: RaysGrid, capacity: u32, park: f32) -> Result<Self> {
         let graphics = |name: &str, pass: u32| -> Result<Guard<GraphicsPipeline<RaysIo>>> {
             let defines = [("PASS", pass.to_string())];
-            let desc = GraphicsDesc {
+            let desc = GraphicsDesc::storage_only(
                 name,
-                vertex: "control/rays.vert",
-                fragment: "control/rays.frag",
-                defines: &defines,
-                color_format: None,
-                depth_format: None,
-                blend: false,
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            };
+                "control/rays.vert",
+                "control/rays.frag",
+                &defines,
+            );
             Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
         };
         let count = graphics("rays count", 0)?;

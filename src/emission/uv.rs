@@ -97,16 +97,7 @@ impl UvSurface {
     ) -> Result<Self> {
         check_size(ctx, layout, size)?;
         let texels = size[0] as u64 * size[1] as u64;
-        let desc = GraphicsDesc {
-            name: "uv",
-            vertex: "emission/uv.vert",
-            fragment: "emission/uv.frag",
-            defines: &[],
-            color_format: None,
-            depth_format: None,
-            blend: false,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-        };
+        let desc = GraphicsDesc::storage_only("uv", "emission/uv.vert", "emission/uv.frag", &[]);
         let raster = Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?);
         let compute = |name, shader| -> Result<Guard<ComputePipeline<UvIo>>> {
             let d = ComputeDesc::plain(name, shader, &[], 64);

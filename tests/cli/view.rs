@@ -36,66 +36,75 @@ fn view_without_a_display_says_how_to_run_headless() {
     assert!(t.contains("fluidform run") && t.contains("xvfb-run"), "{t}");
 }
 
-#[test]
-fn view_frames_match_run_after_switch_flips() {
-    let dir = tempfile::tempdir().unwrap();
-    let shot = dir.path().join("view.png");
+/// Six frames of `scene` at 160 x 120 in the window with `flips` (`--at` commands, sent
+/// through the interface the keys use) against `run` with `switches`: the golden images'
+/// tolerance, 99% of pixels within 4/255. Returns the window's last frame.
+fn view_matches_run(
+    dir: &std::path::Path,
+    scene: &str,
+    flips: &[&str],
+    switches: &[&str],
+) -> image::RgbaImage {
+    let shot = dir.join("view.png");
     let size = ["--width", "160", "--height", "120"];
     let mut args = vec![
         "--scene",
-        "demo",
+        scene,
         "--frames",
         "6",
         "--validation",
         "--hide-panel",
     ];
     args.extend(size);
-    let shot_arg = shot.to_str().unwrap();
-    // The flips reach the frame loop through the commands the L and B keys send.
-    args.extend([
-        "--at",
-        "2:set list abuffer",
-        "--at",
-        "3:set density murakami",
-        "--screenshot",
-        shot_arg,
-    ]);
+    for f in flips {
+        args.extend(["--at", f]);
+    }
+    args.extend(["--screenshot", shot.to_str().unwrap()]);
     let o = view(&args);
     let t = text(&o);
     assert!(o.status.success(), "{t}");
     assert!(t.contains("view: 6 frames"), "{t}");
     assert!(!t.contains("[vulkan ERROR"), "{t}");
-    let out = dir.path().join("run");
+    assert_eq!(t.matches("view rebuilt").count(), flips.len(), "{t}");
+    let out = dir.join("run");
     let mut run = vec![
         "run",
         "--scene",
-        "demo",
+        scene,
         "--frames",
         "6",
         "--validation",
         "--quiet",
     ];
     run.extend(size);
-    run.extend(["--list", "abuffer", "--density", "murakami"]);
+    run.extend(switches);
     run.extend(["--out", out.to_str().unwrap()]);
     let o = fluidform(&run);
     assert!(o.status.success(), "{}", text(&o));
     let (a, b) = (rgba(&shot), rgba(&out.join("frame_0005.png")));
     assert_eq!(a.dimensions(), (160, 120));
     assert_eq!(a.dimensions(), b.dimensions());
-    // The golden images' tolerance: 99% of pixels within 4/255.
     let close = (a.pixels().zip(b.pixels()))
         .filter(|(p, q)| p.0.iter().zip(q.0).all(|(x, y)| x.abs_diff(y) <= 4))
         .count();
     let frac = close as f64 / (160.0 * 120.0);
     assert!(
         frac >= 0.99,
-        "only {frac:.4} of the pixels agree with run's frame"
+        "{scene} {flips:?}: only {frac:.4} of the pixels agree with run's frame"
     );
+    a
+}
+
+#[test]
+fn view_frames_match_run_after_switch_flips() {
+    let dir = tempfile::tempdir().unwrap();
+    let flips = ["2:set list abuffer", "3:set density murakami"];
+    let switches = ["--list", "abuffer", "--density", "murakami"];
+    let a = view_matches_run(dir.path(), "demo", &flips, &switches);
     // The density function changed the picture: the default's frame differs.
     let out2 = dir.path().join("plain");
     let mut plain = vec!["run", "--scene", "demo", "--frames", "6", "--quiet"];
-    plain.extend(size);
+    plain.extend(["--width", "160", "--height", "120"]);
     plain.extend(["--out", out2.to_str().unwrap()]);
     assert!(fluidform(&plain).status.success());
     assert_ne!(rgba(&out2.join("frame_0005.png")).as_raw(), a.as_raw());
@@ -104,41 +113,11 @@ fn view_frames_match_run_after_switch_flips() {
 #[test]
 fn view_switches_the_surface_live_as_run_draws_it() {
     let dir = tempfile::tempdir().unwrap();
-    let shot = dir.path().join("view.png");
-    let size = ["--width", "160", "--height", "120"];
-    let mut args = vec![
-        "--scene",
+    view_matches_run(
+        dir.path(),
         "drop",
-        "--frames",
-        "6",
-        "--validation",
-        "--hide-panel",
-    ];
-    args.extend(size);
-    args.extend([
-        "--at",
-        "2:set surface mesh",
-        "--screenshot",
-        shot.to_str().unwrap(),
-    ]);
-    let o = view(&args);
-    let t = text(&o);
-    assert!(o.status.success(), "{t}");
-    assert!(t.contains("--surface mesh: view rebuilt"), "{t}");
-    let out = dir.path().join("run");
-    let mut run = vec!["run", "--scene", "drop", "--frames", "6", "--quiet"];
-    run.extend(size);
-    run.extend(["--surface", "mesh", "--out", out.to_str().unwrap()]);
-    let o = fluidform(&run);
-    assert!(o.status.success(), "{}", text(&o));
-    let (a, b) = (rgba(&shot), rgba(&out.join("frame_0005.png")));
-    let close = (a.pixels().zip(b.pixels()))
-        .filter(|(p, q)| p.0.iter().zip(q.0).all(|(x, y)| x.abs_diff(y) <= 4))
-        .count();
-    let frac = close as f64 / (160.0 * 120.0);
-    assert!(
-        frac >= 0.99,
-        "only {frac:.4} of the pixels agree with run's mesh frame"
+        &["2:set surface mesh"],
+        &["--surface", "mesh"],
     );
 }
 

@@ -60,16 +60,12 @@ impl MetaballRenderer {
         };
         let graphics = |name: &str, pass: u32| -> Result<Guard<Graphics>> {
             let defines = refs(&[("PASS", pass.to_string())]);
-            let desc = GraphicsDesc {
+            let desc = GraphicsDesc::storage_only(
                 name,
-                vertex: "render/metaball/billboard.vert",
-                fragment: "render/metaball/billboard.frag",
-                defines: &defines,
-                color_format: None,
-                depth_format: None,
-                blend: false,
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            };
+                "render/metaball/billboard.vert",
+                "render/metaball/billboard.frag",
+                &defines,
+            );
             Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
         };
         let (count, fill) = match settings.list {

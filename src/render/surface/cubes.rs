@@ -33,16 +33,12 @@ impl Cubes {
         let raster = |name, pass: u32| -> Result<Guard<Graphics>> {
             let mut defines = super::scale_defines();
             defines.push(("PASS", pass.to_string()));
-            let desc = GraphicsDesc {
+            let desc = GraphicsDesc::storage_only(
                 name,
-                vertex: "render/surface/mesh.vert",
-                fragment: "render/surface/mesh.frag",
-                defines: &defines,
-                color_format: None,
-                depth_format: None,
-                blend: false,
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            };
+                "render/surface/mesh.vert",
+                "render/surface/mesh.frag",
+                &defines,
+            );
             Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
         };
         let depth = raster("mesh depth", 0)?;

@@ -17,16 +17,13 @@ pub struct ScreenSpace {
 
 impl ScreenSpace {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let splat = GraphicsDesc {
-            name: "splat",
-            vertex: "render/surface/splat.vert",
-            fragment: "render/surface/splat.frag",
-            defines: &super::scale_defines(),
-            color_format: None,
-            depth_format: None,
-            blend: false,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-        };
+        let defines = super::scale_defines();
+        let splat = GraphicsDesc::storage_only(
+            "splat",
+            "render/surface/splat.vert",
+            "render/surface/splat.frag",
+            &defines,
+        );
         let splat = Guard::new(ctx, GraphicsPipeline::new(ctx, &splat)?);
         let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
             let defines = super::scale_defines();
