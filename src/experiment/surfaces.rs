@@ -97,7 +97,7 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let mut md = format!(
         "# Surfaces: metaballs, screen-space fluid, marching cubes\n\n\
          Each scene played once per surface (`fluidform run --scene S --surface K --width \
-         {side} --height {side}`, the scene's material; metaballs with the S-buffer), the same \
+         {side} --height {side}`, the scene's material; metaballs with the S-buffer, sorted for glass and tinted as by default), the same \
          simulation each time. GPU medians per frame of the `render` scope and its passes; \
          memory: the renderer's buffers (`memory_bytes` of summary.json); the last frame of \
          each, left to right in the table's order.\n\n\

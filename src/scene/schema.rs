@@ -97,6 +97,8 @@ pub struct Look {
     pub tank: Option<bool>,
     /// Metaballs (default) or points (coloured by particle, as groups need).
     pub render: Option<crate::config::RenderKind>,
+    /// The fluid's surface under metaballs rendering (`--surface`).
+    pub surface: Option<crate::config::SurfaceKind>,
 }
 
 impl Look {
@@ -105,6 +107,11 @@ impl Look {
         let mut sw = sw.clone();
         if sw.metaball.material.is_none() {
             sw.metaball.material = self.material;
+        }
+        if sw.metaball.surface.is_none()
+            && sw.view.render.or(self.render) != Some(crate::config::RenderKind::Points)
+        {
+            sw.metaball.surface = self.surface;
         }
         if let Some([w, h]) = self.size {
             sw.frame.width = sw.frame.width.or(Some(w));

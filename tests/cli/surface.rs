@@ -179,6 +179,24 @@ fn the_other_surfaces_draw_and_refuse_what_they_do_not_use() {
         }
         assert!(out.join("frame_0001.png").exists());
     }
+    // A scene's [look] picks the surface; the switch overrides it.
+    let scene = dir.path().join("look.toml");
+    std::fs::write(
+        &scene,
+        "name = \"look\"\nframes = 1\n[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 0.5]\n\
+         [[blocks]]\nmin = [0.1, 0.0, 0.1]\nmax = [0.3, 0.2, 0.3]\n\
+         [look]\nsurface = \"mesh\"\nsize = [64, 48]\n",
+    )
+    .unwrap();
+    for (extra, want) in [(None, "mesh"), (Some("screen-space"), "screen-space")] {
+        let out = dir.path().join(format!("look-{want}"));
+        let mut a = vec!["run", "--scene", scene.to_str().unwrap(), "--quiet"];
+        a.extend(extra.map(|k| ["--surface", k]).into_iter().flatten());
+        a.extend(["--out", out.to_str().unwrap()]);
+        let o = fluidform(&a);
+        assert!(o.status.success(), "{}", text(&o));
+        assert_eq!(summary(&out)["stats"]["render"]["renderer"], want);
+    }
     for (args, why) in [
         (
             &["--surface", "mesh", "--list", "abuffer"][..],
