@@ -3,13 +3,11 @@
 //! appended to a soup whose count drives an indirect draw, and the soup rasterised into
 //! the G-buffer in two passes (nearest depth and thickness, then the nearest fragment's
 //! interpolated normal). Checked against `crate::surface::march` on the same grid.
-use super::{SurfaceBuffers, SurfaceBufs, SurfaceIo, SurfacePush};
+use super::{compute_pass, raster_pass, Rec, SurfaceIo};
 use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::track::BufferUse;
-use crate::gpu::{
-    ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
-};
+use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, Scopes};
 use ash::vk;
 
 type Graphics = GraphicsPipeline<SurfaceIo>;
@@ -23,26 +21,11 @@ pub struct Cubes {
 
 impl Cubes {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
-            let defines = super::scale_defines();
-            let desc = ComputeDesc::plain(name, shader, &defines, 64);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
-        };
-        let density = compute("density", "render/surface/density.comp")?;
-        let cells = compute("cells", "render/surface/cells.comp")?;
-        let raster = |name, pass: u32| -> Result<Guard<Graphics>> {
-            let mut defines = super::scale_defines();
-            defines.push(("PASS", pass.to_string()));
-            let desc = GraphicsDesc::storage_only(
-                name,
-                "render/surface/mesh.vert",
-                "render/surface/mesh.frag",
-                &defines,
-            );
-            Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
-        };
-        let depth = raster("mesh depth", 0)?;
-        let normals = raster("mesh normals", 1)?;
+        let density = compute_pass(ctx, "density", "render/surface/density.comp")?;
+        let cells = compute_pass(ctx, "cells", "render/surface/cells.comp")?;
+        let shaders = ("render/surface/mesh.vert", "render/surface/mesh.frag");
+        let depth = raster_pass(ctx, "mesh depth", shaders, Some(0))?;
+        let normals = raster_pass(ctx, "mesh normals", shaders, Some(1))?;
         Ok(Self {
             density: density.take(),
             cells: cells.take(),
@@ -50,20 +33,17 @@ impl Cubes {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
-        bufs: &SurfaceBufs,
-        push: &SurfacePush,
-        b: &SurfaceBuffers,
-        n: u32,
+        r: &Rec,
     ) -> Result<()> {
+        let (bufs, push, b) = (&r.bufs, &r.push, r.b);
         scopes.begin(ctx, cmd, "density");
         ctx.fill(cmd, &b.grid, 0);
-        self.density.dispatch(ctx, cmd, bufs, push, n as u64);
+        self.density.dispatch(ctx, cmd, bufs, push, r.n as u64);
         scopes.end(ctx, cmd);
         scopes.begin(ctx, cmd, "cells");
         ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0]);

@@ -11,7 +11,9 @@ pub mod screen;
 pub use buffers::SurfaceBuffers;
 
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{
+    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
+};
 use crate::kinds::SurfaceKind;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
@@ -92,6 +94,35 @@ impl SurfaceFluid {
 
 type Compute = ComputePipeline<SurfaceIo>;
 
+/// A compute pass of the surfaces (the fixed-point scales defined).
+fn compute_pass<'c>(ctx: &'c Context, name: &str, shader: &str) -> Result<Guard<'c, Compute>> {
+    let defines = scale_defines();
+    let desc = ComputeDesc::plain(name, shader, &defines, 64);
+    Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
+}
+
+/// A pass drawing into no attachment (the scales and, if given, PASS defined).
+fn raster_pass<'c>(
+    ctx: &'c Context,
+    name: &str,
+    (vertex, fragment): (&str, &str),
+    pass: Option<u32>,
+) -> Result<Guard<'c, GraphicsPipeline<SurfaceIo>>> {
+    let mut defines = scale_defines();
+    defines.extend(pass.map(|p| ("PASS", p.to_string())));
+    let desc = GraphicsDesc::storage_only(name, vertex, fragment, &defines);
+    Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
+}
+
+/// What every pass of a frame's surface records with: its buffers, push constants and the
+/// particle count.
+pub(super) struct Rec<'a> {
+    bufs: SurfaceBufs<'a>,
+    push: SurfacePush,
+    b: &'a SurfaceBuffers,
+    n: u32,
+}
+
 /// The buffers of the metaball renderer a surface reads and writes (parameters, counters,
 /// picture, sky, opaque layer, scene depth) and the frame's particles.
 pub struct Frame<'a> {
@@ -169,16 +200,20 @@ impl Surface {
         b: &SurfaceBuffers,
         n: u32,
     ) -> Result<()> {
-        let bufs = f.bufs(b);
-        let push = b.push();
+        let r = Rec {
+            bufs: f.bufs(b),
+            push: b.push(),
+            b,
+            n,
+        };
         if let Some(s) = &self.screen {
-            s.record(ctx, cmd, scopes, &bufs, &push, b, n);
+            s.record(ctx, cmd, scopes, &r);
         }
         if let Some(c) = &self.cubes {
-            c.record(ctx, cmd, scopes, &bufs, &push, b, n)?;
+            c.record(ctx, cmd, scopes, &r)?;
         }
         scopes.begin(ctx, cmd, "shade");
-        self.shade.dispatch(ctx, cmd, &bufs, &push, b.pixels);
+        self.shade.dispatch(ctx, cmd, &r.bufs, &r.push, b.pixels);
         scopes.end(ctx, cmd);
         Ok(())
     }

@@ -1,12 +1,10 @@
 //! Screen-space fluid (van der Laan, Green & Sainz 2009): particles splatted as spheres
 //! into the nearest depth and an additive thickness, a separable bilateral filter of the
 //! depth (x, then y), and normals from the smoothed depth into the G-buffer.
-use super::{SurfaceBuffers, SurfaceBufs, SurfaceIo, SurfacePush};
+use super::{compute_pass, raster_pass, Rec, SurfaceIo};
 use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
-use crate::gpu::{
-    ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
-};
+use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, Scopes};
 use ash::vk;
 
 pub struct ScreenSpace {
@@ -17,21 +15,10 @@ pub struct ScreenSpace {
 
 impl ScreenSpace {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let defines = super::scale_defines();
-        let splat = GraphicsDesc::storage_only(
-            "splat",
-            "render/surface/splat.vert",
-            "render/surface/splat.frag",
-            &defines,
-        );
-        let splat = Guard::new(ctx, GraphicsPipeline::new(ctx, &splat)?);
-        let compute = |name, shader| -> Result<Guard<ComputePipeline<SurfaceIo>>> {
-            let defines = super::scale_defines();
-            let desc = ComputeDesc::plain(name, shader, &defines, 64);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
-        };
-        let smooth = compute("smooth", "render/surface/smooth.comp")?;
-        let normals = compute("normals", "render/surface/normals.comp")?;
+        let shaders = ("render/surface/splat.vert", "render/surface/splat.frag");
+        let splat = raster_pass(ctx, "splat", shaders, None)?;
+        let smooth = compute_pass(ctx, "smooth", "render/surface/smooth.comp")?;
+        let normals = compute_pass(ctx, "normals", "render/surface/normals.comp")?;
         Ok(Self {
             splat: splat.take(),
             smooth: smooth.take(),
@@ -39,17 +26,14 @@ impl ScreenSpace {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
-        bufs: &SurfaceBufs,
-        push: &SurfacePush,
-        b: &SurfaceBuffers,
-        n: u32,
+        r: &Rec,
     ) {
+        let (bufs, push, b, n) = (&r.bufs, &r.push, r.b, r.n);
         let px = b.pixels;
         scopes.begin(ctx, cmd, "splat");
         ctx.fill(cmd, &b.zbits, u32::MAX);
