@@ -245,3 +245,36 @@ fn every_surface_covers_what_the_metaballs_cover() {
     }
     common::finish(&ctx);
 }
+
+#[test]
+fn an_overflowing_soup_grows_and_the_frame_is_redone() {
+    let ctx = common::ctx();
+    let (pts, cam) = blob_scene();
+    let mut centers = ctx
+        .storage_buffer("centers", pts.len() as u64 * 16)
+        .unwrap();
+    ctx.upload(&mut centers, 0, &pts).unwrap();
+    let r = MetaballRenderer::new(&ctx, settings(SurfaceKind::Mesh)).unwrap();
+    let mut b = r.buffers(&ctx, pts.len() as u64, 1, false).unwrap();
+    // Room for 10 triangles: the frame overflows, the soup grows to fit and it is redone.
+    b.surface.as_mut().unwrap().capacity = 30;
+    let (st, redos) = r
+        .render_sync(&ctx, &mut b, &centers, pts.len() as u32, &cam, 0)
+        .unwrap();
+    assert!(redos >= 1, "no redo");
+    assert_eq!(st.overflow, 0);
+    let sb = b.surface.as_ref().unwrap();
+    assert!(
+        sb.capacity >= 3 * st.triangles,
+        "{} < 3 x {}",
+        sb.capacity,
+        st.triangles
+    );
+    assert_eq!(sb.soup(&ctx).unwrap().len() as u64, 3 * st.triangles);
+    assert!(st.triangles > 100, "{} triangles", st.triangles);
+    b.destroy(&ctx);
+    let mut r = r;
+    r.destroy(&ctx);
+    ctx.destroy_buffer(&mut centers);
+    common::finish(&ctx);
+}
