@@ -29,6 +29,9 @@ void main() {
     ivec3 cells = dims() - 1;
     if (id >= uint(cells.x * cells.y * cells.z)) return;
     ivec3 c = ivec3(id % uint(cells.x), id / uint(cells.x) % uint(cells.y), id / uint(cells.x * cells.y));
+    // A cell with no node a particle reached has no density: below the level, empty.
+    uvec3 lo = uvec3(args[4], args[5], args[6]), hi = uvec3(args[7], args[8], args[9]);
+    if (any(lessThan(uvec3(c) + 1u, lo)) || any(greaterThan(uvec3(c), hi))) return;
     float iso = pc.look.x;
     float v[8];
     uint mask = 0u;

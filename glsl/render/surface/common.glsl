@@ -29,7 +29,8 @@ layout(std430, binding = SF_B_GRID) buffer Grid { uint grid[]; };
 layout(std430, binding = SF_B_CASES) readonly buffer Cases { uint cases[]; };
 // Triangle soup: per vertex (position, 1), (unit normal out of the fluid, 0).
 layout(std430, binding = SF_B_VERTS) buffer Verts { vec4 verts[]; };
-// VkDrawIndirectCommand of the mesh: vertex count (atomic), 1, 0, 0.
+// VkDrawIndirectCommand of the mesh: vertex count (atomic), 1, 0, 0; then the lowest and
+// highest grid node any particle reached (atomicMin, atomicMax: x, y, z each).
 layout(std430, binding = SF_B_ARGS) buffer Args { uint args[]; };
 layout(push_constant) uniform Push {
     vec4 origin;  // grid origin xyz, w = cell

@@ -129,7 +129,7 @@ impl SurfaceBuffers {
         let table = case_table();
         let mut cases = buf("case table", only(mesh, table.len() as u64 * 4))?;
         let verts = buf("triangle soup", only(mesh, capacity * VERTEX_BYTES))?;
-        let args = Guard::new(ctx, ctx.indirect_buffer("surface draw args", 16)?);
+        let args = Guard::new(ctx, ctx.indirect_buffer("surface draw args", 40)?);
         if mesh {
             ctx.upload(&mut cases, 0, &table)?;
         }

@@ -43,10 +43,12 @@ impl Cubes {
         let (bufs, push, b) = (&r.bufs, &r.push, r.b);
         scopes.begin(ctx, cmd, "density");
         ctx.fill(cmd, &b.grid, 0);
+        // The draw's arguments, then the box of nodes reached (empty).
+        let m = u32::MAX;
+        ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0, m, m, m, 0, 0, 0]);
         self.density.dispatch(ctx, cmd, bufs, push, r.n as u64);
         scopes.end(ctx, cmd);
         scopes.begin(ctx, cmd, "cells");
-        ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0]);
         self.cells.dispatch(ctx, cmd, bufs, push, b.shape.cells());
         scopes.end(ctx, cmd);
         scopes.begin(ctx, cmd, "raster");
