@@ -382,28 +382,6 @@ pub struct GraphicsDesc<'a> {
     pub topology: vk::PrimitiveTopology,
 }
 
-impl<'a> GraphicsDesc<'a> {
-    /// Triangles into no attachment: the fragment shader only writes storage buffers
-    /// (per-pixel lists, splats, G-buffers), drawn in `begin_empty_rendering`.
-    pub fn storage_only(
-        name: &'a str,
-        vertex: &'a str,
-        fragment: &'a str,
-        defines: &'a [(&'a str, String)],
-    ) -> Self {
-        Self {
-            name,
-            vertex,
-            fragment,
-            defines,
-            color_format: None,
-            depth_format: None,
-            blend: false,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-        }
-    }
-}
-
 /// A graphics pipeline of interface `I` (both stages checked against it).
 pub struct GraphicsPipeline<I: Interface> {
     pub pipeline: vk::Pipeline,
