@@ -222,10 +222,10 @@ impl ParticleExport {
         f: crate::config::MeshFormat,
     ) -> Result<PathBuf> {
         use crate::config::MeshFormat;
-        use crate::surface::{density_grid, files, march};
+        use crate::surface::{density_grid, files, march, ISO};
         let (h, rest, spacing) = self.fluid;
         let pos: Vec<[f32; 3]> = snap.pos.iter().map(|p| [p[0], p[1], p[2]]).collect();
-        let mesh = march(&density_grid(&pos, h, self.mass, rest, 0.5 * spacing), 0.5);
+        let mesh = march(&density_grid(&pos, h, self.mass, rest, 0.5 * spacing), ISO);
         let path = self.out.join(match f {
             MeshFormat::Obj => format!("surface_{frame:04}.obj"),
             MeshFormat::Ply => format!("surface_{frame:04}.ply"),

@@ -7,3 +7,7 @@ pub mod files;
 pub mod table;
 
 pub use cubes::{density_grid, density_on, march, Grid, Mesh};
+
+/// The fluid's surface level: half the rest density (the mesh export's and the GPU
+/// marching cubes').
+pub const ISO: f32 = 0.5;

@@ -53,8 +53,7 @@ pub struct SurfaceFluid {
     pub bounds: [[f32; 3]; 2],
 }
 
-/// The marching cubes' iso level: half the rest density, as the mesh export's.
-pub const ISO: f32 = 0.5;
+pub use crate::surface::ISO;
 /// Fixed point of the density grid (atomic adds of the density over the rest density).
 pub const GRID_SCALE: f32 = 4194304.0;
 /// Fixed point of the thickness (per metre).
