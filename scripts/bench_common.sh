@@ -1,6 +1,6 @@
 # Sourced by the bench_*.sh scripts: picks the binary (FLUIDFORM_BIN, else a release
 # build), splits --device from the bench switches, and names the results folder.
-# Sets: bin, dev (array), args (array), slug, dir.
+# Sets: bin, dev (array), args (array), slug, dir (FLUIDFORM_RESULTS, else results/<slug>).
 bin=${FLUIDFORM_BIN:-}
 if [ -z "$bin" ]; then
   cargo build --release --quiet
@@ -18,5 +18,5 @@ done
 [[ " ${args[*]} " == *" --frames "* ]] || args+=(--frames 20)
 [[ " ${args[*]} " == *" --warmup "* ]] || args+=(--warmup 3)
 slug=$("$bin" devices --slug "${dev[@]}")
-dir=results/$slug
+dir=${FLUIDFORM_RESULTS:-results/$slug}
 mkdir -p "$dir"

@@ -2,12 +2,25 @@
 # Regenerate results/<device-slug>/render.md: the thesis's rendering setup (2048 particles
 # in a resting blob, 512x512, Wyvill, T = 0.9, R = 0.04, I = 2) for none, A-buffer and
 # S-buffer, with Phong and with glass at recursion depth 3.
-# Usage: scripts/bench_render.sh [--device N|NAME] [--frames N]
+# Usage: scripts/bench_render.sh [--device N|NAME] [--frames N] [--particles N]
+#        [--width W] [--height H] (the last three shrink the setup, e.g. for a quick check)
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/bench_common.sh "$@"
-setup=(--particles 2048 --width 512 --height 512 --density wyvill --threshold 0.9 --radius 0.04 --refine 2)
+n=2048 w=512 h=512
+rest=()
+set -- "${args[@]}"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --particles) n=$2; shift 2 ;;
+    --width) w=$2; shift 2 ;;
+    --height) h=$2; shift 2 ;;
+    *) rest+=("$1"); shift ;;
+  esac
+done
+args=("${rest[@]}")
+setup=(--particles "$n" --width "$w" --height "$h" --density wyvill --threshold 0.9 --radius 0.04 --refine 2)
 phong=("$bin" bench render --out out/bench/render-phong "${setup[@]}" --material phong "${dev[@]}" "${args[@]}")
 glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material glass --depth 3 "${dev[@]}" "${args[@]}")
 "${phong[@]}" > /dev/null

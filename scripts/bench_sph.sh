@@ -1,19 +1,27 @@
 #!/usr/bin/env bash
 # Regenerate results/<device-slug>/sph.md: SPH steps per second and per-pass ms for every
 # neighbour strategy over N = 8K..1M, and the 32K dam-break stability run (10 000 steps).
-# Usage: scripts/bench_sph.sh [--device N|NAME] [--frames N]
+# Usage: scripts/bench_sph.sh [--device N|NAME] [--frames N] [--particles N] [--skip-stability]
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+skip=0
+pass=()
+for a in "$@"; do
+  case "$a" in
+    --skip-stability) skip=1 ;;
+    *) pass+=("$a") ;;
+  esac
+done
+source scripts/bench_common.sh "${pass[@]}"
 md=$dir/sph.md
 sweep=("$bin" bench sph --out out/bench/sph "${dev[@]}" "${args[@]}")
 stab=("$bin" bench stability --out out/bench/stability "${dev[@]}")
 "${sweep[@]}" > /dev/null
-"${stab[@]}" > /dev/null
+[ "$skip" = 1 ] || "${stab[@]}" > /dev/null
 cp out/bench/sph/sweep.csv "$dir/sph.csv"
 cp out/bench/sph/sweep.png "$dir/sph.png"
-cp out/bench/stability/stability.json "$dir/stability.json"
+[ "$skip" = 1 ] || cp out/bench/stability/stability.json "$dir/stability.json"
 {
   echo "# SPH on $slug"
   echo
@@ -22,7 +30,7 @@ cp out/bench/stability/stability.json "$dir/stability.json"
   echo "Made by \`scripts/bench_sph.sh ${*}\`, which runs:"
   echo
   echo "    fluidform ${sweep[*]:1}"
-  echo "    fluidform ${stab[*]:1}"
+  [ "$skip" = 1 ] || echo "    fluidform ${stab[*]:1}"
   echo
   echo "## Steps: the dam break scaled to N, one step per repetition"
   echo
@@ -32,8 +40,12 @@ cp out/bench/stability/stability.json "$dir/stability.json"
   echo
   echo "## Stability: the 32K dam break for 10 000 steps"
   echo
-  cat out/bench/stability/sweep.md
-  echo
-  echo "Checkpoints (every 1000 steps) are in stability.json."
+  if [ "$skip" = 1 ]; then
+    echo "Not run (--skip-stability)."
+  else
+    cat out/bench/stability/sweep.md
+    echo
+    echo "Checkpoints (every 1000 steps) are in stability.json."
+  fi
 } > "$md"
 echo "wrote $md"

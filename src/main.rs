@@ -103,7 +103,8 @@ enum Command {
         json: bool,
     },
     /// Reproduce a table or figure of the papers: table2..table8, fig9, adaptive,
-    /// scaling, or all; writes <out>/<name>.csv, .md, .png and findings.md
+    /// scaling, fidelity, surfaces, or all (list: their names); writes <out>/<name>.csv,
+    /// .md, .png and findings.md
     Experiment {
         name: String,
         /// Output directory (default results/<device-slug>)
@@ -114,6 +115,13 @@ enum Command {
         quick: bool,
         #[command(flatten)]
         common: fluidform::config::CommonArgs,
+    },
+    /// Every device's results side by side: each table's numbers per device beside the
+    /// paper's, and each finding's verdict per device; writes <results>/devices.md
+    Compare {
+        /// The folder with one results folder per device
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
     },
 }
 
@@ -484,6 +492,10 @@ fn real_main() -> Result<()> {
             quick,
             common,
         } => {
+            if name == "list" {
+                println!("{}", fluidform::experiment::NAMES.join("\n"));
+                return Ok(());
+            }
             if common.particles.is_some() {
                 bail!("experiment: --particles is not used (each experiment sets its own counts)");
             }
@@ -498,6 +510,11 @@ fn real_main() -> Result<()> {
             for f in &files {
                 println!("wrote {}", f.display());
             }
+            Ok(())
+        }
+        Command::Compare { results } => {
+            let p = fluidform::experiment::compare::write_devices(&results)?;
+            println!("wrote {}", p.display());
             Ok(())
         }
     }

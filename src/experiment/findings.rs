@@ -4,7 +4,7 @@
 use super::{io, write, Env, NAMES};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub const ORDER: &str = "S-buffer faster than A-buffer faster than none in every row";
 pub const MEMORY: &str = "S-buffer memory below the A-buffer's";
@@ -55,13 +55,14 @@ impl Finding {
     }
 }
 
+/// One experiment's `<name>.findings.json`.
 #[derive(Serialize, Deserialize)]
-struct Saved {
-    experiment: String,
-    quick: bool,
-    device: String,
-    date: String,
-    findings: Vec<Finding>,
+pub struct Saved {
+    pub experiment: String,
+    pub quick: bool,
+    pub device: String,
+    pub date: String,
+    pub findings: Vec<Finding>,
 }
 
 /// Save `<name>.findings.json` with the run's device, date and mode.
@@ -77,11 +78,11 @@ pub fn save(env: &Env, name: &str, found: &[Finding]) -> Result<()> {
     write(&env.out.join(format!("{name}.findings.json")), &text)
 }
 
-/// findings.md from every `<name>.findings.json` in the output directory.
-pub fn rebuild(env: &Env) -> Result<PathBuf> {
+/// Every experiment's saved findings in `dir`, in `NAMES` order.
+pub fn load(dir: &Path) -> Result<Vec<Saved>> {
     let mut saved = Vec::new();
     for name in NAMES {
-        let p = env.out.join(format!("{name}.findings.json"));
+        let p = dir.join(format!("{name}.findings.json"));
         if !p.exists() {
             continue;
         }
@@ -90,6 +91,28 @@ pub fn rebuild(env: &Env) -> Result<PathBuf> {
             .map_err(|e| Error::Param(format!("{}: {e}", p.display())))?;
         saved.push(s);
     }
+    Ok(saved)
+}
+
+/// A claim's verdict over the experiments that measure it: refuted where any refutes it.
+pub fn overall<'a>(verdicts: impl IntoIterator<Item = &'a Verdict>) -> Verdict {
+    let measured: Vec<Verdict> = verdicts
+        .into_iter()
+        .copied()
+        .filter(|v| *v != Verdict::NotMeasured)
+        .collect();
+    if measured.is_empty() {
+        Verdict::NotMeasured
+    } else if measured.contains(&Verdict::Refuted) {
+        Verdict::Refuted
+    } else {
+        Verdict::Confirmed
+    }
+}
+
+/// findings.md from every `<name>.findings.json` in the output directory.
+pub fn rebuild(env: &Env) -> Result<PathBuf> {
+    let saved = load(&env.out)?;
     let mut claims: Vec<String> = Vec::new();
     for s in &saved {
         for f in &s.findings {
@@ -101,7 +124,8 @@ pub fn rebuild(env: &Env) -> Result<PathBuf> {
     let mut md = format!(
         "# The papers' findings on {}\n\nWritten by `fluidform experiment`: each claim of the \
          papers, confirmed or refuted by the experiments that measure it (their tables are \
-         beside this file). A claim is refuted where any experiment refutes it.\n\n",
+         beside this file). A claim is refuted where any experiment refutes it. Every device's \
+         verdicts side by side: `fluidform compare` writes them to ../devices.md.\n\n",
         env.meta.device
     );
     for c in &claims {
@@ -114,17 +138,7 @@ pub fn rebuild(env: &Env) -> Result<PathBuf> {
                     .map(move |f| (s, f))
             })
             .collect();
-        let measured: Vec<_> = all
-            .iter()
-            .filter(|(_, f)| f.verdict != Verdict::NotMeasured)
-            .collect();
-        let overall = if measured.is_empty() {
-            Verdict::NotMeasured
-        } else if measured.iter().any(|(_, f)| f.verdict == Verdict::Refuted) {
-            Verdict::Refuted
-        } else {
-            Verdict::Confirmed
-        };
+        let overall = overall(all.iter().map(|(_, f)| &f.verdict));
         md.push_str(&format!("## {c}: **{}**\n\n", overall.word()));
         for (s, f) in all {
             md.push_str(&format!(

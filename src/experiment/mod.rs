@@ -3,6 +3,7 @@
 //! beside ours, and its verdicts on the papers' findings into `<name>.findings.json`, from
 //! which `findings.md` is rebuilt (so single experiments and `all` leave the same file).
 pub mod adaptive;
+pub mod compare;
 pub mod fidelity;
 pub mod findings;
 pub mod measure;
