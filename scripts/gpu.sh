@@ -6,7 +6,7 @@
 #   dam break for 3 simulated seconds, rendering off 10%; then the steps that were cut run
 #   again with what is left, if that is at least twice their first share; 3% for the pages.
 # A step that would overrun its share is cut (killed at it) or skipped, with a line saying so.
-# Writes <out> (default results/<device-slug>/): every table, findings.md, character.md,
+# Writes <out> (default results/<device-slug>/, with --quick out/gpu-quick/<slug>/): every table, findings.md, character.md,
 # dambreak.md and gpu.md (what each step took); then devices.md beside it (every device
 # side by side). Logs go to out/gpu/ (FLUIDFORM_LOGS).
 # Usage: scripts/gpu.sh [--device D] [--budget-s S] [--quick] [--out DIR] [--validation]
@@ -49,7 +49,8 @@ if [ ! -e ../shared/assets ] && [ -d .gpu/assets ]; then
 fi
 
 slug=$("$bin" devices --slug "${dev[@]}") || { echo "gpu.sh: no usable Vulkan device" >&2; exit 1; }
-[ -n "$out" ] || out=results/$slug
+# A quick run never lands on a device's committed results.
+[ -n "$out" ] || out=$([ $quick = 1 ] && echo out/gpu-quick || echo results)/$slug
 logs=${FLUIDFORM_LOGS:-out/gpu}
 mkdir -p "$out" "$logs"
 export FLUIDFORM_RESULTS=$out
