@@ -129,7 +129,7 @@ done
 if [ $quick = 1 ]; then
   ch=(--width 160 --height 90 --particles 4096 --frames 6 --save-every 3)
 else
-  ch=(--width 1280 --height 720 --particles 65536 --save-every 50)
+  ch=(--width 1280 --height 720 --particles 65536 --save-every 199)  # its first and last frames
 fi
 cmd=("$bin" run --scene character "${ch[@]}" --out "$logs/character" --quiet "${dev[@]}" "${val[@]}")
 rm -rf "$logs/character"

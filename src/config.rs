@@ -141,6 +141,10 @@ pub struct MetaballArgs {
     /// Marching-cubes cell of --surface mesh, in rest particle spacings (default 0.5)
     #[arg(long, value_name = "F")]
     pub mesh_cell: Option<f32>,
+    /// The primary rays' march: every sample of the fixed step (the thesis's, default), or
+    /// lipschitz: samples the field's Lipschitz bound proves outside are skipped (same hits)
+    #[arg(long, value_enum)]
+    pub march: Option<MarchKind>,
 }
 
 /// Camera of rendered scenes.

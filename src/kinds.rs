@@ -90,4 +90,12 @@ switch_enum!(
     }
 );
 switch_enum!(ShowMesh { Off, Shaded, Wire });
+switch_enum!(
+    /// The metaball march's step: the thesis's fixed grid, or the same grid with the samples
+    /// skipped that the summed field's Lipschitz bound proves on the ray's side.
+    MarchKind {
+        Fixed,
+        Lipschitz
+    }
+);
 pub(crate) use switch_enum;

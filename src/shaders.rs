@@ -188,8 +188,12 @@ fn metaballs(v: &mut Vec<Variant>) {
             for density in DensityFn::value_variants() {
                 for sorted in [false, true] {
                     let d = MetaballSettings::defines_for(list, *density, material, sorted);
+                    for march in crate::kinds::MarchKind::value_variants() {
+                        let mut d = d.clone();
+                        d.extend(MetaballSettings::march_defines(*march));
+                        v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                    }
                     for f in [
-                        "render/metaball/march.comp",
                         "render/metaball/depths.comp",
                         "render/metaball/sort_lists.comp",
                     ] {

@@ -410,6 +410,7 @@ fn a_variant_switch_with_an_unknown_value_fails_to_compile() {
         ("render/metaball/march.comp", "DENSITY"),
         ("render/metaball/march.comp", "LIST"),
         ("render/metaball/march.comp", "MATERIAL"),
+        ("render/metaball/march.comp", "MARCH"),
         ("render/metaball/billboard.frag", "PASS"),
         ("render/surface/shade.comp", "MATERIAL"),
         ("render/surface/mesh.frag", "PASS"),

@@ -358,7 +358,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             "RenderStats",
             fields!(GpuStats;
             abuffer_nodes, longest, overflow, offscreen_samples, sbuffer_fragments,
-            budget_pixels, triangles, pad1),
+            budget_pixels, triangles, rays, steps, evals, candidates),
         ),
         (
             "control/force.comp",

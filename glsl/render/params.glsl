@@ -38,6 +38,10 @@ struct RenderStats {
     uint sbuffer_fragments;  // S-buffer total (copied from the scan)
     uint budget_pixels;      // pixels whose loops were cut short
     uint triangles;          // marching cubes: triangles made (surface/cells.comp)
-    uint pad1;
+    uint rays;               // rays marched, primary and secondary
+    // The march's per-ray counters, 64-bit totals as (lo, hi) (march.comp's add64).
+    uvec2 steps;       // samples taken, refinement included
+    uvec2 evals;       // metaball terms summed (field and gradient)
+    uvec2 candidates;  // metaballs the primary rays' lists offer (none: every one)
 };
 #endif

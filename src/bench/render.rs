@@ -67,6 +67,8 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     })?;
                 let after = r.frame_stats(&b, 0);
                 let cut = after.budget_pixels.max(st.budget_pixels);
+                // The march's per-ray counters of the last timed frame, per pixel.
+                let per_px = after.march.per_pixel(settings.pixels());
                 row.extra = vec![
                     ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
                     (
@@ -75,6 +77,9 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     ),
                     ("fragments".into(), st.fragments.to_string()),
                     ("longest list".into(), st.longest.to_string()),
+                    ("steps/px".into(), format!("{:.1}", per_px.0)),
+                    ("evals/px".into(), format!("{:.0}", per_px.1)),
+                    ("candidates/px".into(), format!("{:.1}", per_px.2)),
                     ("redos".into(), redos.to_string()),
                     (
                         "overflow in timed frames".into(),

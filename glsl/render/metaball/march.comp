@@ -1,5 +1,6 @@
 #version 450
 #extension GL_EXT_control_flow_attributes : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 // Ray marching through the metaball field, one invocation per pixel. The primary ray
 // marches the depth interval covered by the spheres of its pixel's list (LIST none: the
 // fluid's bounds), sums only those metaballs, refines the hit by bisection and takes the
@@ -12,11 +13,16 @@
 const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
 uint longest = 0u;
+// Per-ray counters (summed over the subgroup, then added to stats as 64-bit totals).
+uint n_rays = 0u, n_steps = 0u, n_evals = 0u, n_candidates = 0u;
 // llvmpipe stops a batch's loops after about 65535 iterations in total (hang protection);
 // every later loop then exits at once. Each loop below checks on exit that it ended by
 // its own condition (CUT_UNLESS, the negated loop condition); pixels where one did not are counted in stats.budget_pixels, so a
 // cut-short frame is reported, never silently wrong. Never set on a real GPU.
 bool cut = false;
+// --march lipschitz: the sorted S-buffer's depth window widened by this, so the sums also
+// count the metaballs that can reach the next stretch of the ray (field_reach).
+float reach_extra = 0.0;
 #define CUT_UNLESS(ended) if (!(ended)) cut = true;
 
 // Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Several
@@ -31,7 +37,7 @@ bool cut = false;
             [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) { \
                 uint j_ = b_ + u_; \
                 vec4 c_ = j_ < P.n ? centers[j_] : vec4(-1.0); \
-                if (c_.w >= 0.0) { vec3 d = x - c_.xyz; ACC += TERM; } } } \
+                if (c_.w >= 0.0) { vec3 d = x - c_.xyz; ACC += TERM; n_evals++; } } } \
         CUT_UNLESS(!(b_ < P.n)) \
     } else { SUM_LIST(x, p, ACC, TERM) } }
 #if LIST == LIST_ABUFFER
@@ -39,7 +45,7 @@ bool cut = false;
     uint n_ = heads[p]; \
     for (; n_ != NIL;) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
-            if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_ = e_.y; } } } \
+            if (n_ != NIL) { uvec2 e_ = nodes[n_]; vec3 d = x - centers[e_.x].xyz; ACC += TERM; n_evals++; n_ = e_.y; } } } \
     CUT_UNLESS(n_ == NIL) }
 #elif LIST == LIST_SBUFFER && SORTED
 // Sorted ranges: a binary search (on depths.comp's keys) finds the first centre at depth
@@ -48,7 +54,7 @@ bool cut = false;
 // is zero at x (the window has a 0.1% margin for rounding).
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint e_ = min(offsets[p], P.list_capacity); \
-    float z_ = view_depth(x), r_ = radius() * 1.001 + 1e-6; \
+    float z_ = view_depth(x), r_ = radius() * 1.001 + 1e-6 + reach_extra; \
     uint lo_ = range_start(p), hi_ = e_; \
     while (lo_ < hi_) { \
         uint m_ = (lo_ + hi_) >> 1; \
@@ -62,7 +68,7 @@ bool cut = false;
             if (more_ && s_ < e_) { \
                 vec3 c_ = centers[list[s_]].xyz; \
                 if (view_depth(c_) > z_ + r_) more_ = false; \
-                else { vec3 d = x - c_; ACC += TERM; } } } } \
+                else { vec3 d = x - c_; ACC += TERM; n_evals++; } } } } \
     CUT_UNLESS(!(more_ && b_ < e_)) }
 #elif LIST == LIST_SBUFFER
 #define SUM_LIST(x, p, ACC, TERM) { \
@@ -71,7 +77,7 @@ bool cut = false;
     for (; b_ < e_; b_ += 8u) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             uint s_ = b_ + u_; \
-            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } \
+            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; n_evals++; } } } \
     CUT_UNLESS(!(b_ < e_)) }
 #elif LIST == LIST_NONE
 #define SUM_LIST(x, p, ACC, TERM)
@@ -85,6 +91,20 @@ float field(vec3 x, uint p) {
 #endif
     float f = 0.0;
     SUM_METABALLS(x, p, f, density2(dot(d, d)))
+    return f;
+}
+
+// The field at x and how many metaballs lie within R + reach of x: only those can be
+// nonzero anywhere on the next `reach` of a ray through x.
+vec2 field_reach(vec3 x, uint p, float reach) {
+#if LIST == LIST_NONE
+    p = ALL;
+#endif
+    float near2 = (radius() + reach) * (radius() + reach);
+    vec2 f = vec2(0.0);
+    reach_extra = reach;
+    SUM_METABALLS(x, p, f, vec2(density2(dot(d, d)), dot(d, d) < near2 ? 1.0 : 0.0))
+    reach_extra = 0.0;
     return f;
 }
 
@@ -146,6 +166,7 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
 #error "LIST names no list mode"
 #endif
     longest = max(longest, len);
+    n_candidates += len;
     return vec2(max(iv.x, 0.0), iv.y);
 }
 
@@ -162,7 +183,9 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
     uint i = 0u;
+    n_rays++;
     for (; i < P.max_steps && t <= t1; ++i) {
+        n_steps++;
         vec3 x = o + d * t;
         uint p = pixel;
         if (pixel == NIL) {
@@ -177,6 +200,7 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
             float a = prev, b = t;
             uint k = 0u;
             for (; k < P.refine; ++k) {
+                n_steps++;
                 float m = 0.5 * (a + b);
                 vec3 xm = o + d * m;
                 uint pm = pixel == NIL ? project(xm) : pixel;
@@ -193,6 +217,48 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     return -1.0;
 }
 
+#if MARCH == MARCH_LIPSCHITZ
+// `march` on the same grid for a primary ray, whose pixel's list holds every metaball the
+// ray meets: at a sample where the field is f, the m metaballs within R + R of it change
+// the field by at most m SLOPE_MAX / R per unit length over the next R, so the grid samples
+// closer than |f - T| R / (m SLOPE_MAX) are on this sample's side and are skipped (all of
+// the next R when m = 0). The first sample across T, its bracket and its bisection are the
+// fixed march's: the same hits.
+float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w, reach = radius();
+    float slope = SLOPE_MAX / radius();
+    float k0 = ceil(t0 / step);
+    float k = 0.0;
+    float t = k0 * step;
+    n_rays++;
+    uint i = 0u;
+    for (; i < P.max_steps && k < float(P.max_steps) && t <= t1; ++i) {
+        n_steps++;
+        vec3 x = o + d * t;
+        vec2 fm = field_reach(x, pixel, reach);
+        if ((fm.x >= T) != inside) {
+            float a = max(t - step, 0.0), b = t;
+            uint r = 0u;
+            for (; r < P.refine; ++r) {
+                n_steps++;
+                float m = 0.5 * (a + b);
+                if ((field(o + d * m, pixel) >= T) != inside) b = m; else a = m;
+            }
+            CUT_UNLESS(!(r < P.refine))
+            return b;
+        }
+        float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
+        // Samples strictly closer than `safe` (and within `reach`) are skipped.
+        k += max(ceil(min(safe, reach) / step - 1e-4), 1.0);
+        t = (k0 + k) * step;
+    }
+    CUT_UNLESS(!(i < P.max_steps && k < float(P.max_steps) && t <= t1))
+    return -1.0;
+}
+#elif MARCH != MARCH_FIXED
+#error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
+#endif
+
 vec3 normal_at(vec3 x, uint pixel) {
     uint p = pixel == NIL ? project(x) : pixel;
     if (p == NIL) p = ALL;
@@ -202,6 +268,25 @@ vec3 normal_at(vec3 x, uint pixel) {
 }
 
 #include "render/shading.glsl"
+
+// v added to the 64-bit (lo, hi) total at stats member M, exactly: the subgroup sums v's
+// low and high 16 bits apart (each sum fits 32 bits) and one lane adds them with carries.
+#define ADD64(M, V) { \
+    uint v_ = (V); \
+    uint lo_ = subgroupAdd(v_ & 0xFFFFu), hi_ = subgroupAdd(v_ >> 16); \
+    if (subgroupElect()) { \
+        uint a_ = lo_ + (hi_ << 16), c_ = (hi_ >> 16) + (a_ < lo_ ? 1u : 0u); \
+        uint o_ = atomicAdd(stats.M.x, a_); \
+        c_ += o_ + a_ < o_ ? 1u : 0u; \
+        if (c_ > 0u) atomicAdd(stats.M.y, c_); } }
+
+void add_counters() {
+    uint rays = subgroupAdd(n_rays);
+    if (subgroupElect()) atomicAdd(stats.rays, rays);
+    ADD64(steps, n_steps)
+    ADD64(evals, n_evals)
+    ADD64(candidates, n_candidates)
+}
 
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
 
@@ -219,6 +304,7 @@ void main() {
 
 #if LIST == LIST_NONE
     vec2 iv = ray_box(o, d, box_lo(), box_hi());
+    n_candidates = P.n;
 #else
     vec2 iv = list_interval(o, d, id);
 #endif
@@ -234,7 +320,16 @@ void main() {
         Path r = stack[--sp];
         bool primary = r.depth == 0u;
         vec2 span = primary ? iv : ray_box(r.o, r.d, box_lo(), box_hi());
+#if MARCH == MARCH_LIPSCHITZ
+        // Secondary rays sample other pixels' lists: no bound holds across them.
+        float t = span.x > span.y ? -1.0
+            : primary ? march_lipschitz(r.o, r.d, span.x, span.y, r.inside, id)
+            : march(r.o, r.d, span.x, span.y, r.inside, NIL);
+#elif MARCH == MARCH_FIXED
         float t = span.x <= span.y ? march(r.o, r.d, span.x, span.y, r.inside, primary ? id : NIL) : -1.0;
+#else
+#error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
+#endif
         if (t < 0.0) {
             // Left the fluid's bounds (or the screen, with offscreen_end): the sky, or the
             // opaque layer for a primary ray that reached it. Secondary rays see the sky.
@@ -298,4 +393,5 @@ void main() {
     if (longest > 0u) atomicMax(stats.longest, longest);
     if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);
     if (cut) atomicAdd(stats.budget_pixels, 1u);
+    add_counters();
 }

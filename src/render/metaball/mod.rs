@@ -11,7 +11,7 @@ pub mod stats;
 pub use buffers::MetaballBuffers;
 pub use renderer::MetaballRenderer;
 pub use settings::MetaballSettings;
-pub use stats::{FrameStats, GpuStats};
+pub use stats::{FrameStats, GpuStats, MarchCounts};
 
 /// A resting blob: the `n` points of a cubic lattice of the given spacing nearest to the
 /// origin (the thesis's 2048 particles, until characters exist).

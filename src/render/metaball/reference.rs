@@ -56,6 +56,28 @@ pub fn ray_box(origin: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(f32, f32)
 
 /// March the ray (unit `dir`) through the box of the metaballs grown by R.
 pub fn march(centers: &[Vec3], p: &MarchParams, origin: Vec3, dir: Vec3) -> Option<Hit> {
+    march_counted(centers, p, origin, dir).0
+}
+
+/// `march` and the samples it took, refinement included (march.comp's step counter).
+pub fn march_counted(
+    centers: &[Vec3],
+    p: &MarchParams,
+    origin: Vec3,
+    dir: Vec3,
+) -> (Option<Hit>, u32) {
+    let mut steps = 0;
+    let hit = march_inner(centers, p, origin, dir, &mut steps);
+    (hit, steps)
+}
+
+fn march_inner(
+    centers: &[Vec3],
+    p: &MarchParams,
+    origin: Vec3,
+    dir: Vec3,
+    steps: &mut u32,
+) -> Option<Hit> {
     if centers.is_empty() {
         return None;
     }
@@ -69,10 +91,12 @@ pub fn march(centers: &[Vec3], p: &MarchParams, origin: Vec3, dir: Vec3) -> Opti
         if t > t1 {
             return None;
         }
+        *steps += 1;
         if field(centers, p, origin + dir * t) >= p.threshold {
             // Bisection between the last outside sample and this inside one.
             let (mut a, mut b) = (prev, t);
             for _ in 0..p.refine {
+                *steps += 1;
                 let m = 0.5 * (a + b);
                 if field(centers, p, origin + dir * m) >= p.threshold {
                     b = m;

@@ -328,6 +328,7 @@ impl MetaballRenderer {
             budget_pixels: st.budget_pixels,
             list_bytes,
             triangles: st.triangles as u64,
+            march: super::stats::MarchCounts::of(&st),
         }
     }
 

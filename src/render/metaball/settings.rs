@@ -2,7 +2,7 @@
 //! defaults, and their GPU mirror.
 use crate::config::Switches;
 use crate::error::{Error, Result};
-use crate::kinds::{DensityFn, ListKind, Material, SurfaceKind};
+use crate::kinds::{DensityFn, ListKind, MarchKind, Material, SurfaceKind};
 use crate::render::surface::SurfaceFluid;
 use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
@@ -24,6 +24,9 @@ pub struct MetaballSettings {
     /// March step (default R / 8).
     pub step: f32,
     pub max_steps: u32,
+    /// The primary rays' march: the fixed grid, or skipping what the Lipschitz bound proves.
+    #[serde(default = "fixed")]
+    pub march: MarchKind,
     /// Secondary samples that leave the screen end the path (else: every metaball).
     pub offscreen_end: bool,
     /// S-buffer ranges sorted by the metaballs' view depth (a `sort` pass), each sample
@@ -65,6 +68,10 @@ fn metaballs() -> SurfaceKind {
 
 fn half() -> f32 {
     0.5
+}
+
+fn fixed() -> MarchKind {
+    MarchKind::Fixed
 }
 
 pub const MAX_DEPTH: u32 = 6;
@@ -119,6 +126,7 @@ impl MetaballSettings {
             depth: sw.metaball.depth.unwrap_or(1),
             step: radius / 8.0,
             max_steps: 2048,
+            march: sw.metaball.march.unwrap_or(MarchKind::Fixed),
             offscreen_end: sw
                 .metaball
                 .offscreen
@@ -153,6 +161,7 @@ impl MetaballSettings {
                 ("--refine", m.refine.is_some()),
                 ("--offscreen", m.offscreen.is_some()),
                 ("--list-sort", m.list_sort.is_some()),
+                ("--march", m.march.is_some()),
             ];
             if let Some((name, _)) = listed.iter().find(|(_, set)| *set) {
                 return Err(Error::Param(format!(
@@ -242,7 +251,23 @@ impl MetaballSettings {
     /// LIST, DENSITY, MATERIAL and SORTED with the named values the shaders compare
     /// against (`LIST_SBUFFER`, ...), all from here.
     pub fn shader_defines(&self) -> Vec<(String, String)> {
-        Self::defines_for(self.list, self.density, self.material, self.sorts_lists())
+        let mut d = Self::defines_for(self.list, self.density, self.material, self.sorts_lists());
+        d.extend(Self::march_defines(self.march));
+        d
+    }
+
+    /// The march.comp defines of a march kind (MARCH and its named values).
+    pub fn march_defines(march: MarchKind) -> Vec<(String, String)> {
+        use clap::ValueEnum;
+        let index = |m: MarchKind| MarchKind::value_variants().iter().position(|v| *v == m);
+        let values: Vec<(String, u32)> = MarchKind::value_variants()
+            .iter()
+            .map(|m| (m.as_str(), index(*m).unwrap_or(0) as u32))
+            .collect();
+        let refs: Vec<(&str, u32)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let mut d = vec![("MARCH".to_string(), index(march).unwrap_or(0).to_string())];
+        d.extend(crate::gpu::interface::enum_defines("MARCH", &refs));
+        d
     }
 
     /// The defines of one configuration (also the shader registry's variants).
@@ -261,6 +286,11 @@ impl MetaballSettings {
             (
                 "SORTED".to_string(),
                 ((sorted && list == ListKind::Sbuffer) as u32).to_string(),
+            ),
+            // max |dD/dq| of the density: the march's Lipschitz bound (density.rs).
+            (
+                "SLOPE_MAX".to_string(),
+                format!("{:.6}", density.slope_max()),
             ),
         ];
         // The named values the shaders compare against, from the same index functions.

@@ -16,7 +16,18 @@ pub struct GpuStats {
     pub budget_pixels: u32,
     /// Marching cubes: triangles the frame made.
     pub triangles: u32,
-    pub pad1: u32,
+    /// Rays marched, primary and secondary.
+    pub rays: u32,
+    /// 64-bit totals as [lo, hi]: samples taken (refinement included), metaball terms
+    /// summed (field and gradient), metaballs the primary rays' lists offer.
+    pub steps: [u32; 2],
+    pub evals: [u32; 2],
+    pub candidates: [u32; 2],
+}
+
+/// A (lo, hi) pair as one number.
+pub fn wide(v: [u32; 2]) -> u64 {
+    v[0] as u64 | (v[1] as u64) << 32
 }
 
 impl GpuStats {
@@ -46,4 +57,38 @@ pub struct FrameStats {
     /// Marching cubes: the frame's triangles (else 0).
     #[serde(default)]
     pub triangles: u64,
+    /// The march's per-ray counters: rays marched (primary and secondary), samples taken
+    /// (refinement included), metaball terms summed (density and gradient), and metaballs
+    /// the primary rays' lists offered (none: every metaball to every pixel).
+    #[serde(default)]
+    pub march: MarchCounts,
+}
+
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct MarchCounts {
+    pub rays: u64,
+    pub steps: u64,
+    pub evaluations: u64,
+    pub candidates: u64,
+}
+
+impl MarchCounts {
+    pub fn of(st: &GpuStats) -> Self {
+        Self {
+            rays: st.rays as u64,
+            steps: wide(st.steps),
+            evaluations: wide(st.evals),
+            candidates: wide(st.candidates),
+        }
+    }
+
+    /// (steps, evaluations, candidates) per pixel of a frame of `pixels`.
+    pub fn per_pixel(&self, pixels: u64) -> (f64, f64, f64) {
+        let p = pixels.max(1) as f64;
+        (
+            self.steps as f64 / p,
+            self.evaluations as f64 / p,
+            self.candidates as f64 / p,
+        )
+    }
 }
