@@ -73,17 +73,10 @@ fn march_counters_match_the_cpu_reference_and_the_lists() {
     };
     let lo = centers.iter().fold(Vec3::splat(f32::MAX), |a, c| a.min(*c)) - Vec3::splat(p.radius);
     let hi = centers.iter().fold(Vec3::splat(f32::MIN), |a, c| a.max(*c)) + Vec3::splat(p.radius);
-    let inv = cam.view_proj().inverse();
     let (mut rays, mut steps, mut hits) = (0u64, 0u64, 0u64);
     for y in 0..H {
         for x in 0..W {
-            let ndc = glam::Vec2::new(
-                (x as f32 + 0.5) / W as f32 * 2.0 - 1.0,
-                (y as f32 + 0.5) / H as f32 * 2.0 - 1.0,
-            );
-            let a = inv.project_point3(ndc.extend(0.0));
-            let b = inv.project_point3(ndc.extend(1.0));
-            let dir = (b - a).normalize();
+            let dir = cam.pixel_ray(x, y, W, H);
             if ray_box(cam.eye, dir, lo, hi).is_some() {
                 rays += 1;
             }

@@ -190,17 +190,10 @@ fn primary_hits_match_the_cpu_reference() {
         };
         let (_, dbg, _) = render(&ctx, s.clone(), &sc, true);
         let dbg = dbg.unwrap();
-        let inv = sc.cam.view_proj().inverse();
         let (mut checked, mut disagree) = (0, 0);
         for y in (0..H).step_by(3) {
             for x in (0..W).step_by(3) {
-                let ndc = glam::Vec2::new(
-                    (x as f32 + 0.5) / W as f32 * 2.0 - 1.0,
-                    (y as f32 + 0.5) / H as f32 * 2.0 - 1.0,
-                );
-                let a = inv.project_point3(ndc.extend(0.0));
-                let b = inv.project_point3(ndc.extend(1.0));
-                let dir = (b - a).normalize();
+                let dir = sc.cam.pixel_ray(x, y, W, H);
                 let cpu = march(&centers, &p, sc.cam.eye, dir);
                 let g = dbg[(y * W + x) as usize];
                 match (cpu, g[0] >= 0.0) {
@@ -243,17 +236,10 @@ fn billboards_are_conservative() {
     let r2 = s.radius * s.radius;
     let (_, _, lists) = render(&ctx, s, &sc, false);
     let lists = lists.unwrap();
-    let inv = sc.cam.view_proj().inverse();
     let mut hits = 0;
     for y in 0..H {
         for x in 0..W {
-            let ndc = glam::Vec2::new(
-                (x as f32 + 0.5) / W as f32 * 2.0 - 1.0,
-                (y as f32 + 0.5) / H as f32 * 2.0 - 1.0,
-            );
-            let a = inv.project_point3(ndc.extend(0.0));
-            let b = inv.project_point3(ndc.extend(1.0));
-            let d = (b - a).normalize();
+            let d = sc.cam.pixel_ray(x, y, W, H);
             let list = &lists[(y * W + x) as usize];
             for (j, p) in sc.pts.iter().enumerate() {
                 let oc = sc.cam.eye - Vec3::new(p[0], p[1], p[2]);

@@ -173,15 +173,10 @@ fn screen_space_splats_are_the_spheres_ray_hits() {
     let share = SPACING.powi(3) / (4.0 / 3.0 * std::f32::consts::PI * r.powi(3));
     let f = Frame::new(&ctx, s, &pts, &cam);
     let (depth, thick) = f.b.surface.as_ref().unwrap().splats(&ctx).unwrap();
-    let inv = cam.view_proj().inverse();
     let fwd = (Vec3::ZERO - cam.eye).normalize();
     let mut hits = 0;
     for (i, (&z, &t)) in depth.iter().zip(&thick).enumerate() {
-        let (x, y) = ((i as u32 % W) as f32, (i as u32 / W) as f32);
-        let ndc = glam::Vec2::new((x + 0.5) / W as f32, (y + 0.5) / H as f32) * 2.0 - 1.0;
-        let a = inv.project_point3(ndc.extend(0.0));
-        let b = inv.project_point3(ndc.extend(1.0));
-        let d = (b - a).normalize();
+        let d = cam.pixel_ray(i as u32 % W, i as u32 / W, W, H);
         let (mut near, mut chords) = (f32::MAX, 0.0f32);
         for p in &pts {
             let oc = cam.eye - Vec3::new(p[0], p[1], p[2]);

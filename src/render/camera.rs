@@ -44,6 +44,19 @@ impl Camera {
         self.proj() * self.view()
     }
 
+    /// The unit direction of the primary ray through pixel (x, y)'s centre of a w x h
+    /// frame, as march.comp makes it (the near and far points unprojected).
+    pub fn pixel_ray(&self, x: u32, y: u32, w: u32, h: u32) -> Vec3 {
+        let inv = self.view_proj().inverse();
+        let ndc = glam::Vec2::new(
+            (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+            (y as f32 + 0.5) / h as f32 * 2.0 - 1.0,
+        );
+        let a = inv.project_point3(ndc.extend(0.0));
+        let b = inv.project_point3(ndc.extend(1.0));
+        (b - a).normalize()
+    }
+
     /// Camera right and up axes in world space.
     pub fn axes(&self) -> (Vec3, Vec3) {
         let v = self.view();
