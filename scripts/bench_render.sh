@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerate results/<device-slug>/render.md: the thesis's rendering setup (2048 particles
 # in a resting blob, 512x512, Wyvill, T = 0.9, R = 0.04, I = 2) for none, A-buffer and
-# S-buffer, with Phong and with glass at recursion depth 3.
+# S-buffer, with Phong and with glass at recursion depth 3; then Phong with --march lipschitz.
 # Usage: scripts/bench_render.sh [--device N|NAME] [--frames N] [--particles N]
 #        [--width W] [--height H] (the last three shrink the setup, e.g. for a quick check)
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
@@ -23,12 +23,15 @@ args=("${rest[@]}")
 setup=(--particles "$n" --width "$w" --height "$h" --density wyvill --threshold 0.9 --radius 0.04 --refine 2)
 phong=("$bin" bench render --out out/bench/render-phong "${setup[@]}" --material phong "${dev[@]}" "${args[@]}")
 glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material glass --depth 3 "${dev[@]}" "${args[@]}")
+lip=("$bin" bench render --out out/bench/render-lipschitz "${setup[@]}" --material phong --march lipschitz "${dev[@]}" "${args[@]}")
 "${phong[@]}" > /dev/null
 "${glass[@]}" > /dev/null
+"${lip[@]}" > /dev/null
 cp out/bench/render-phong/sweep.csv "$dir/render-phong.csv"
 cp out/bench/render-glass/sweep.csv "$dir/render-glass.csv"
 cp out/bench/render-phong/sweep.png "$dir/render-phong.png"
 cp out/bench/render-glass/sweep.png "$dir/render-glass.png"
+cp out/bench/render-lipschitz/sweep.csv "$dir/render-lipschitz.csv"
 md=$dir/render.md
 {
   echo "# Metaball rendering on $slug"
@@ -39,6 +42,7 @@ md=$dir/render.md
   echo
   echo "    fluidform ${phong[*]:1}"
   echo "    fluidform ${glass[*]:1}"
+  echo "    fluidform ${lip[*]:1}"
   echo
   echo "The thesis (GTX 1080 Ti, 2048 particles shaped like a character, 512x512): Phong"
   echo "none 11 / A-buffer 87 / S-buffer 98 fps, 8.7 / 5.8 MB; transparent at depth 3:"
@@ -55,5 +59,12 @@ md=$dir/render.md
   cat out/bench/render-glass/sweep.md
   echo
   echo "![Glass frame time per list](render-glass.png)"
+  echo
+  echo "## Phong, --march lipschitz"
+  echo
+  echo "Primary rays skip the samples the field's Lipschitz bound proves outside (the same"
+  echo "hits); compare steps/px and render/march with the Phong table above."
+  echo
+  cat out/bench/render-lipschitz/sweep.md
 } > "$md"
 echo "wrote $md"

@@ -102,6 +102,7 @@ const SPECS: &[Spec] = &[
     },
     sweep("render-phong", "render", "bench render: thesis frame, Phong"),
     sweep("render-glass", "render", "bench render: thesis frame, glass at depth 3"),
+    sweep("render-lipschitz", "render", "bench render: thesis frame, Phong, --march lipschitz"),
     sweep("sph", "sph", "bench sph: one SPH step"),
     Spec {
         file: "solvers",
