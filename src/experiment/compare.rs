@@ -171,17 +171,16 @@ fn key(spec: &Spec, row: &BTreeMap<String, String>) -> Vec<String> {
         .collect()
 }
 
-/// One table with a column per device and metric; None where fewer than two devices have it.
-fn table(spec: &Spec, root: &Path, devices: &[Device]) -> Result<Option<String>> {
+/// The path of `spec`'s CSV in device `d`'s folder.
+fn csv_of(root: &Path, d: &Device, spec: &Spec) -> PathBuf {
+    root.join(&d.slug).join(format!("{}.csv", spec.file))
+}
+
+/// One table with a column per device and metric, for the devices that have its CSV.
+fn table(spec: &Spec, root: &Path, devices: &[&Device]) -> Result<String> {
     let mut have = Vec::new();
-    for d in devices {
-        let p = root.join(&d.slug).join(format!("{}.csv", spec.file));
-        if p.exists() {
-            have.push((d, read_csv(&p)?));
-        }
-    }
-    if have.len() < 2 {
-        return Ok(None);
+    for &d in devices {
+        have.push((d, read_csv(&csv_of(root, d, spec))?));
     }
     // Rows in first-seen order over the devices; the paper's numbers from the first that has them.
     let mut order: Vec<Vec<String>> = Vec::new();
@@ -236,23 +235,14 @@ fn table(spec: &Spec, root: &Path, devices: &[Device]) -> Result<Option<String>>
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    Ok(Some(md))
+    Ok(md)
 }
 
 /// Each claim's overall verdict per device (a device measures a claim when one of its
 /// experiments does).
 fn verdicts(devices: &[Device]) -> String {
     let with: Vec<&Device> = devices.iter().filter(|d| !d.saved.is_empty()).collect();
-    let mut claims: Vec<&str> = Vec::new();
-    for d in &with {
-        for s in &d.saved {
-            for f in &s.findings {
-                if !claims.contains(&f.claim.as_str()) {
-                    claims.push(&f.claim);
-                }
-            }
-        }
-    }
+    let claims = findings::claims(with.iter().flat_map(|d| &d.saved));
     let mut md = String::from("## The papers' findings per device\n\n| claim |");
     for d in &with {
         md.push_str(&format!(" [{}]({}/findings.md) |", d.slug, d.slug));
@@ -318,27 +308,17 @@ pub fn write_devices(root: &Path) -> Result<PathBuf> {
     let mut only = Vec::new();
     md.push_str(&verdicts(&devs));
     for spec in SPECS {
-        match table(spec, root, &devs)? {
-            Some(t) => md.push_str(&t),
-            None => {
-                let on: Vec<&str> = devs
-                    .iter()
-                    .filter(|d| {
-                        root.join(&d.slug)
-                            .join(format!("{}.csv", spec.file))
-                            .exists()
-                    })
-                    .map(|d| d.slug.as_str())
-                    .collect();
-                if !on.is_empty() {
-                    only.push(format!(
-                        "- {} ({}): {}\n",
-                        spec.title,
-                        spec.file,
-                        on.join(", ")
-                    ));
-                }
-            }
+        let on: Vec<&Device> = devs
+            .iter()
+            .filter(|d| csv_of(root, d, spec).exists())
+            .collect();
+        match on.len() {
+            0 => {}
+            1 => only.push(format!(
+                "- {} ({}): {}\n",
+                spec.title, spec.file, on[0].slug
+            )),
+            _ => md.push_str(&table(spec, root, &on)?),
         }
     }
     if !only.is_empty() {

@@ -110,17 +110,23 @@ pub fn overall<'a>(verdicts: impl IntoIterator<Item = &'a Verdict>) -> Verdict {
     }
 }
 
-/// findings.md from every `<name>.findings.json` in the output directory.
-pub fn rebuild(env: &Env) -> Result<PathBuf> {
-    let saved = load(&env.out)?;
-    let mut claims: Vec<String> = Vec::new();
-    for s in &saved {
+/// Every claim the saved findings speak of, in first-seen order.
+pub fn claims<'a>(saved: impl IntoIterator<Item = &'a Saved>) -> Vec<&'a str> {
+    let mut claims: Vec<&str> = Vec::new();
+    for s in saved {
         for f in &s.findings {
-            if !claims.contains(&f.claim) {
-                claims.push(f.claim.clone());
+            if !claims.contains(&f.claim.as_str()) {
+                claims.push(&f.claim);
             }
         }
     }
+    claims
+}
+
+/// findings.md from every `<name>.findings.json` in the output directory.
+pub fn rebuild(env: &Env) -> Result<PathBuf> {
+    let saved = load(&env.out)?;
+    let claims = claims(&saved);
     let mut md = format!(
         "# The papers' findings on {}\n\nWritten by `fluidform experiment`: each claim of the \
          papers, confirmed or refuted by the experiments that measure it (their tables are \
@@ -128,13 +134,13 @@ pub fn rebuild(env: &Env) -> Result<PathBuf> {
          verdicts side by side: `fluidform compare` writes them to ../devices.md.\n\n",
         env.meta.device
     );
-    for c in &claims {
+    for &c in &claims {
         let all: Vec<(&Saved, &Finding)> = saved
             .iter()
             .flat_map(|s| {
                 s.findings
                     .iter()
-                    .filter(|f| &f.claim == c)
+                    .filter(|f| f.claim == c)
                     .map(move |f| (s, f))
             })
             .collect();

@@ -173,6 +173,23 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
 vec3 box_lo() { return bounds[0].xyz - vec3(radius()); }
 vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
 
+// The crossing between ray parameters a (this side of T) and b (across it), refined by
+// P.refine bisection steps; pixel as in `march` (NIL: each sample projects).
+float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
+    float T = threshold();
+    uint k = 0u;
+    for (; k < P.refine; ++k) {
+        n_steps++;
+        float m = 0.5 * (a + b);
+        vec3 xm = o + d * m;
+        uint pm = pixel == NIL ? project(xm) : pixel;
+        if (pm == NIL) pm = ALL;
+        if ((field(xm, pm) >= T) != inside) b = m; else a = m;
+    }
+    CUT_UNLESS(!(k < P.refine))
+    return b;
+}
+
 // March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
 // ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
 // -2 when a secondary sample left the screen and paths end there. Samples sit on the
@@ -196,20 +213,7 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
                 p = ALL;
             }
         }
-        if ((field(x, p) >= T) != inside) {
-            float a = prev, b = t;
-            uint k = 0u;
-            for (; k < P.refine; ++k) {
-                n_steps++;
-                float m = 0.5 * (a + b);
-                vec3 xm = o + d * m;
-                uint pm = pixel == NIL ? project(xm) : pixel;
-                if (pm == NIL) pm = ALL;
-                if ((field(xm, pm) >= T) != inside) b = m; else a = m;
-            }
-            CUT_UNLESS(!(k < P.refine))
-            return b;
-        }
+        if ((field(x, p) >= T) != inside) return bisect(o, d, prev, t, inside, pixel);
         prev = t;
         t += step;
     }
@@ -236,17 +240,7 @@ float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixe
         n_steps++;
         vec3 x = o + d * t;
         vec2 fm = field_reach(x, pixel, reach);
-        if ((fm.x >= T) != inside) {
-            float a = max(t - step, 0.0), b = t;
-            uint r = 0u;
-            for (; r < P.refine; ++r) {
-                n_steps++;
-                float m = 0.5 * (a + b);
-                if ((field(o + d * m, pixel) >= T) != inside) b = m; else a = m;
-            }
-            CUT_UNLESS(!(r < P.refine))
-            return b;
-        }
+        if ((fm.x >= T) != inside) return bisect(o, d, max(t - step, 0.0), t, inside, pixel);
         float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
         // Samples strictly closer than `safe` (and within `reach`) are skipped.
         k += max(ceil(min(safe, reach) / step - 1e-4), 1.0);
