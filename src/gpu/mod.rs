@@ -8,6 +8,7 @@ pub mod guard;
 pub mod instance;
 pub mod interface;
 pub mod memory;
+pub mod overlay;
 pub mod pipeline;
 pub mod present;
 pub mod profiler;

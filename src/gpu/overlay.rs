@@ -1,5 +1,6 @@
-//! The overlay's renderer: egui's shapes drawn with egui-ash-renderer into the swapchain
-//! image, inside the presenter's rendering scope, after the scene's picture.
+//! The viewer's overlay renderer: egui's shapes drawn with egui-ash-renderer into the
+//! swapchain image, inside the presenter's rendering scope, after the scene's picture. It
+//! records Vulkan commands, so it lives in the GPU core with the presenter.
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use ash::vk;

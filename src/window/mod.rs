@@ -6,7 +6,6 @@ pub mod command;
 pub mod flags;
 mod input;
 mod orbit;
-mod overlay;
 mod panel;
 mod session;
 
@@ -133,7 +132,7 @@ pub fn view(opts: ViewOptions) -> Result<()> {
     let handle = window.window_handle().map_err(no_display)?.as_raw();
     let mut presenter = Presenter::new(&ctx, display, handle, opts.present, size)?;
     let played = (|| {
-        let mut overlay = overlay::Overlay::new(&ctx, presenter.format)?;
+        let mut overlay = crate::gpu::overlay::Overlay::new(&ctx, presenter.format)?;
         let mut args = flags::args_of(&opts.switches);
         // The window, not --width/--height, sizes the picture.
         args = flags::with(&args, "width", None);
@@ -209,7 +208,7 @@ fn play(
     event_loop: &mut winit::event_loop::EventLoop<()>,
     input: &mut input::Input,
     presenter: &mut Presenter,
-    overlay: &mut overlay::Overlay,
+    overlay: &mut crate::gpu::overlay::Overlay,
     s: &mut session::Session,
 ) -> Result<Walls> {
     let mut walls = Walls::default();
