@@ -145,6 +145,13 @@ pub struct MetaballArgs {
     /// lipschitz: samples the field's Lipschitz bound proves outside are skipped (same hits)
     #[arg(long, value_enum)]
     pub march: Option<MarchKind>,
+    /// How the S-buffer's per-pixel lists are built: rasterising the billboards (the
+    /// thesis's, default) or compute from the per-tile lists (already in depth order)
+    #[arg(long, value_enum)]
+    pub build: Option<BuildKind>,
+    /// Tile size in pixels of --list tiles and --build compute: 8, 16 (default) or 32
+    #[arg(long, value_name = "PX")]
+    pub tile: Option<u32>,
 }
 
 /// Camera of rendered scenes.

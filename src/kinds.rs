@@ -46,11 +46,24 @@ switch_enum!(
     }
 );
 
-switch_enum!(ListKind {
-    None,
-    Abuffer,
-    Sbuffer
-});
+switch_enum!(
+    /// The metaball lists: none, the A-buffer's linked lists, the S-buffer's ranges (the
+    /// thesis's), or per-tile ranges sorted by (tile, depth) after tile-based splatting.
+    ListKind {
+        None,
+        Abuffer,
+        Sbuffer,
+        Tiles
+    }
+);
+switch_enum!(
+    /// How per-pixel lists are built: by rasterising the billboards (the thesis's), or in
+    /// compute from the per-tile lists, each pixel's range already in depth order.
+    BuildKind {
+        Raster,
+        Compute
+    }
+);
 switch_enum!(DensityFn {
     Blinn,
     Wyvill,

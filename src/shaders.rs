@@ -175,10 +175,11 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
     }
 }
 
-/// The metaball renderer per list, material, density function and sort.
+/// The metaball renderer per list, material, density function and sort; the tile passes.
 fn metaballs(v: &mut Vec<Variant>) {
     use crate::render::metaball::renderer::MetaballIo;
-    for list in [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer] {
+    let lists = [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer, ListKind::Tiles];
+    for list in lists {
         for material in [
             Material::Phong,
             Material::Glass,
@@ -186,12 +187,19 @@ fn metaballs(v: &mut Vec<Variant>) {
             Material::Gold,
         ] {
             for density in DensityFn::value_variants() {
+                // Only the S-buffer has an unsorted and a sorted form.
                 for sorted in [false, true] {
+                    if sorted && list != ListKind::Sbuffer {
+                        continue;
+                    }
                     let d = MetaballSettings::defines_for(list, *density, material, sorted);
                     for march in crate::kinds::MarchKind::value_variants() {
                         let mut d = d.clone();
                         d.extend(MetaballSettings::march_defines(*march));
                         v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                    }
+                    if list == ListKind::Tiles {
+                        continue;
                     }
                     for f in [
                         "render/metaball/depths.comp",
@@ -208,6 +216,16 @@ fn metaballs(v: &mut Vec<Variant>) {
                 }
             }
         }
+    }
+    // The tile passes read no material or density.
+    let d = MetaballSettings::defines_for(ListKind::Tiles, DensityFn::Wyvill, Material::Phong, false);
+    v.push(with::<MetaballIo>("render/metaball/tile_bin.comp", &d));
+    v.push(with::<MetaballIo>("render/metaball/tile_ranges.comp", &d));
+    for pass in 0..2 {
+        let mut d = d.clone();
+        d.push(kv("PASS", pass));
+        v.push(with::<MetaballIo>("render/metaball/tile_pairs.comp", &d));
+        v.push(with::<MetaballIo>("render/metaball/pixel_lists.comp", &d));
     }
 }
 

@@ -351,14 +351,15 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             fields!(RenderParams;
             view_proj, inv_view_proj, view, proj, eye, sun, absorb, f0, base, tank_min, tank_max,
             width, height,
-            n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, opaque),
+            n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, opaque,
+            tile, tiles_x, rank_bits, pair_capacity),
         ),
         (
             "render/metaball/march.comp",
             "RenderStats",
             fields!(GpuStats;
             abuffer_nodes, longest, overflow, offscreen_samples, sbuffer_fragments,
-            budget_pixels, triangles, rays, steps, evals, candidates),
+            budget_pixels, triangles, rays, steps, evals, candidates, pairs, pad),
         ),
         (
             "control/force.comp",

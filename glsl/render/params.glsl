@@ -28,6 +28,12 @@ struct RenderParams {
     uint sky_h;
     uint debug;
     uint opaque;  // 1: the opaque layer is drawn (march.comp)
+    // Per-tile lists (render/metaball/tiles.glsl): tile size in pixels, tiles per row, bits
+    // of a pair key's depth rank (key = tile << rank_bits | rank), the pairs' capacity.
+    uint tile;
+    uint tiles_x;
+    uint rank_bits;
+    uint pair_capacity;
 };
 const uint NIL = 0xFFFFFFFFu;
 struct RenderStats {
@@ -43,5 +49,7 @@ struct RenderStats {
     uvec2 steps;       // samples taken, refinement included
     uvec2 evals;       // metaball terms summed (field and gradient)
     uvec2 candidates;  // metaballs the primary rays' lists offer (none: every one)
+    uint pairs;        // per-tile lists: (tile, metaball) pairs of the frame
+    uint pad;
 };
 #endif

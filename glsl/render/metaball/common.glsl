@@ -2,7 +2,7 @@
 // the per-pixel metaball lists. Bindings: MetaballIo in src/render/metaball/renderer.rs
 // (MB_B_* defines); RenderParams and RenderStats mirror src/render/metaball/settings.rs
 // and stats.rs (field offsets tested). Defines from Rust: LIST (LIST_NONE | LIST_ABUFFER |
-// LIST_SBUFFER), SORTED (1: S-buffer ranges sorted by depth), DENSITY (DENSITY_BLINN |
+// LIST_SBUFFER | LIST_TILES), SORTED (1: S-buffer ranges sorted by depth), DENSITY (DENSITY_BLINN |
 // _WYVILL | _NISHIMURA | _MURAKAMI), MATERIAL (MATERIAL_PHONG | _GLASS | _TINTED | _METAL).
 #ifndef METABALL_COMMON_GLSL
 #define METABALL_COMMON_GLSL
@@ -26,6 +26,18 @@ layout(std430, binding = MB_B_DEPTHS) buffer Depths { float depths[]; };  // vie
 layout(std430, binding = MB_B_OPAQUE) readonly buffer Opaque { uint opaque[]; };
 // With the opaque layer: the NDC depth of the first surface each primary ray meets (march.comp).
 layout(std430, binding = MB_B_SCENE_DEPTH) writeonly buffer SceneDepth { float scene_depth[]; };
+// Per-tile lists (src/render/metaball/tiles.rs): each metaball's pixel rectangle (x0 | y0
+// << 16, x1 | y1 << 16), its depth key and index sorted front to back, each depth rank's
+// first pair (W scanned), the (tile, metaball) pairs by key tile << rank_bits | rank, then
+// sorted, each sorted pair's metaball (xyz, view depth), each tile's pair range [x, y).
+layout(std430, binding = MB_B_RECTS) buffer Rects { uvec2 rects[]; };
+layout(std430, binding = MB_B_BALL_KEYS) buffer BallKeys { uint ball_keys[]; };
+layout(std430, binding = MB_B_BALL_IDS) buffer BallIds { uint ball_ids[]; };
+layout(std430, binding = MB_B_PAIR_COUNTS) buffer PairCounts { uint pair_counts[]; };
+layout(std430, binding = MB_B_PAIR_KEYS) buffer PairKeys { uint pair_keys[]; };
+layout(std430, binding = MB_B_PAIR_IDS) buffer PairIds { uint pair_ids[]; };
+layout(std430, binding = MB_B_TILE_BALLS) buffer TileBalls { vec4 tile_balls[]; };
+layout(std430, binding = MB_B_TILE_RANGES) buffer TileRanges { uvec2 tile_ranges[]; };
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
 
@@ -81,4 +93,14 @@ float density_grad_over_r(float r2) {
 }
 
 uint pixel_index(uvec2 p) { return p.y * P.width + p.x; }
+
+// The tile holding pixel (x, y), and the one holding pixel index p.
+uint tile_of(uvec2 pix) { return (pix.y / P.tile) * P.tiles_x + pix.x / P.tile; }
+uint tile_of_pixel(uint p) { return tile_of(uvec2(p % P.width, p / P.width)); }
+
+// Whether pixel (x, y) lies in a packed rectangle.
+bool rect_holds(uvec2 r, uvec2 pix) {
+    return pix.x >= (r.x & 0xFFFFu) && pix.y >= (r.x >> 16) && pix.x < (r.y & 0xFFFFu)
+        && pix.y < (r.y >> 16);
+}
 #endif

@@ -9,6 +9,7 @@
 // (off screen: every metaball, or the path ends).
 #include "common/index.glsl"
 #include "common.glsl"
+#include "blocks.glsl"
 
 const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
@@ -24,6 +25,15 @@ bool cut = false;
 // count the metaballs that can reach the next stretch of the ray (field_reach).
 float reach_extra = 0.0;
 #define CUT_UNLESS(ended) if (!(ended)) cut = true;
+
+#if LIST == LIST_TILES
+// --list tiles: one workgroup per 8 x 8 pixel block. The front STAGE pairs of the block's
+// tile stay in shared memory for the sums; ball(s) reads pair s from there or memory.
+const uint STAGE = 256u;
+shared vec4 s_balls[STAGE];
+uint stage_lo = 0u, stage_hi = 0u;
+vec4 ball(uint s) { return s >= stage_lo && s < stage_hi ? s_balls[s - stage_lo] : tile_balls[s]; }
+#endif
 
 // Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Several
 // metaballs per loop iteration (the inner loops unroll away), ALL_UNROLL over every metaball:
@@ -79,6 +89,27 @@ float reach_extra = 0.0;
             uint s_ = b_ + u_; \
             if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; n_evals++; } } } \
     CUT_UNLESS(!(b_ < e_)) }
+#elif LIST == LIST_TILES
+// The tile of pixel p holds every metaball whose billboard covers one of its pixels, sorted
+// by depth: the sorted S-buffer's exact depth window, over the tile's range (ball()).
+#define SUM_LIST(x, p, ACC, TERM) { \
+    uvec2 t_ = tile_ranges[tile_of_pixel(p)]; \
+    float z_ = view_depth(x), r_ = radius() * 1.001 + 1e-6 + reach_extra; \
+    uint lo_ = t_.x, hi_ = t_.y; \
+    while (lo_ < hi_) { \
+        uint m_ = (lo_ + hi_) >> 1; \
+        if (ball(m_).w < z_ - r_) lo_ = m_ + 1u; else hi_ = m_; } \
+    CUT_UNLESS(!(lo_ < hi_)) \
+    bool more_ = true; \
+    uint b_ = lo_; \
+    for (; more_ && b_ < t_.y; b_ += 8u) { \
+        [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
+            uint s_ = b_ + u_; \
+            if (more_ && s_ < t_.y) { \
+                vec4 c_ = ball(s_); \
+                if (c_.w > z_ + r_) more_ = false; \
+                else { vec3 d = x - c_.xyz; ACC += TERM; n_evals++; } } } } \
+    CUT_UNLESS(!(more_ && b_ < t_.y)) }
 #elif LIST == LIST_NONE
 #define SUM_LIST(x, p, ACC, TERM)
 #else
@@ -133,6 +164,7 @@ vec2 ray_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
     return vec2(max(max(min(a, b).x, min(a, b).y), max(min(a, b).z, 0.0)), min(min(max(a, b).x, max(a, b).y), max(a, b).z));
 }
 
+#if LIST != LIST_TILES
 // The depth interval the spheres of pixel p cover along the primary ray.
 vec2 list_interval(vec3 o, vec3 d, uint p) {
     float R2 = radius() * radius();
@@ -169,6 +201,47 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
     n_candidates += len;
     return vec2(max(iv.x, 0.0), iv.y);
 }
+#endif
+
+#if LIST == LIST_TILES
+// list_interval over the block's tile, its pairs staged in shared memory in batches of 64
+// (every invocation of the group calls this: it holds barriers); then the tile's front
+// STAGE pairs are staged for the sums. Candidates: the tile's pairs.
+vec2 tile_interval(vec3 o, vec3 d) {
+    uvec2 range = tile_ranges[tile_of(block_origin())];
+    float R2 = radius() * radius();
+    vec2 iv = vec2(1e30, -1e30);
+    uint l = gl_LocalInvocationIndex;
+    uint base = range.x;
+    for (; base < range.y; base += 64u) {
+        barrier();
+        if (base + l < range.y) s_balls[l] = tile_balls[base + l];
+        barrier();
+        uint m = min(64u, range.y - base);
+        [[unroll]] for (uint j = 0u; j < 64u; ++j) {
+            vec3 oc = o - s_balls[j].xyz;
+            float b = dot(oc, d);
+            float disc = b * b - (dot(oc, oc) - R2);
+            if (j < m && disc > 0.0) {
+                float q = sqrt(disc);
+                iv = vec2(min(iv.x, -b - q), max(iv.y, -b + q));
+            }
+        }
+    }
+    CUT_UNLESS(!(base < range.y))
+    barrier();
+    for (uint k = l; k < STAGE; k += 64u) {
+        if (range.x + k < range.y) s_balls[k] = tile_balls[range.x + k];
+    }
+    barrier();
+    stage_lo = range.x;
+    stage_hi = min(range.y, range.x + STAGE);
+    uint len = range.y - range.x;
+    longest = max(longest, len);
+    n_candidates += len;
+    return vec2(max(iv.x, 0.0), iv.y);
+}
+#endif
 
 vec3 box_lo() { return bounds[0].xyz - vec3(radius()); }
 vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
@@ -287,9 +360,16 @@ struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
 const int STACK = 8;
 
 void main() {
+#if LIST == LIST_TILES
+    // One workgroup per 8 x 8 block; pixels past the frame join its barriers, then leave.
+    uvec2 pix = block_pixel();
+    bool valid = pix.x < P.width && pix.y < P.height;
+    uint id = valid ? pixel_index(pix) : 0u;
+#else
     uint id = global_id();
     if (id >= P.width * P.height) return;
     uvec2 pix = uvec2(id % P.width, id / P.width);
+#endif
     vec2 ndc = (vec2(pix) + 0.5) / vec2(P.width, P.height) * 2.0 - 1.0;
     vec4 a = P.inv_view_proj * vec4(ndc, 0.0, 1.0);
     vec4 b = P.inv_view_proj * vec4(ndc, 1.0, 1.0);
@@ -299,6 +379,9 @@ void main() {
 #if LIST == LIST_NONE
     vec2 iv = ray_box(o, d, box_lo(), box_hi());
     n_candidates = P.n;
+#elif LIST == LIST_TILES
+    vec2 iv = tile_interval(o, d);
+    if (!valid) return;
 #else
     vec2 iv = list_interval(o, d, id);
 #endif

@@ -38,14 +38,17 @@ pub struct MetaballBuffers {
     pub debug_on: bool,
     /// The other surfaces' buffers (none for the metaballs).
     pub surface: Option<crate::render::surface::SurfaceBuffers>,
+    /// The per-tile lists (token sizes unless the frame bins tiles).
+    pub tiles: super::tiles::TileBuffers,
 }
 
 /// Bytes of one list entry: an S-buffer metaball index, an A-buffer (index, next) node.
 pub fn entry_bytes(list: ListKind) -> u64 {
-    if list == ListKind::Abuffer {
-        8
-    } else {
-        4
+    match list {
+        ListKind::Abuffer => 8,
+        // A pair's key, metaball and gathered (xyz, depth).
+        ListKind::Tiles => super::tiles::PAIR_BYTES,
+        _ => 4,
     }
 }
 
@@ -117,6 +120,7 @@ impl MetaballBuffers {
         if let Some(sb) = &mut self.surface {
             sb.destroy(ctx);
         }
+        self.tiles.destroy(ctx);
     }
 
     /// RGBA8 pixels of the frame last rendered in `slot` (after its fence).
@@ -143,7 +147,7 @@ impl MetaballBuffers {
         };
         let entry = entry_bytes(s.list);
         let list_capacity = match s.list {
-            ListKind::None => 0,
+            ListKind::None | ListKind::Tiles => 0,
             _ => capacity.max(1).min(ctx.max_storage_range() / entry),
         };
         // Buffers a configuration does not use stay bound, at a token size.
@@ -163,7 +167,7 @@ impl MetaballBuffers {
         let sky = buf("sky image", sky_px.len() as u64 * 4)?;
         let depths = buf(
             "metaball depths",
-            only(s.sorts_lists(), n_capacity.max(1) * 4),
+            only(s.sorts_lists() || s.bins_tiles(), n_capacity.max(1) * 4),
         )?;
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
@@ -187,6 +191,10 @@ impl MetaballBuffers {
             }
         };
         let surface = Guard::new(ctx, surface);
+        let tiles = Guard::new(
+            ctx,
+            super::tiles::TileBuffers::new(ctx, s, scan, n_capacity)?,
+        );
         let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
         let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);
         let mut stats_readback = Guard::new(ctx, Vec::new());
@@ -228,6 +236,7 @@ impl MetaballBuffers {
                 list_capacity,
                 debug_on: debug,
                 surface: surface.take(),
+                tiles: tiles.take(),
             },
         );
         ctx.upload(&mut b.sky, 0, &sky_px)?;
@@ -247,7 +256,7 @@ impl MetaballBuffers {
             )));
         }
         match list {
-            ListKind::None => Ok(()),
+            ListKind::None | ListKind::Tiles => Ok(()),
             // The new list is made before the old one goes, so a failed allocation leaves
             // the buffers as they were.
             ListKind::Sbuffer => {

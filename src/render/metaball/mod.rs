@@ -7,6 +7,7 @@ pub mod reference;
 pub mod renderer;
 pub mod settings;
 pub mod stats;
+pub mod tiles;
 
 pub use buffers::MetaballBuffers;
 pub use renderer::MetaballRenderer;

@@ -13,7 +13,8 @@ use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
     Scopes,
 };
-use crate::kinds::ListKind;
+use super::tiles::{blocks, TilePasses};
+use crate::kinds::{BuildKind, ListKind};
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::render::surface::{Frame, Surface};
@@ -25,7 +26,8 @@ crate::gpu_interface! {
     pub MetaballIo / MetaballBufs: "MB", push () {
         params = 0, centers = 1, bounds = 2, offsets = 3, list = 4, heads = 5, nodes = 6,
         stats = 7, pixels = 8, debug = 9, sky = 10, depths = 11, opaque = 12,
-        scene_depth = 13,
+        scene_depth = 13, rects = 14, ball_keys = 15, ball_ids = 16, pair_counts = 17,
+        pair_keys = 18, pair_ids = 19, tile_balls = 20, tile_ranges = 21,
     }
 }
 
@@ -36,8 +38,11 @@ pub struct MetaballRenderer {
     pub settings: MetaballSettings,
     count: Option<Graphics>,
     fill: Option<Graphics>,
-    /// Sorted S-buffer: every metaball's view depth, then each pixel's range by it.
+    /// Sorted S-buffer built by raster: every metaball's view depth, then each pixel's
+    /// range by it.
     sort: Option<(Compute, Compute)>,
+    /// Per-tile lists (tiles, and the S-buffer built in compute from them).
+    tiles: Option<TilePasses>,
     /// The metaballs' ray march (none for the other surfaces).
     march: Option<Compute>,
     /// Screen-space fluid or marching cubes instead of the metaballs.
@@ -69,8 +74,8 @@ impl MetaballRenderer {
             Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
         };
         let (count, fill) = match settings.list {
-            _ if !settings.marches() => (None, None),
-            ListKind::None => (None, None),
+            _ if !settings.marches() || settings.build == BuildKind::Compute => (None, None),
+            ListKind::None | ListKind::Tiles => (None, None),
             ListKind::Sbuffer => (Some(graphics("count", 0)?), Some(graphics("fill", 1)?)),
             ListKind::Abuffer => (None, Some(graphics("fill", 2)?)),
         };
@@ -88,7 +93,12 @@ impl MetaballRenderer {
         };
         let march = Guard::new(ctx, march);
         let surface = Guard::new(ctx, surface);
-        let sort = match settings.sorts_lists() {
+        let tiles = match settings.bins_tiles() {
+            true => Some(TilePasses::new(ctx, &settings, &defines)?),
+            false => None,
+        };
+        let tiles = Guard::new(ctx, tiles);
+        let sort = match settings.sort_pass() {
             true => Some((
                 compute("depths", "render/metaball/depths.comp")?,
                 compute("sort lists", "render/metaball/sort_lists.comp")?,
@@ -102,6 +112,7 @@ impl MetaballRenderer {
             count: count.map(Guard::take),
             fill: fill.map(Guard::take),
             sort: sort.map(|(d, s)| (d.take(), s.take())),
+            tiles: tiles.take(),
             march: march.take(),
             surface: surface.take(),
             scan: scan.take(),
@@ -165,6 +176,14 @@ impl MetaballRenderer {
             depths: &b.depths,
             opaque: &b.opaque,
             scene_depth: &b.scene_depth,
+            rects: &b.tiles.rects,
+            ball_keys: &b.tiles.ball_keys,
+            ball_ids: &b.tiles.ball_ids,
+            pair_counts: &b.tiles.pair_counts,
+            pair_keys: &b.tiles.pair_keys,
+            pair_ids: &b.tiles.pair_ids,
+            tile_balls: &b.tiles.tile_balls,
+            tile_ranges: &b.tiles.tile_ranges,
         }
     }
 
@@ -203,19 +222,24 @@ impl MetaballRenderer {
         let s = &self.settings;
         let (w, h) = (s.width, s.height);
         let px = s.pixels();
-        if s.sorts_lists() && n as u64 * 4 > b.depths.size {
+        if (s.sorts_lists() || s.bins_tiles()) && n as u64 * 4 > b.depths.size {
             return Err(Error::Param(format!(
                 "{n} metaballs: the buffers were made for {}",
                 b.depths.size / 4
             )));
         }
-        let params = RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on);
+        if s.bins_tiles() {
+            super::settings::check_pair_keys(s, n)?;
+        }
+        let pairs = b.tiles.pair_capacity;
+        let params =
+            RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on, pairs);
         ctx.update(cmd, &b.params, 0, &[params]);
         ctx.fill(cmd, &b.stats, 0);
         match s.list {
             ListKind::Sbuffer => ctx.fill(cmd, &b.offsets, 0),
             ListKind::Abuffer => ctx.fill(cmd, &b.heads, u32::MAX),
-            ListKind::None => {}
+            ListKind::None | ListKind::Tiles => {}
         }
         if let (Some(surface), Some(sb)) = (&self.surface, &b.surface) {
             let frame = Frame {
@@ -244,9 +268,17 @@ impl MetaballRenderer {
             ctx.draw(cmd, 6, n);
             ctx.end_rendering(cmd);
         };
-        if let Some(count) = &self.count {
+        if let Some(tiles) = &self.tiles {
+            tiles.record_bins(ctx, cmd, scopes, &self.scan, &b.tiles, &bufs, n as u64)?;
+        }
+        let compute_lists = s.list == ListKind::Sbuffer && s.build == BuildKind::Compute;
+        if self.count.is_some() || compute_lists {
             scopes.begin(ctx, cmd, "count");
-            draw(count);
+            match (&self.count, &self.tiles) {
+                (Some(count), _) => draw(count),
+                (None, Some(tiles)) => tiles.record_count(ctx, cmd, &bufs, s),
+                (None, None) => {}
+            }
             scopes.end(ctx, cmd);
             scopes.begin(ctx, cmd, "scan");
             self.scan.record(
@@ -272,6 +304,10 @@ impl MetaballRenderer {
             scopes.begin(ctx, cmd, "fill");
             draw(fill);
             scopes.end(ctx, cmd);
+        } else if let (true, Some(tiles)) = (compute_lists, &self.tiles) {
+            scopes.begin(ctx, cmd, "fill");
+            tiles.record_fill(ctx, cmd, &bufs, s);
+            scopes.end(ctx, cmd);
         }
         let groups = px.div_ceil(march.local_size as u64);
         if let Some((depths, sort)) = &self.sort {
@@ -282,7 +318,12 @@ impl MetaballRenderer {
             scopes.end(ctx, cmd);
         }
         scopes.begin(ctx, cmd, "march");
-        march.dispatch_groups(ctx, cmd, &bufs, &(), groups);
+        // Tiles: one workgroup per 8 x 8 block (march.comp stages the block's tile).
+        let march_groups = match s.list {
+            ListKind::Tiles => blocks(s),
+            _ => groups,
+        };
+        march.dispatch_groups(ctx, cmd, &bufs, &(), march_groups);
         scopes.end(ctx, cmd);
         Ok(())
     }
@@ -306,8 +347,11 @@ impl MetaballRenderer {
         let st: GpuStats =
             bytemuck::pod_read_unaligned(b.stats_readback[slot].mapped().expect("mapped"));
         let px = self.settings.pixels();
+        let pairs = st.pairs as u64;
+        let tile_bytes = b.tiles.bytes(pairs, b.tiles.rects.size / 8);
         let (fragments, mut list_bytes) = match self.settings.list {
             ListKind::None => (0, 0),
+            ListKind::Tiles => (pairs, tile_bytes),
             ListKind::Sbuffer => {
                 let f = st.sbuffer_fragments as u64;
                 (f, (px + 1) * 4 + f * 4)
@@ -317,8 +361,11 @@ impl MetaballRenderer {
                 (f, px * 4 + f * 8 + 4)
             }
         };
-        if self.settings.sorts_lists() {
+        if self.settings.sorts_lists() || self.settings.bins_tiles() {
             list_bytes += b.depths.size;
+        }
+        if self.settings.list == ListKind::Sbuffer && self.settings.bins_tiles() {
+            list_bytes += tile_bytes;
         }
         FrameStats {
             fragments,
@@ -328,6 +375,7 @@ impl MetaballRenderer {
             budget_pixels: st.budget_pixels,
             list_bytes,
             triangles: st.triangles as u64,
+            pairs,
             march: super::stats::MarchCounts::of(&st),
         }
     }
@@ -363,10 +411,20 @@ impl MetaballRenderer {
 
     /// Room for what frame `st` overflowed: list entries, or the mesh's triangles.
     pub fn grow(&self, ctx: &Context, b: &mut MetaballBuffers, st: &FrameStats) -> Result<()> {
-        match &mut b.surface {
-            Some(sb) => sb.grow(ctx, st.triangles),
-            None => b.grow(ctx, self.settings.list, st.fragments),
+        if let Some(sb) = &mut b.surface {
+            return sb.grow(ctx, st.triangles);
         }
+        if !self.settings.bins_tiles() {
+            return b.grow(ctx, self.settings.list, st.fragments);
+        }
+        // Pairs first: a frame short of pairs also undercounts its pixels' lists.
+        if st.pairs > b.tiles.pair_capacity {
+            return b.tiles.grow(ctx, st.pairs);
+        }
+        if self.settings.list == ListKind::Sbuffer && st.fragments > b.list_capacity {
+            return b.grow(ctx, ListKind::Sbuffer, st.fragments);
+        }
+        Ok(())
     }
 
     /// The S-buffer's per-pixel lists of the frame last rendered (tests and debugging).
@@ -402,6 +460,7 @@ impl MetaballRenderer {
         }
         self.march.destroy(ctx);
         self.surface.destroy(ctx);
+        self.tiles.destroy(ctx);
         if let Some((d, s)) = &mut self.sort {
             d.destroy(ctx);
             s.destroy(ctx);

@@ -2,7 +2,7 @@
 //! defaults, and their GPU mirror.
 use crate::config::Switches;
 use crate::error::{Error, Result};
-use crate::kinds::{DensityFn, ListKind, MarchKind, Material, SurfaceKind};
+use crate::kinds::{BuildKind, DensityFn, ListKind, MarchKind, Material, SurfaceKind};
 use crate::render::surface::SurfaceFluid;
 use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
@@ -27,6 +27,13 @@ pub struct MetaballSettings {
     /// The primary rays' march: the fixed grid, or skipping what the Lipschitz bound proves.
     #[serde(default = "fixed")]
     pub march: MarchKind,
+    /// How the S-buffer's lists are built: rasterised billboards, or compute from the
+    /// per-tile lists (each range then in depth order, no sort pass). Tiles: compute.
+    #[serde(default = "raster")]
+    pub build: BuildKind,
+    /// Tile size in pixels of the per-tile lists (tiles, and compute-built S-buffers).
+    #[serde(default = "tile16")]
+    pub tile: u32,
     /// Secondary samples that leave the screen end the path (else: every metaball).
     pub offscreen_end: bool,
     /// S-buffer ranges sorted by the metaballs' view depth (a `sort` pass), each sample
@@ -74,6 +81,17 @@ fn fixed() -> MarchKind {
     MarchKind::Fixed
 }
 
+fn raster() -> BuildKind {
+    BuildKind::Raster
+}
+
+fn tile16() -> u32 {
+    16
+}
+
+/// The tile sizes `--tile` takes.
+pub const TILES: [u32; 3] = [8, 16, 32];
+
 pub const MAX_DEPTH: u32 = 6;
 pub const MAX_REFINE: u32 = 32;
 
@@ -94,6 +112,7 @@ pub fn list_index(l: ListKind) -> u32 {
         ListKind::None => 0,
         ListKind::Abuffer => 1,
         ListKind::Sbuffer => 2,
+        ListKind::Tiles => 3,
     }
 }
 
@@ -127,6 +146,8 @@ impl MetaballSettings {
             step: radius / 8.0,
             max_steps: 2048,
             march: sw.metaball.march.unwrap_or(MarchKind::Fixed),
+            build: sw.metaball.build.unwrap_or(BuildKind::Raster),
+            tile: sw.metaball.tile.unwrap_or(16),
             offscreen_end: sw
                 .metaball
                 .offscreen
@@ -162,6 +183,8 @@ impl MetaballSettings {
                 ("--offscreen", m.offscreen.is_some()),
                 ("--list-sort", m.list_sort.is_some()),
                 ("--march", m.march.is_some()),
+                ("--build", m.build.is_some()),
+                ("--tile", m.tile.is_some()),
             ];
             if let Some((name, _)) = listed.iter().find(|(_, set)| *set) {
                 return Err(Error::Param(format!(
@@ -174,6 +197,24 @@ impl MetaballSettings {
             s.sorted = false;
         } else if sw.metaball.mesh_cell.is_some() {
             return Err(Error::Param("--mesh-cell belongs to --surface mesh".into()));
+        }
+        match (s.list, sw.metaball.build) {
+            (ListKind::Tiles, Some(BuildKind::Raster)) => {
+                return Err(Error::Param(
+                    "--list tiles is built in compute (its pairs are sorted by tile and depth); \
+                     --build raster applies to the S-buffer"
+                        .into(),
+                ))
+            }
+            (ListKind::Tiles, _) => s.build = BuildKind::Compute,
+            _ => {}
+        }
+        if sw.metaball.tile.is_some() && s.build != BuildKind::Compute {
+            return Err(Error::Param(format!(
+                "--tile sets the tiles of --list tiles and --build compute, not --list {} \
+                 built by raster",
+                s.list.as_str()
+            )));
         }
         if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
             return Err(Error::Param(format!(
@@ -190,6 +231,17 @@ impl MetaballSettings {
         self.sorted && self.list == ListKind::Sbuffer && self.marches()
     }
 
+    /// Whether the frame runs the per-pixel sort pass (sorted lists built by raster; the
+    /// compute build fills each range in depth order).
+    pub fn sort_pass(&self) -> bool {
+        self.sorts_lists() && self.build == BuildKind::Raster
+    }
+
+    /// Whether the frame bins the metaballs into per-tile lists (tiles, compute builds).
+    pub fn bins_tiles(&self) -> bool {
+        self.marches() && self.build == BuildKind::Compute
+    }
+
     /// Whether the surface is the ray-marched metaballs (the lists are built).
     pub fn marches(&self) -> bool {
         self.surface == SurfaceKind::Metaballs
@@ -197,8 +249,16 @@ impl MetaballSettings {
 
     /// The list's name in tables: none, abuffer, sbuffer (the thesis's), sbuffer-sorted.
     pub fn list_name(&self) -> String {
+        let compute = self.build == BuildKind::Compute;
+        let tile = match self.tile {
+            16 => String::new(),
+            t => format!("-{t}"),
+        };
         match self.list {
+            ListKind::Sbuffer if self.sorted && compute => format!("sbuffer-sorted-compute{tile}"),
             ListKind::Sbuffer if self.sorted => "sbuffer-sorted".into(),
+            ListKind::Sbuffer if compute => format!("sbuffer-compute{tile}"),
+            ListKind::Tiles => format!("tiles{tile}"),
             l => l.as_str(),
         }
     }
@@ -227,6 +287,24 @@ impl MetaballSettings {
                 "--mesh-cell must be within [0.1, 4] rest spacings, got {}",
                 self.mesh_cell
             )));
+        }
+        if !TILES.contains(&self.tile) {
+            return Err(Error::Param(format!(
+                "--tile must be 8, 16 or 32 pixels, got {}",
+                self.tile
+            )));
+        }
+        match (self.list, self.build) {
+            (ListKind::Tiles, BuildKind::Raster) => {
+                return Err(Error::Param("--list tiles is built in compute".into()))
+            }
+            (ListKind::None | ListKind::Abuffer, BuildKind::Compute) => {
+                return Err(Error::Param(format!(
+                    "--build compute builds the S-buffer's ranges (and the tiles), not --list {}",
+                    self.list.as_str()
+                )))
+            }
+            _ => {}
         }
         if self.depth > MAX_DEPTH {
             return Err(Error::Param(format!(
@@ -357,8 +435,39 @@ pub struct RenderParams {
     pub debug: u32,
     /// 1: the opaque layer (colours, then depths) is bound and used.
     pub opaque: u32,
+    /// Per-tile lists: the tile size in pixels, tiles per row, the bits of a pair key's
+    /// depth rank (key = tile << rank_bits | rank) and the pairs' capacity.
+    pub tile: u32,
+    pub tiles_x: u32,
+    pub rank_bits: u32,
+    pub pair_capacity: u32,
 }
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 368);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 384);
+
+/// Bits of a pair key's depth rank among `n` metaballs (at least one).
+pub fn rank_bits(n: u32) -> u32 {
+    (32 - n.saturating_sub(1).leading_zeros()).max(1)
+}
+
+/// Tiles of a frame: (per row, in all).
+pub fn tile_grid(s: &MetaballSettings) -> (u32, u64) {
+    let (tx, ty) = (s.width.div_ceil(s.tile), s.height.div_ceil(s.tile));
+    (tx, tx as u64 * ty as u64)
+}
+
+/// A pair key (tile << rank_bits | rank) must stay below u32::MAX, the padding's key.
+pub fn check_pair_keys(s: &MetaballSettings, n: u32) -> Result<()> {
+    let (_, tiles) = tile_grid(s);
+    let bits = rank_bits(n);
+    if tiles << bits >= u32::MAX as u64 {
+        return Err(Error::Param(format!(
+            "{tiles} tiles of {} px x {n} metaballs need pair keys of more than 32 bits; use a \
+             larger --tile or a smaller frame",
+            s.tile
+        )));
+    }
+    Ok(())
+}
 
 impl RenderParams {
     pub fn new(
@@ -368,6 +477,7 @@ impl RenderParams {
         list_capacity: u64,
         sky: (u32, u32),
         debug: bool,
+        pairs: u64,
     ) -> Self {
         let vp = cam.view_proj();
         let proj = cam.proj();
@@ -403,6 +513,10 @@ impl RenderParams {
             sky_h: sky.1,
             debug: debug as u32,
             opaque: s.opaque as u32,
+            tile: s.tile,
+            tiles_x: s.width.div_ceil(s.tile),
+            rank_bits: rank_bits(n),
+            pair_capacity: pairs.min(u32::MAX as u64) as u32,
         }
     }
 }

@@ -23,6 +23,9 @@ pub struct GpuStats {
     pub steps: [u32; 2],
     pub evals: [u32; 2],
     pub candidates: [u32; 2],
+    /// Per-tile lists: the frame's (tile, metaball) pairs.
+    pub pairs: u32,
+    pub pad: u32,
 }
 
 /// A (lo, hi) pair as one number.
@@ -57,6 +60,9 @@ pub struct FrameStats {
     /// Marching cubes: the frame's triangles (else 0).
     #[serde(default)]
     pub triangles: u64,
+    /// Per-tile lists (tiles, compute-built S-buffers): the frame's (tile, metaball) pairs.
+    #[serde(default)]
+    pub pairs: u64,
     /// The march's per-ray counters: rays marched (primary and secondary), samples taken
     /// (refinement included), metaball terms summed (density and gradient), and metaballs
     /// the primary rays' lists offered (none: every metaball to every pixel).
