@@ -10,9 +10,6 @@
 #include "common.glsl"
 #include "blocks.glsl"
 
-shared uvec2 s_rect[64];
-shared uint s_id[64];
-
 void main() {
     uvec2 pix = block_pixel();
     bool valid = pix.x < P.width && pix.y < P.height;
@@ -24,29 +21,25 @@ void main() {
 #elif PASS != 0
 #error "PASS is 0 (count) or 1 (fill)"
 #endif
-    uint l = gl_LocalInvocationIndex;
-    uint base = range.x;
-    for (; base < range.y; base += 64u) {
-        barrier();
-        if (base + l < range.y) {
-            uint id = pair_ids[base + l];
-            s_id[l] = id;
-            s_rect[l] = rects[id];
-        }
-        barrier();
-        uint m = min(64u, range.y - base);
-        [[unroll]] for (uint j = 0u; j < 64u; ++j) {
-            if (j < m && rect_holds(s_rect[j], pix)) {
+    // Every invocation of the block reads the same pair at once (one broadcast load).
+    uint k = range.x;
+    for (; k < range.y; k += 8u) {
+        [[unroll]] for (uint u = 0u; u < 8u; ++u) {
+            uint i = k + u;
+            if (i < range.y) {
+                uint id = pair_ids[i];
+                if (rect_holds(rects[id], pix)) {
 #if PASS == 1
-                uint slot = start + count;
-                if (slot < P.list_capacity) list[slot] = s_id[j];
+                    uint slot = start + count;
+                    if (slot < P.list_capacity) list[slot] = id;
 #endif
-                count++;
+                    count++;
+                }
             }
         }
     }
     // llvmpipe's loop budget (march.comp): a cut loop makes the frame wrong; reported.
-    if (base < range.y && valid) atomicAdd(stats.budget_pixels, 1u);
+    if (k < range.y && valid) atomicAdd(stats.budget_pixels, 1u);
     if (!valid) return;
 #if PASS == 0
     offsets[p] = count;

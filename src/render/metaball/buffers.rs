@@ -193,7 +193,7 @@ impl MetaballBuffers {
         let surface = Guard::new(ctx, surface);
         let tiles = Guard::new(
             ctx,
-            super::tiles::TileBuffers::new(ctx, s, scan, n_capacity)?,
+            super::tiles::TileBuffers::new(ctx, s, scan, n_capacity, capacity)?,
         );
         let bounds = Guard::new(ctx, BoundsBuffers::new(ctx, n_capacity.max(1))?);
         let scan = Guard::new(ctx, scan.scratch(ctx, if sbuf { px + 1 } else { 0 })?);

@@ -144,10 +144,16 @@ impl MetaballRenderer {
         slots: usize,
         debug: bool,
     ) -> Result<MetaballBuffers> {
-        self.buffers_with_capacity(ctx, n_capacity, slots, debug, self.settings.pixels() * 4)
+        let first = match self.settings.list {
+            // A few tiles per metaball.
+            ListKind::Tiles => n_capacity * 4 + super::settings::tile_grid(&self.settings).1,
+            _ => self.settings.pixels() * 4,
+        };
+        self.buffers_with_capacity(ctx, n_capacity, slots, debug, first)
     }
 
-    /// As `buffers`, with the list's first capacity in entries (it grows on overflow).
+    /// As `buffers`, with the list's first capacity in entries (tiles: pairs; it grows on
+    /// overflow).
     pub fn buffers_with_capacity(
         &self,
         ctx: &Context,
@@ -425,33 +431,6 @@ impl MetaballRenderer {
             return b.grow(ctx, ListKind::Sbuffer, st.fragments);
         }
         Ok(())
-    }
-
-    /// The S-buffer's per-pixel lists of the frame last rendered (tests and debugging).
-    pub fn sbuffer_lists(&self, ctx: &Context, b: &MetaballBuffers) -> Result<Vec<Vec<u32>>> {
-        if self.settings.list != ListKind::Sbuffer {
-            return Err(Error::Param("not an S-buffer renderer".into()));
-        }
-        let px = self.settings.pixels() as usize;
-        let ends: Vec<u32> = ctx.readback(&b.offsets, 0, px)?;
-        let total = ends.last().copied().unwrap_or(0) as usize;
-        let list: Vec<u32> = ctx.readback(&b.list, 0, total.min(b.list_capacity as usize))?;
-        Ok((0..px)
-            .map(|p| {
-                let start = if p == 0 { 0 } else { ends[p - 1] as usize };
-                list[start..ends[p] as usize].to_vec()
-            })
-            .collect())
-    }
-
-    /// Per-pixel (t, normal) of the primary hits (t < 0: none), when built with debug.
-    pub fn debug(&self, ctx: &Context, b: &MetaballBuffers) -> Result<Vec<[f32; 4]>> {
-        if !b.debug_on {
-            return Err(Error::Param(
-                "the renderer's buffers were made without debug output".into(),
-            ));
-        }
-        ctx.readback(&b.debug, 0, self.settings.pixels() as usize)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -44,11 +44,17 @@ impl TileBuffers {
         s: &MetaballSettings,
         scan: &ScanPass,
         n_capacity: u64,
+        capacity: u64,
     ) -> Result<Self> {
         let used = s.bins_tiles();
         let (_, tiles) = tile_grid(s);
-        // A first guess (a few tiles per metaball); overflow grows it to what a frame needs.
-        let pairs = if used { n_capacity * 4 + tiles } else { 0 };
+        // Tiles: the caller's first capacity; compute-built S-buffers: a few tiles per
+        // metaball. Overflow grows it to what a frame needs.
+        let pairs = match (used, s.list) {
+            (false, _) => 0,
+            (true, crate::kinds::ListKind::Tiles) => capacity.max(1),
+            (true, _) => n_capacity * 4 + tiles,
+        };
         let only = |bytes: u64| if used { bytes.max(16) } else { 16 };
         let n = n_capacity.max(1);
         let buf =
