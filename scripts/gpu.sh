@@ -115,7 +115,7 @@ mapfile -t names < <("$bin" experiment list)
 [ $quick = 1 ] && names=(table8 fig9 scaling)
 qx=()
 [ $quick = 1 ] && qx=(--quick)
-weight() { case $1 in fidelity) echo 3 ;; surfaces) echo 2 ;; adaptive | scaling) echo 2 ;; *) echo 1 ;; esac; }
+weight() { case $1 in fidelity) echo 3 ;; surfaces | lists) echo 2 ;; adaptive | scaling) echo 2 ;; *) echo 1 ;; esac; }
 total=0
 for n in "${names[@]}"; do total=$(( total + $(weight "$n") )); done
 from=$(now) span=$(( $(until_pct 72) - $(now) )) acc=0

@@ -30,6 +30,7 @@ pub fn variants() -> Vec<Variant> {
         with::<sort::SortIo>("primitives/oddeven.comp", &[]),
         with::<sort::SortIo>("primitives/bitonic.comp", &[]),
         with::<crate::particles::LiveArgsIo>("common/live_args.comp", &[]),
+        with::<crate::bench::floor::FmaIo>("bench/fma.comp", &[]),
         with::<crate::sph::hooks::ConstantForceIo>("sph/constant_force.comp", &[]),
         with::<crate::sph::health::HealthIo>("sph/health.comp", &[]),
         with::<crate::sph::errors::StepErrorIo>("sph/step_error.comp", &[]),
@@ -178,7 +179,12 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
 /// The metaball renderer per list, material, density function and sort; the tile passes.
 fn metaballs(v: &mut Vec<Variant>) {
     use crate::render::metaball::renderer::MetaballIo;
-    let lists = [ListKind::None, ListKind::Abuffer, ListKind::Sbuffer, ListKind::Tiles];
+    let lists = [
+        ListKind::None,
+        ListKind::Abuffer,
+        ListKind::Sbuffer,
+        ListKind::Tiles,
+    ];
     for list in lists {
         for material in [
             Material::Phong,
@@ -218,7 +224,8 @@ fn metaballs(v: &mut Vec<Variant>) {
         }
     }
     // The tile passes read no material or density.
-    let d = MetaballSettings::defines_for(ListKind::Tiles, DensityFn::Wyvill, Material::Phong, false);
+    let d =
+        MetaballSettings::defines_for(ListKind::Tiles, DensityFn::Wyvill, Material::Phong, false);
     v.push(with::<MetaballIo>("render/metaball/tile_bin.comp", &d));
     v.push(with::<MetaballIo>("render/metaball/tile_ranges.comp", &d));
     for pass in 0..2 {

@@ -122,6 +122,32 @@ fn sweep_files(dir: &std::path::Path) {
     }
 }
 
+/// lists.csv: every list mode on both looks and the character, each timed, with a floor
+/// below its time.
+fn lists_files(dir: &std::path::Path) {
+    let (_, rows) = read_csv(&dir.join("lists.csv"));
+    for mode in [
+        "abuffer",
+        "sbuffer",
+        "sbuffer-compute",
+        "sbuffer-sorted-compute",
+        "tiles",
+    ] {
+        let row = (rows.iter())
+            .find(|r| r["look"].starts_with("Phong") && r["mode"] == mode)
+            .unwrap_or_else(|| panic!("lists.csv has no Phong row for {mode}"));
+        let (ms, floor) = (num(row, "render_ms"), num(row, "floor_ms"));
+        assert!(
+            ms > 0.0 && floor > 0.0 && floor < ms,
+            "{mode}: {ms} ms, floor {floor}"
+        );
+    }
+    for look in ["glass", "character"] {
+        let n = rows.iter().filter(|r| r["look"].starts_with(look)).count();
+        assert!(n >= 4, "lists.csv: {n} {look} rows");
+    }
+}
+
 #[test]
 fn quick_experiments_write_every_file_and_column() {
     let dir = std::env::temp_dir().join(format!("fluidform-experiment-{}", std::process::id()));
@@ -159,6 +185,7 @@ fn quick_experiments_write_every_file_and_column() {
         assert!(img.width() > 256 && img.height() > 128);
     }
     sweep_files(&dir);
+    lists_files(&dir);
     // Every claim of the papers gets a verdict.
     let f = std::fs::read_to_string(dir.join("findings.md")).unwrap();
     for claim in [
@@ -169,6 +196,13 @@ fn quick_experiments_write_every_file_and_column() {
         findings::GRID_LINEAR,
         fluidform::experiment::surfaces::SCREEN_FASTER,
         fluidform::experiment::surfaces::CUBES_CHEAP,
+        fluidform::experiment::lists::COMPUTE_BEATS_ABUFFER,
+        fluidform::experiment::lists::COMPUTE_AS_FAST,
+        fluidform::experiment::lists::TILES_BEAT_LISTS,
+        fluidform::experiment::lists::LIPSCHITZ_FEWER,
+        fluidform::experiment::lists::BEST_PHONG,
+        fluidform::experiment::lists::BEST_GLASS,
+        fluidform::experiment::lists::DEMO_FASTER,
         "cost rises with the radius R",
         "cost rises with the refinement steps I",
         "cost rises with the recursion depth",

@@ -79,7 +79,11 @@ fn compute_built_lists_hold_the_raster_built_ones() {
     let ctx = common::ctx();
     for (w, h) in [(1, 1), (17, 9), (513, 511)] {
         for sorted in [false, true] {
-            let raster = render(&ctx, settings(w, h, ListKind::Sbuffer, BuildKind::Raster, sorted), None);
+            let raster = render(
+                &ctx,
+                settings(w, h, ListKind::Sbuffer, BuildKind::Raster, sorted),
+                None,
+            );
             let s = settings(w, h, ListKind::Sbuffer, BuildKind::Compute, sorted);
             let compute = render(&ctx, s, None);
             let (rl, cl) = (raster.lists.unwrap(), compute.lists.unwrap());
@@ -88,13 +92,23 @@ fn compute_built_lists_hold_the_raster_built_ones() {
             for (p, (a, b)) in rl.iter().zip(&cl).enumerate() {
                 let (sa, sb): (BTreeSet<u32>, BTreeSet<u32>) =
                     (a.iter().copied().collect(), b.iter().copied().collect());
-                assert_eq!(sa, sb, "{w}x{h} sorted={sorted}: pixel {p}'s metaballs differ");
-                assert_eq!(a.len(), b.len(), "{w}x{h}: pixel {p} holds a metaball twice");
+                assert_eq!(
+                    sa, sb,
+                    "{w}x{h} sorted={sorted}: pixel {p}'s metaballs differ"
+                );
+                assert_eq!(
+                    a.len(),
+                    b.len(),
+                    "{w}x{h}: pixel {p} holds a metaball twice"
+                );
                 // Front to back: the compute fill's order, and the raster's after its sort
                 // (the same depth sequence; ties may come in either order).
                 let da: Vec<f32> = a.iter().map(|&i| depths[i as usize]).collect();
                 let db: Vec<f32> = b.iter().map(|&i| depths[i as usize]).collect();
-                assert!(db.windows(2).all(|d| d[0] <= d[1]), "{w}x{h}: pixel {p} not front to back");
+                assert!(
+                    db.windows(2).all(|d| d[0] <= d[1]),
+                    "{w}x{h}: pixel {p} not front to back"
+                );
                 if sorted {
                     assert_eq!(da, db, "{w}x{h}: pixel {p}'s depth order differs");
                 }
@@ -106,12 +120,19 @@ fn compute_built_lists_hold_the_raster_built_ones() {
             let tiles_x = w.div_ceil(16) as usize;
             for (t, list) in tiles.iter().enumerate() {
                 let d: Vec<f32> = list.iter().map(|&i| depths[i as usize]).collect();
-                assert!(d.windows(2).all(|d| d[0] <= d[1]), "tile {t} not front to back");
+                assert!(
+                    d.windows(2).all(|d| d[0] <= d[1]),
+                    "tile {t} not front to back"
+                );
             }
             for (p, l) in cl.iter().enumerate() {
                 let (x, y) = (p % w as usize, p / w as usize);
-                let tile: BTreeSet<u32> = tiles[(y / 16) * tiles_x + x / 16].iter().copied().collect();
-                assert!(l.iter().all(|i| tile.contains(i)), "pixel {p}: a metaball its tile lacks");
+                let tile: BTreeSet<u32> =
+                    tiles[(y / 16) * tiles_x + x / 16].iter().copied().collect();
+                assert!(
+                    l.iter().all(|i| tile.contains(i)),
+                    "pixel {p}: a metaball its tile lacks"
+                );
             }
         }
     }
@@ -140,9 +161,21 @@ fn tiles_give_the_sbuffers_picture() {
         let tiles = render(&ctx, s.clone(), None).pixels;
         let a = agreement(&tiles, &reference, 4);
         let name = format!("{material:?} depth {depth} tile {tile} {march:?}");
-        assert!(a >= 0.99, "{name}: {:.2}% of pixels within 4/255", a * 100.0);
+        assert!(
+            a >= 0.99,
+            "{name}: {:.2}% of pixels within 4/255",
+            a * 100.0
+        );
         // The fluid is in the picture: the sky alone would agree trivially.
-        let sky = render(&ctx, { s.threshold = 1e6; s }, None).pixels;
+        let sky = render(
+            &ctx,
+            {
+                s.threshold = 1e6;
+                s
+            },
+            None,
+        )
+        .pixels;
         assert!(agreement(&tiles, &sky, 4) < 0.9, "{name}: no fluid drawn");
     }
     common::finish(&ctx);
@@ -168,19 +201,46 @@ fn pairs_and_lists_grow_on_overflow_and_the_picture_is_unchanged() {
 #[test]
 fn switches_that_do_not_apply_are_refused() {
     let refused = [
-        (vec!["--list", "tiles", "--tile", "7"], "--tile must be 8, 16 or 32"),
-        (vec!["--build", "compute", "--list", "abuffer"], "not --list abuffer"),
-        (vec!["--build", "compute", "--list", "none"], "not --list none"),
-        (vec!["--build", "raster", "--list", "tiles"], "built in compute"),
-        (vec!["--list", "sbuffer", "--tile", "8"], "--tile sets the tiles"),
-        (vec!["--list", "tiles", "--list-sort", "on"], "--list-sort applies"),
-        (vec!["--surface", "mesh", "--build", "compute"], "--build belongs"),
+        (
+            vec!["--list", "tiles", "--tile", "7"],
+            "--tile must be 8, 16 or 32",
+        ),
+        (
+            vec!["--build", "compute", "--list", "abuffer"],
+            "not --list abuffer",
+        ),
+        (
+            vec!["--build", "compute", "--list", "none"],
+            "not --list none",
+        ),
+        (
+            vec!["--build", "raster", "--list", "tiles"],
+            "built in compute",
+        ),
+        (
+            vec!["--list", "sbuffer", "--tile", "8"],
+            "--tile sets the tiles",
+        ),
+        (
+            vec!["--list", "tiles", "--list-sort", "on"],
+            "--list-sort applies",
+        ),
+        (
+            vec!["--surface", "mesh", "--build", "compute"],
+            "--build belongs",
+        ),
     ];
     for (args, want) in refused {
-        let e = MetaballSettings::from_switches(&switches(&args)).unwrap_err().to_string();
+        let e = MetaballSettings::from_switches(&switches(&args))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(want), "{args:?}: {e}");
         assert_eq!(e.lines().count(), 1, "{args:?}: not one line: {e}");
     }
-    let s = MetaballSettings::from_switches(&switches(&["--list", "tiles", "--tile", "32"])).unwrap();
-    assert_eq!((s.build, s.tile, s.list_name().as_str()), (BuildKind::Compute, 32, "tiles-32"));
+    let s =
+        MetaballSettings::from_switches(&switches(&["--list", "tiles", "--tile", "32"])).unwrap();
+    assert_eq!(
+        (s.build, s.tile, s.list_name().as_str()),
+        (BuildKind::Compute, 32, "tiles-32")
+    );
 }

@@ -3,6 +3,7 @@
 //! (sweep.csv + sweep.md) when several configurations run.
 pub mod control;
 pub mod emission;
+pub mod floor;
 pub mod particles;
 pub mod plot;
 pub mod primitives;

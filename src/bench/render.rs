@@ -1,9 +1,11 @@
 //! `bench render`: the thesis's rendering tables. A resting blob of N particles (2048 by
-//! default) at 512x512, every axis the tables vary from the switches: --list (all three
-//! when unset), --material, --density, --threshold, --radius, --refine, --depth; or
+//! default) at 512x512, every axis the tables vary from the switches: --list (every list
+//! mode and build when unset: none, A-buffer, S-buffer unsorted and sorted built by raster
+//! and by compute, tiles), --build, --tile, --march, --material, --density, --threshold, --radius, --refine, --depth; or
 //! --surface screen-space|mesh (one row, no lists) on the same blob.
+use super::floor::Floor;
 use super::{measure, BenchOptions, Row};
-use crate::config::{ListKind, SurfaceKind};
+use crate::config::{BuildKind, ListKind, SurfaceKind};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
 use crate::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
@@ -17,32 +19,18 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let pts = blob(n, spacing);
     let mut centers = ctx.storage_buffer("metaball centers", (n * 16) as u64)?;
     ctx.upload(&mut centers, 0, &pts)?;
-    // (list, sorted): every list when --list is unset, the S-buffer both unsorted (the
-    // thesis's) and sorted (ours) unless --list-sort picks one.
-    let sorted = MetaballSettings::from_switches(sw)?.sorted;
-    let other = sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs);
-    let lists = match (sw.metaball.list, sw.metaball.list_sort) {
-        // Another surface draws without lists.
-        _ if other.is_some() => vec![(ListKind::None, false)],
-        (Some(l), _) => vec![(l, sorted)],
-        (None, Some(_)) => vec![
-            (ListKind::None, false),
-            (ListKind::Abuffer, false),
-            (ListKind::Sbuffer, sorted),
-        ],
-        (None, None) => vec![
-            (ListKind::None, false),
-            (ListKind::Abuffer, false),
-            (ListKind::Sbuffer, false),
-            (ListKind::Sbuffer, true),
-        ],
+    let lists = rows_of(sw)?;
+    // The floor's rates, measured in this run (metaball rows only).
+    let floor = match sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs) {
+        None => Some(Floor::measure(ctx, opts)?),
+        Some(_) => None,
     };
+    let other = sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs);
     let mut rows = Vec::new();
     let result = (|| -> Result<()> {
-        for (list, sorted) in lists {
+        for (list, sorted, build) in lists {
             let mut settings = MetaballSettings::from_switches(sw)?;
-            settings.list = list;
-            settings.sorted = sorted;
+            (settings.list, settings.sorted, settings.build) = (list, sorted, build);
             settings.fluid = Some(blob_fluid(&pts, spacing));
             let name = match other {
                 Some(k) => k.as_str(),
@@ -87,6 +75,16 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     ),
                     ("pixels past loop budget".into(), cut.to_string()),
                 ];
+                if let Some(f) = &floor {
+                    // The least traffic: the centres read, the picture written, the lists
+                    // written once and read once.
+                    let px = settings.pixels() as f64;
+                    let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
+                    let ms = f.ms(bytes, after.march.evaluations as f64);
+                    row.extra.push(("floor ms".into(), format!("{ms:.4}")));
+                    let above = row.main.median / ms.max(1e-12);
+                    row.extra.push(("x floor".into(), format!("{above:.1}")));
+                }
                 if cut > 0 {
                     eprintln!(
                         "warning: {name}: {cut} pixels' rays were cut short by llvmpipe's loop \
@@ -103,6 +101,44 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     })();
     ctx.destroy_buffer(&mut centers);
     result.map(|_| rows)
+}
+
+/// The (list, sorted, build) rows: what --list, --list-sort and --build pick, or every
+/// list mode (both S-buffer orders by both builds, and tiles) when --list is unset.
+fn rows_of(sw: &crate::config::Switches) -> Result<Vec<(ListKind, bool, BuildKind)>> {
+    let s = MetaballSettings::from_switches(sw)?;
+    if sw
+        .metaball
+        .surface
+        .is_some_and(|k| k != SurfaceKind::Metaballs)
+    {
+        return Ok(vec![(ListKind::None, false, BuildKind::Raster)]);
+    }
+    if sw.metaball.list.is_some() {
+        return Ok(vec![(s.list, s.sorted, s.build)]);
+    }
+    let sorts = match sw.metaball.list_sort {
+        Some(_) => vec![s.sorted],
+        None => vec![false, true],
+    };
+    let builds = match sw.metaball.build {
+        Some(b) => vec![b],
+        None => vec![BuildKind::Raster, BuildKind::Compute],
+    };
+    let mut rows = Vec::new();
+    if sw.metaball.build.is_none() {
+        rows.push((ListKind::None, false, BuildKind::Raster));
+        rows.push((ListKind::Abuffer, false, BuildKind::Raster));
+    }
+    for build in builds {
+        for &sorted in &sorts {
+            rows.push((ListKind::Sbuffer, sorted, build));
+        }
+    }
+    if sw.metaball.build != Some(BuildKind::Raster) {
+        rows.push((ListKind::Tiles, false, BuildKind::Compute));
+    }
+    Ok(rows)
 }
 
 /// The blob's fluid for the other surfaces: its spacing, the default smoothing length, its

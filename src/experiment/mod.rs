@@ -6,6 +6,7 @@ pub mod adaptive;
 pub mod compare;
 pub mod fidelity;
 pub mod findings;
+pub mod lists;
 pub mod measure;
 pub mod surfaces;
 pub mod sweeps;
@@ -24,7 +25,7 @@ use std::time::Instant;
 
 pub const NAMES: &[&str] = &[
     "table2", "table3", "table4", "table5", "table6", "table7", "table8", "fig9", "adaptive",
-    "scaling", "fidelity", "surfaces",
+    "scaling", "fidelity", "surfaces", "lists",
 ];
 
 pub struct ExperimentOptions {
@@ -82,7 +83,8 @@ impl Env {
         s: &MetaballSettings,
         n: u64,
     ) -> Result<(&MetaballRenderer, &mut MetaballBuffers)> {
-        let key = format!("{:?}", s.shader_defines());
+        // The build and tile size choose passes and buffers beside the defines.
+        let key = format!("{:?} {:?} {}", s.shader_defines(), s.build, s.tile);
         let fits = self.renderers.get(&key).is_some_and(|e| e.2 >= n);
         if !fits {
             if let Some((mut r, mut b, _)) = self.renderers.remove(&key) {
@@ -345,6 +347,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>>
             "scaling" => sweeps::scaling(ctx, env)?,
             "fidelity" => fidelity::fidelity(env)?,
             "surfaces" => surfaces::surfaces(env)?,
+            "lists" => lists::lists(ctx, env)?,
             table => {
                 let def = tables::def(table).expect("a table name");
                 measure::table(ctx, env, def)?

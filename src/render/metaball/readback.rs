@@ -34,7 +34,6 @@ impl MetaballRenderer {
         ctx.readback(&b.debug, 0, self.settings.pixels() as usize)
     }
 
-
     /// Each tile's metaballs in list order (tiles and compute-built S-buffers).
     pub fn tile_lists(&self, ctx: &Context, b: &MetaballBuffers) -> Result<Vec<Vec<u32>>> {
         if !self.settings.bins_tiles() {

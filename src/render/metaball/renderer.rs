@@ -6,6 +6,7 @@
 use super::buffers::MetaballBuffers;
 use super::settings::{MetaballSettings, RenderParams};
 use super::stats::{FrameStats, GpuStats};
+use super::tiles::{blocks, TilePasses};
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::Destroy;
@@ -13,7 +14,6 @@ use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
     Scopes,
 };
-use super::tiles::{blocks, TilePasses};
 use crate::kinds::{BuildKind, ListKind};
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
@@ -125,6 +125,7 @@ impl MetaballRenderer {
     pub fn retune(&mut self, settings: MetaballSettings) -> Result<()> {
         settings.validate()?;
         let same = settings.shader_defines() == self.settings.shader_defines()
+            && (settings.build, settings.tile) == (self.settings.build, self.settings.tile)
             && (settings.width, settings.height) == (self.settings.width, self.settings.height)
             && settings.sky == self.settings.sky;
         if !same {
@@ -238,8 +239,7 @@ impl MetaballRenderer {
             super::settings::check_pair_keys(s, n)?;
         }
         let pairs = b.tiles.pair_capacity;
-        let params =
-            RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on, pairs);
+        let params = RenderParams::new(s, cam, n, b.list_capacity, b.sky_size, b.debug_on, pairs);
         ctx.update(cmd, &b.params, 0, &[params]);
         ctx.fill(cmd, &b.stats, 0);
         match s.list {

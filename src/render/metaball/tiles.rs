@@ -201,7 +201,15 @@ impl TilePasses {
         self.sort.record(ctx, cmd, &t.ball_keys, &t.ball_ids, n)?;
         self.count.dispatch(ctx, cmd, bufs, &(), n + 1);
         let counts = &t.pair_counts;
-        scan.record(ctx, cmd, counts, counts, n + 1, ScanKind::Exclusive, &t.scan)?;
+        scan.record(
+            ctx,
+            cmd,
+            counts,
+            counts,
+            n + 1,
+            ScanKind::Exclusive,
+            &t.scan,
+        )?;
         self.emit.dispatch(ctx, cmd, bufs, &(), n);
         scopes.end(ctx, cmd);
         scopes.begin(ctx, cmd, "pair sort");
@@ -241,7 +249,12 @@ impl TilePasses {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for p in [&mut self.bin, &mut self.count, &mut self.emit, &mut self.ranges] {
+        for p in [
+            &mut self.bin,
+            &mut self.count,
+            &mut self.emit,
+            &mut self.ranges,
+        ] {
             p.destroy(ctx);
         }
         if let Some((c, f)) = &mut self.pixels {

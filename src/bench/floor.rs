@@ -1,0 +1,93 @@
+//! A rough floor for a frame on this device, measured in the same run as the frame: its
+//! least memory traffic over the buffer-copy bandwidth, or its density evaluations over
+//! the FMA rate, whichever is larger. `bench render` prints each row's floor and how far
+//! above it the row is.
+use super::{measure, BenchOptions};
+use crate::error::Result;
+use crate::gpu::{ComputeDesc, ComputePipeline, Context, Guard};
+use bytemuck::{Pod, Zeroable};
+use serde_json::json;
+
+/// FLOPs of one density evaluation (Wyvill, from r^2 and the sum): d = x - c (3), r^2 (5),
+/// q^2 (1), the cubic in q^2 by Horner (6), the sum (1).
+pub const FLOPS_PER_EVAL: f64 = 16.0;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FmaPush {
+    pub iters: u32,
+    pub a: f32,
+}
+
+crate::gpu_interface! {
+    /// glsl/bench/fma.comp
+    pub FmaIo / FmaBufs: "FMA", push FmaPush { out = 0 }
+}
+
+/// Iterations per invocation of fma.comp (64 FLOPs each), within llvmpipe's loop budget.
+const ITERS: u32 = 512;
+
+pub struct Floor {
+    /// Bytes per second a buffer copy moves (read plus written).
+    pub bytes_per_s: f64,
+    pub flops_per_s: f64,
+}
+
+impl Floor {
+    /// Measure both rates (median of the bench's repetitions).
+    pub fn measure(ctx: &Context, opts: &BenchOptions) -> Result<Self> {
+        let cpu = ctx.info.kind.to_lowercase().contains("cpu");
+        // Enough work to time well: about a millisecond on a GPU, tens on lavapipe.
+        let (bytes, invocations): (u64, u64) = match cpu {
+            true => (32 << 20, 1 << 16),
+            false => (512 << 20, 1 << 22),
+        };
+        let src = Guard::new(ctx, ctx.storage_buffer("floor copy source", bytes)?);
+        let dst = Guard::new(ctx, ctx.storage_buffer("floor copy target", bytes)?);
+        let out = Guard::new(ctx, ctx.storage_buffer("floor fma out", invocations * 16)?);
+        let desc = ComputeDesc::plain("fma rate", "bench/fma.comp", &[], 256);
+        let fma = Guard::new(ctx, ComputePipeline::<FmaIo>::new(ctx, &desc)?);
+        let copy = measure(ctx, opts, "copy", bytes, "copy", json!({}), |prof, cmd| {
+            prof.begin(ctx, cmd, "copy");
+            ctx.copy(cmd, &src, 0, &dst, 0, bytes);
+            prof.end(ctx, cmd);
+            Ok(())
+        })?;
+        let push = FmaPush {
+            iters: ITERS,
+            a: 0.999,
+        };
+        let rate = measure(
+            ctx,
+            opts,
+            "fma",
+            invocations,
+            "fma",
+            json!({}),
+            |prof, cmd| {
+                prof.begin(ctx, cmd, "fma");
+                fma.dispatch(ctx, cmd, &FmaBufs { out: &out }, &push, invocations);
+                prof.end(ctx, cmd);
+                Ok(())
+            },
+        )?;
+        let flops = invocations as f64 * ITERS as f64 * 64.0;
+        let floor = Self {
+            bytes_per_s: 2.0 * bytes as f64 / (copy.main.median / 1e3),
+            flops_per_s: flops / (rate.main.median / 1e3),
+        };
+        eprintln!(
+            "floor rates: copy {:.1} GB/s (read + written), FMA {:.1} GFLOP/s",
+            floor.bytes_per_s / 1e9,
+            floor.flops_per_s / 1e9
+        );
+        Ok(floor)
+    }
+
+    /// The floor in ms of a frame that moves `bytes` and evaluates `evals` densities.
+    pub fn ms(&self, bytes: f64, evals: f64) -> f64 {
+        let memory = bytes / self.bytes_per_s;
+        let math = evals * FLOPS_PER_EVAL / self.flops_per_s;
+        memory.max(math) * 1e3
+    }
+}

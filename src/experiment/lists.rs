@@ -1,0 +1,458 @@
+//! `fluidform experiment lists`: every metaball list mode, build and march on the thesis
+//! frame (table 2's Phong and table 6's glass at recursion depth 3), with per-pass GPU
+//! times, list memory and each frame's floor on this device; then the modes that apply on
+//! the liquid character (the default demo). Findings: the compute-built S-buffer against
+//! the A-buffer and the raster-built S-buffer, tiles against every per-pixel list, the
+//! Lipschitz march's steps, and the speed targets of the best mode.
+use super::findings::{Finding, Verdict};
+use super::measure::base;
+use super::{write, Env, Steps};
+use crate::bench::floor::Floor;
+use crate::bench::measure as bench_measure;
+use crate::config::{BuildKind, ListKind, MarchKind, Material, RenderKind};
+use crate::error::{Error, Result};
+use crate::render::metaball::MetaballSettings;
+use serde_json::{json, Value};
+use std::path::PathBuf;
+
+pub const COMPUTE_BEATS_ABUFFER: &str =
+    "compute-built S-buffer faster than the A-buffer (thesis frame, Phong)";
+pub const COMPUTE_AS_FAST: &str =
+    "compute-built S-buffer at least as fast as the raster-built one, in either order";
+pub const TILES_BEAT_LISTS: &str =
+    "tiles faster than every per-pixel list (thesis frame, Phong and glass depth 3)";
+pub const LIPSCHITZ_FEWER: &str = "lipschitz march takes fewer steps than the fixed one";
+pub const BEST_PHONG: &str = "best list mode at least 2x the S-buffer (thesis frame, Phong)";
+pub const BEST_GLASS: &str =
+    "best list mode at least 2x the sorted S-buffer (thesis frame, glass depth 3)";
+pub const DEMO_FASTER: &str =
+    "the default demo's render pass at least 2x faster with the best list mode";
+
+/// A list mode: (list, sorted, build, tile, march).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Mode(ListKind, bool, BuildKind, u32, MarchKind);
+
+const FIXED: MarchKind = MarchKind::Fixed;
+const LIP: MarchKind = MarchKind::Lipschitz;
+const R: BuildKind = BuildKind::Raster;
+const C: BuildKind = BuildKind::Compute;
+const S: ListKind = ListKind::Sbuffer;
+const T: ListKind = ListKind::Tiles;
+
+const MODES: &[Mode] = &[
+    Mode(ListKind::Abuffer, false, R, 16, FIXED),
+    Mode(S, false, R, 16, FIXED),
+    Mode(S, true, R, 16, FIXED),
+    Mode(S, false, C, 16, FIXED),
+    Mode(S, true, C, 16, FIXED),
+    Mode(T, false, C, 8, FIXED),
+    Mode(T, false, C, 16, FIXED),
+    Mode(T, false, C, 32, FIXED),
+    Mode(S, false, R, 16, LIP),
+    Mode(S, true, C, 16, LIP),
+    Mode(T, false, C, 8, LIP),
+    Mode(T, false, C, 16, LIP),
+];
+
+/// The modes played on the liquid character (its tinted look sorts S-buffers by default).
+const CHARACTER: &[Mode] = &[
+    Mode(S, true, R, 16, FIXED),
+    Mode(S, true, C, 16, FIXED),
+    Mode(T, false, C, 8, FIXED),
+    Mode(T, false, C, 16, FIXED),
+    Mode(T, false, C, 16, LIP),
+];
+
+impl Mode {
+    fn apply(&self, s: &mut MetaballSettings) {
+        (s.list, s.sorted, s.build, s.tile, s.march) = (self.0, self.1, self.2, self.3, self.4);
+    }
+
+    fn name(&self) -> String {
+        let mut s = base(8, 8).expect("the thesis defaults");
+        self.apply(&mut s);
+        match self.4 {
+            LIP => format!("{} lipschitz", s.list_name()),
+            _ => s.list_name(),
+        }
+    }
+
+    fn per_pixel(&self) -> bool {
+        self.0 != T
+    }
+}
+
+/// One measured configuration.
+struct Cell {
+    mode: Mode,
+    ms: f64,
+    passes: String,
+    list_mb: f64,
+    steps: f64,
+    evals: f64,
+    floor: f64,
+}
+
+/// Glass at depth 3 costs ten Phong frames on lavapipe: the sorted lists only (the
+/// unsorted ones and the A-buffer sum every metaball of a pixel at each sample).
+const GLASS_MODES: &[Mode] = &[
+    Mode(S, true, R, 16, FIXED),
+    Mode(S, true, C, 16, FIXED),
+    Mode(T, false, C, 8, FIXED),
+    Mode(T, false, C, 16, FIXED),
+    Mode(S, true, C, 16, LIP),
+    Mode(T, false, C, 16, LIP),
+];
+
+/// (label, material, depth, modes): table 2's Phong, table 6's glass at recursion depth 3.
+type Look = (&'static str, Material, u32, &'static [Mode]);
+const LOOKS: [Look; 2] = [
+    ("Phong (table 2)", Material::Phong, 1, MODES),
+    ("glass, depth 3 (table 6)", Material::Glass, 3, GLASS_MODES),
+];
+
+fn thesis_frame(
+    ctx: &crate::gpu::Context,
+    env: &mut Env,
+    steps: &mut Steps,
+) -> Result<Vec<Vec<Cell>>> {
+    let centers = env.scene(ctx)?.centers.clone();
+    let cam = env.scene(ctx)?.camera;
+    let n = centers.len();
+    let opts = env.bench_options("lists", "lists");
+    let floor = Floor::measure(ctx, &opts)?;
+    let mut buf = ctx.storage_buffer("thesis centers", (n * 16) as u64)?;
+    let mut out = Vec::new();
+    let result = (|| -> Result<()> {
+        ctx.upload(&mut buf, 0, &centers)?;
+        for (label, material, depth, modes) in LOOKS {
+            let mut row = Vec::new();
+            for mode in modes {
+                steps.start(&format!("{label} {}", mode.name()));
+                let mut s = base(env.width, env.height)?;
+                (s.material, s.depth) = (material, depth);
+                mode.apply(&mut s);
+                s.validate()?;
+                let (r, b) = env.renderer(ctx, &s, n as u64)?;
+                let (st, redos) = r.render_sync(ctx, b, &buf, n as u32, &cam, 0)?;
+                let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
+                    "particles": n, "redos": redos });
+                let variant = format!("{}-{}", material.as_str(), mode.name().replace(' ', "-"));
+                let m = bench_measure(
+                    ctx,
+                    &opts,
+                    &variant,
+                    n as u64,
+                    "render",
+                    detail,
+                    |prof, cmd| {
+                        prof.begin(ctx, cmd, "render");
+                        r.record(ctx, cmd, prof, b, &buf, n as u32, &cam, 0)?;
+                        prof.end(ctx, cmd);
+                        Ok(())
+                    },
+                )?;
+                let after = r.frame_stats(b, 0);
+                if after.budget_pixels > 0 || after.overflow > 0 {
+                    return Err(Error::Param(format!(
+                        "lists: {label} {}: {} pixels past the loop budget, {} entries overflowed",
+                        mode.name(),
+                        after.budget_pixels,
+                        after.overflow
+                    )));
+                }
+                let px = s.pixels() as f64;
+                let (st_px, ev_px, _) = after.march.per_pixel(s.pixels());
+                let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
+                let passes = (m.passes.iter())
+                    .filter_map(|(k, v)| Some((k.strip_prefix("render/")?, v.median)))
+                    .map(|(k, v)| format!("{k} {v:.2}"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                row.push(Cell {
+                    mode: *mode,
+                    ms: m.main.median,
+                    passes,
+                    list_mb: st.list_bytes as f64 / 1e6,
+                    steps: st_px,
+                    evals: ev_px,
+                    floor: floor.ms(bytes, after.march.evaluations as f64),
+                });
+                steps.tick();
+            }
+            out.push(row);
+        }
+        Ok(())
+    })();
+    ctx.destroy_buffer(&mut buf);
+    result.map(|_| out)
+}
+
+/// The character scene's median `render` ms per mode.
+fn character(env: &Env, steps: &mut Steps) -> Result<Vec<(Mode, f64)>> {
+    let frames = if env.quick { 8 } else { 60 };
+    let mut out = Vec::new();
+    for mode in CHARACTER {
+        steps.start(&format!("character {}", mode.name()));
+        let mut sw = env.switches.clone();
+        sw.common.quiet = true;
+        sw.view.render = Some(RenderKind::Metaballs);
+        sw.metaball.list = Some(mode.0);
+        if mode.0 == S {
+            sw.metaball.list_sort = Some(crate::config::OnOff::On);
+            sw.metaball.build = Some(mode.2);
+        }
+        sw.metaball.tile = (mode.2 == C).then_some(mode.3);
+        sw.metaball.march = Some(mode.4);
+        let dir = env
+            .runs("lists")
+            .join(format!("character-{}", mode.name().replace(' ', "-")));
+        let opts = crate::run::RunOptions {
+            scene: "character".into(),
+            frames: Some(frames),
+            out: dir.clone(),
+            save_every: frames - 1,
+            switches: sw,
+        };
+        crate::run::run(&opts)?;
+        let text =
+            std::fs::read_to_string(dir.join("summary.json")).map_err(|e| super::io(&dir, e))?;
+        let v: Value =
+            serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))?;
+        let ms = v["pass_ms"]["render"]["median"]
+            .as_f64()
+            .unwrap_or(f64::NAN);
+        out.push((*mode, ms));
+        steps.tick();
+    }
+    Ok(out)
+}
+
+pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
+    let total = (MODES.len() + GLASS_MODES.len() + CHARACTER.len()) as u64;
+    let mut steps = Steps::new("lists", total, env.switches.common.quiet);
+    let cells = thesis_frame(ctx, env, &mut steps)?;
+    let demo = character(env, &mut steps)?;
+    steps.finish();
+    let (w, h, n) = (env.width, env.height, env.particles);
+    let mut md = format!(
+        "# Metaball lists: modes, builds and marches\n\n\
+         The thesis frame (the walker filled with {n} particles, {w}x{h}, Wyvill, T 0.9, \
+         R 0.04, I 2), rendered alone per mode: GPU median of the `render` scope and its \
+         passes; list MB: the list structures' bytes; steps and evaluations per pixel: the \
+         march's counters; floor: the frame's least traffic (centres read, picture written, \
+         lists written and read once) over the copy bandwidth measured in this run, or its \
+         evaluations ({} FLOPs each) over the FMA rate measured in this run, whichever is \
+         larger. Glass runs the sorted lists and tiles only.\n",
+        crate::bench::floor::FLOPS_PER_EVAL
+    );
+    let mut csv =
+        String::from("look,mode,render_ms,passes,list_mb,steps_px,evals_px,floor_ms,x_floor\n");
+    for ((label, _, _, _), row) in LOOKS.iter().zip(&cells) {
+        md.push_str(&format!(
+            "\n## {label}\n\n| mode | render ms | x first row | passes (ms) | list MB | steps/px | evals/px | floor ms | x floor |\n|---|---|---|---|---|---|---|---|---|\n"
+        ));
+        let sb = row.first().map_or(f64::NAN, |c| c.ms);
+        for c in row {
+            md.push_str(&format!(
+                "| {} | {:.2} | {:.2} | {} | {:.2} | {:.2} | {:.0} | {:.4} | {:.0} |\n",
+                c.mode.name(),
+                c.ms,
+                sb / c.ms,
+                c.passes,
+                c.list_mb,
+                c.steps,
+                c.evals,
+                c.floor,
+                c.ms / c.floor
+            ));
+            csv.push_str(&format!(
+                "{label},{},{:.4},\"{}\",{:.4},{:.3},{:.2},{:.5},{:.2}\n",
+                c.mode.name(),
+                c.ms,
+                c.passes,
+                c.list_mb,
+                c.steps,
+                c.evals,
+                c.floor,
+                c.ms / c.floor
+            ));
+        }
+    }
+    let base_ms = demo.first().map_or(f64::NAN, |d| d.1);
+    md.push_str(&format!(
+        "\n## The liquid character (`fluidform run --scene character`, {} frames, tinted)\n\n| mode | render ms | x default |\n|---|---|---|\n",
+        if env.quick { 8 } else { 60 }
+    ));
+    for (mode, ms) in &demo {
+        md.push_str(&format!(
+            "| {} | {ms:.2} | {:.2} |\n",
+            mode.name(),
+            base_ms / ms
+        ));
+        csv.push_str(&format!("character,{},{ms:.4},,,,,,\n", mode.name()));
+    }
+    let labels: Vec<String> = MODES.iter().map(|m| m.name()).collect();
+    let series: Vec<(String, Vec<Option<f64>>)> = (LOOKS.iter().zip(&cells))
+        .map(|((l, _, _, _), row)| {
+            let at = |m: &Mode| row.iter().find(|c| c.mode == *m).map(|c| c.ms);
+            (l.to_string(), MODES.iter().map(at).collect())
+        })
+        .collect();
+    let png = env.out.join("lists.png");
+    crate::bench::plot::grouped_bars(
+        &png,
+        "Metaball list modes, thesis frame",
+        &format!("{}, {}", env.meta.device, env.meta.date),
+        &labels,
+        &series,
+        "render ms per frame",
+    )?;
+    md.push_str("\n![render ms per mode](lists.png)\n");
+    let found = findings(&cells, &demo);
+    let p_csv = env.out.join("lists.csv");
+    write(&p_csv, &csv)?;
+    let p_md = super::finish_md(env, "lists", md, &found)?;
+    Ok((vec![p_csv, p_md, png], found))
+}
+
+fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
+    let ms = |row: &[Cell], m: Mode| row.iter().find(|c| c.mode == m).map_or(f64::NAN, |c| c.ms);
+    let fixed = |row: &[Cell]| -> Vec<(Mode, f64)> {
+        (row.iter())
+            .filter(|c| c.mode.4 == FIXED)
+            .map(|c| (c.mode, c.ms))
+            .collect()
+    };
+    let best = |v: &[(Mode, f64)]| v.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
+    let (phong, glass) = (&cells[0], &cells[1]);
+    let abuf = ms(phong, MODES[0]);
+    let compute = best(
+        &fixed(phong)
+            .into_iter()
+            .filter(|(m, _)| m.0 == S && m.2 == C)
+            .collect::<Vec<_>>(),
+    );
+    let mut found = Vec::new();
+    found.push(match compute {
+        Some((m, t)) => Finding::new(
+            COMPUTE_BEATS_ABUFFER,
+            Verdict::of(t < abuf),
+            format!(
+                "{}: {t:.2} ms, A-buffer {abuf:.2} ms ({:.2}x)",
+                m.name(),
+                abuf / t
+            ),
+        ),
+        None => Finding::new(COMPUTE_BEATS_ABUFFER, Verdict::NotMeasured, String::new()),
+    });
+    let mut holds = true;
+    let mut ev = Vec::new();
+    for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
+        for sorted in [false, true] {
+            let (r, c) = (
+                ms(row, Mode(S, sorted, R, 16, FIXED)),
+                ms(row, Mode(S, sorted, C, 16, FIXED)),
+            );
+            if r.is_nan() || c.is_nan() {
+                continue;
+            }
+            holds &= c <= r;
+            ev.push(format!(
+                "{label} {}: {:.2}x",
+                if sorted { "sorted" } else { "unsorted" },
+                r / c
+            ));
+        }
+    }
+    found.push(Finding::new(
+        COMPUTE_AS_FAST,
+        Verdict::of(holds),
+        format!("raster ms / compute ms: {}", ev.join("; ")),
+    ));
+    let (mut holds, mut ev) = (true, Vec::new());
+    for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
+        let f = fixed(row);
+        let tiles = best(
+            &f.iter()
+                .copied()
+                .filter(|(m, _)| !m.per_pixel())
+                .collect::<Vec<_>>(),
+        );
+        let lists = best(
+            &f.iter()
+                .copied()
+                .filter(|(m, _)| m.per_pixel())
+                .collect::<Vec<_>>(),
+        );
+        if let (Some(t), Some(l)) = (tiles, lists) {
+            holds &= t.1 < l.1;
+            ev.push(format!(
+                "{label}: {} {:.2} ms, best list {} {:.2} ms",
+                t.0.name(),
+                t.1,
+                l.0.name(),
+                l.1
+            ));
+        }
+    }
+    found.push(Finding::new(
+        TILES_BEAT_LISTS,
+        Verdict::of(holds),
+        ev.join("; "),
+    ));
+    let (mut holds, mut ev) = (true, Vec::new());
+    for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
+        for c in row.iter().filter(|c| c.mode.4 == LIP) {
+            let m = c.mode;
+            if let Some(f) = row
+                .iter()
+                .find(|f| f.mode == Mode(m.0, m.1, m.2, m.3, FIXED))
+            {
+                holds &= c.steps < f.steps;
+                ev.push(format!(
+                    "{label} {}: {:.3} -> {:.3} steps/px",
+                    f.mode.name(),
+                    f.steps,
+                    c.steps
+                ));
+            }
+        }
+    }
+    found.push(Finding::new(
+        LIPSCHITZ_FEWER,
+        Verdict::of(holds),
+        ev.join("; "),
+    ));
+    for (claim, row, reference) in [(BEST_PHONG, phong, MODES[1]), (BEST_GLASS, glass, MODES[2])] {
+        let all: Vec<(Mode, f64)> = row.iter().map(|c| (c.mode, c.ms)).collect();
+        let r = ms(row, reference);
+        found.push(match best(&all) {
+            Some((m, t)) => Finding::new(
+                claim,
+                Verdict::of(r / t >= 2.0),
+                format!(
+                    "{}: {t:.2} ms against {} {r:.2} ms ({:.2}x)",
+                    m.name(),
+                    reference.name(),
+                    r / t
+                ),
+            ),
+            None => Finding::new(claim, Verdict::NotMeasured, String::new()),
+        });
+    }
+    let d0 = demo.first().map_or(f64::NAN, |d| d.1);
+    found.push(match best(demo) {
+        Some((m, t)) => Finding::new(
+            DEMO_FASTER,
+            Verdict::of(d0 / t >= 2.0),
+            format!(
+                "{}: {t:.2} ms against the default's {d0:.2} ms ({:.2}x)",
+                m.name(),
+                d0 / t
+            ),
+        ),
+        None => Finding::new(DEMO_FASTER, Verdict::NotMeasured, String::new()),
+    });
+    found
+}
