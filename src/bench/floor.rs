@@ -5,23 +5,15 @@
 use super::{measure, BenchOptions};
 use crate::error::Result;
 use crate::gpu::{ComputeDesc, ComputePipeline, Context, Guard};
-use bytemuck::{Pod, Zeroable};
 use serde_json::json;
 
 /// FLOPs of one density evaluation (Wyvill, from r^2 and the sum): d = x - c (3), r^2 (5),
 /// q^2 (1), the cubic in q^2 by Horner (6), the sum (1).
 pub const FLOPS_PER_EVAL: f64 = 16.0;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct FmaPush {
-    pub iters: u32,
-    pub a: f32,
-}
-
 crate::gpu_interface! {
-    /// glsl/bench/fma.comp
-    pub FmaIo / FmaBufs: "FMA", push FmaPush { out = 0 }
+    /// glsl/bench/fma.comp; push: the iterations per invocation.
+    pub FmaIo / FmaBufs: "FMA", push u32 { out = 0 }
 }
 
 /// Iterations per invocation of fma.comp (64 FLOPs each), within llvmpipe's loop budget.
@@ -53,10 +45,6 @@ impl Floor {
             prof.end(ctx, cmd);
             Ok(())
         })?;
-        let push = FmaPush {
-            iters: ITERS,
-            a: 0.999,
-        };
         let rate = measure(
             ctx,
             opts,
@@ -66,7 +54,7 @@ impl Floor {
             json!({}),
             |prof, cmd| {
                 prof.begin(ctx, cmd, "fma");
-                fma.dispatch(ctx, cmd, &FmaBufs { out: &out }, &push, invocations);
+                fma.dispatch(ctx, cmd, &FmaBufs { out: &out }, &ITERS, invocations);
                 prof.end(ctx, cmd);
                 Ok(())
             },
