@@ -117,20 +117,14 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
                 let detail = json!({ "table": def.name, "row": label, "list": col.name,
                     "settings": s, "particles": n, "redos": redos });
                 let variant = format!("{}-{}", slug(&label), col.name);
-                let row = bench_measure(
-                    ctx,
-                    &opts,
-                    &variant,
-                    n as u64,
-                    "render",
-                    detail,
-                    |prof, cmd| {
-                        prof.begin(ctx, cmd, "render");
-                        r.record(ctx, cmd, prof, b, &buf, n as u32, &cam, 0)?;
-                        prof.end(ctx, cmd);
-                        Ok(())
-                    },
-                )?;
+                let frame = Frame {
+                    r,
+                    b,
+                    centers: &buf,
+                    n: n as u32,
+                    cam: &cam,
+                };
+                let row = time_frame(ctx, &opts, &variant, detail, &frame)?;
                 let after = r.frame_stats(b, 0);
                 let st = sized.map_or(after, |s| s.0);
                 cells.push(Cell {
@@ -155,6 +149,39 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     }
     steps.finish();
     Ok(out)
+}
+
+/// A renderer's frame of `n` metaballs at `centers` seen by `cam`.
+pub struct Frame<'a> {
+    pub r: &'a crate::render::metaball::MetaballRenderer,
+    pub b: &'a crate::render::metaball::MetaballBuffers,
+    pub centers: &'a crate::gpu::Buffer,
+    pub n: u32,
+    pub cam: &'a crate::render::Camera,
+}
+
+/// The bench's timed repetitions of one frame, the `render` scope its headline.
+pub fn time_frame(
+    ctx: &Context,
+    opts: &crate::bench::BenchOptions,
+    variant: &str,
+    detail: serde_json::Value,
+    f: &Frame,
+) -> Result<crate::bench::Row> {
+    bench_measure(
+        ctx,
+        opts,
+        variant,
+        f.n as u64,
+        "render",
+        detail,
+        |prof, cmd| {
+            prof.begin(ctx, cmd, "render");
+            f.r.record(ctx, cmd, prof, f.b, f.centers, f.n, f.cam, 0)?;
+            prof.end(ctx, cmd);
+            Ok(())
+        },
+    )
 }
 
 fn col_index(def: &TableDef, name: &str) -> Option<usize> {
