@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerate results/<device-slug>/render.md: the thesis's rendering setup (2048 particles
 # in a resting blob, 512x512, Wyvill, T = 0.9, R = 0.04, I = 2) for none, A-buffer and
-# S-buffer, with Phong and with glass at recursion depth 3; then Phong with --march lipschitz.
+# S-buffer (built by raster and by compute, unsorted and sorted) and tiles, with Phong and
+# with glass at recursion depth 3; then Phong with --march lipschitz. Each row has its floor.
 # Usage: scripts/bench_render.sh [--device N|NAME] [--frames N] [--particles N]
 #        [--width W] [--height H] (the last three shrink the setup, e.g. for a quick check)
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
