@@ -261,7 +261,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
                 c.ms / c.floor
             ));
             csv.push_str(&format!(
-                "{label},{},{:.4},\"{}\",{:.4},{:.3},{:.2},{:.5},{:.2}\n",
+                "\"{label}\",{},{:.4},\"{}\",{:.4},{:.3},{:.2},{:.5},{:.2}\n",
                 c.mode.name(),
                 c.ms,
                 c.passes,
