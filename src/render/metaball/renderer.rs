@@ -147,7 +147,7 @@ impl MetaballRenderer {
     ) -> Result<MetaballBuffers> {
         let first = match self.settings.list {
             // A few tiles per metaball.
-            ListKind::Tiles => n_capacity * 4 + super::settings::tile_grid(&self.settings).1,
+            ListKind::Tiles => super::tiles::first_pairs(&self.settings, n_capacity),
             _ => self.settings.pixels() * 4,
         };
         self.buffers_with_capacity(ctx, n_capacity, slots, debug, first)
@@ -282,7 +282,7 @@ impl MetaballRenderer {
             scopes.begin(ctx, cmd, "count");
             match (&self.count, &self.tiles) {
                 (Some(count), _) => draw(count),
-                (None, Some(tiles)) => tiles.record_count(ctx, cmd, &bufs, s),
+                (None, Some(tiles)) => tiles.record_pixels(ctx, cmd, &bufs, s, false),
                 (None, None) => {}
             }
             scopes.end(ctx, cmd);
@@ -312,7 +312,7 @@ impl MetaballRenderer {
             scopes.end(ctx, cmd);
         } else if let (true, Some(tiles)) = (compute_lists, &self.tiles) {
             scopes.begin(ctx, cmd, "fill");
-            tiles.record_fill(ctx, cmd, &bufs, s);
+            tiles.record_pixels(ctx, cmd, &bufs, s, true);
             scopes.end(ctx, cmd);
         }
         let groups = px.div_ceil(march.local_size as u64);

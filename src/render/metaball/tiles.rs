@@ -48,12 +48,12 @@ impl TileBuffers {
     ) -> Result<Self> {
         let used = s.bins_tiles();
         let (_, tiles) = tile_grid(s);
-        // Tiles: the caller's first capacity; compute-built S-buffers: a few tiles per
-        // metaball. Overflow grows it to what a frame needs.
+        // Tiles: the caller's first capacity; compute-built S-buffers: the usual guess.
+        // Overflow grows it to what a frame needs.
         let pairs = match (used, s.list) {
             (false, _) => 0,
             (true, crate::kinds::ListKind::Tiles) => capacity.max(1),
-            (true, _) => n_capacity * 4 + tiles,
+            (true, _) => first_pairs(s, n_capacity),
         };
         let only = |bytes: u64| if used { bytes.max(16) } else { 16 };
         let n = n_capacity.max(1);
@@ -222,29 +222,19 @@ impl TilePasses {
         Ok(())
     }
 
-    /// Record the compute-built S-buffer's per-pixel count ("count"); the caller scans it.
-    pub fn record_count(
+    /// Record the compute-built S-buffer's per-pixel count (the caller then scans it), or
+    /// with `fill` its fill, each range in depth order.
+    pub fn record_pixels(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         bufs: &MetaballBufs,
         s: &MetaballSettings,
+        fill: bool,
     ) {
-        if let Some((count, _)) = &self.pixels {
-            count.dispatch_groups(ctx, cmd, bufs, &(), blocks(s));
-        }
-    }
-
-    /// Record the compute-built S-buffer's fill, each range in depth order.
-    pub fn record_fill(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        bufs: &MetaballBufs,
-        s: &MetaballSettings,
-    ) {
-        if let Some((_, fill)) = &self.pixels {
-            fill.dispatch_groups(ctx, cmd, bufs, &(), blocks(s));
+        if let Some((count, filler)) = &self.pixels {
+            let pass = if fill { filler } else { count };
+            pass.dispatch_groups(ctx, cmd, bufs, &(), blocks(s));
         }
     }
 
@@ -266,6 +256,11 @@ impl TilePasses {
 }
 
 crate::impl_destroy!(TilePasses);
+
+/// A first guess at a frame's pairs: a few tiles per metaball.
+pub fn first_pairs(s: &MetaballSettings, n_capacity: u64) -> u64 {
+    n_capacity * 4 + tile_grid(s).1
+}
 
 /// Workgroups of the 8 x 8 pixel-block passes (the pixel lists, the tiles' march).
 pub fn blocks(s: &MetaballSettings) -> u64 {
