@@ -181,9 +181,18 @@ fn thesis_frame(
     result.map(|_| out)
 }
 
+/// Frames the character plays per mode.
+fn character_frames(env: &Env) -> u64 {
+    if env.quick {
+        8
+    } else {
+        60
+    }
+}
+
 /// The character scene's median `render` ms per mode.
 fn character(env: &Env, steps: &mut Steps) -> Result<Vec<(Mode, f64)>> {
-    let frames = if env.quick { 8 } else { 60 };
+    let frames = character_frames(env);
     let mut out = Vec::new();
     for mode in CHARACTER {
         steps.start(&format!("character {}", mode.name()));
@@ -237,7 +246,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
          march's counters; floor: the frame's least traffic (centres read, picture written, \
          lists written and read once) over the copy bandwidth measured in this run, or its \
          evaluations ({} FLOPs each) over the FMA rate measured in this run, whichever is \
-         larger. Glass runs the sorted lists and tiles only.\n",
+         larger. Glass runs the sorted lists and tiles of 8 and 16 only.\n",
         crate::bench::floor::FLOPS_PER_EVAL
     );
     let mut csv =
@@ -276,7 +285,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
     let base_ms = demo.first().map_or(f64::NAN, |d| d.1);
     md.push_str(&format!(
         "\n## The liquid character (`fluidform run --scene character`, {} frames, tinted)\n\n| mode | render ms | x default |\n|---|---|---|\n",
-        if env.quick { 8 } else { 60 }
+        character_frames(env)
     ));
     for (mode, ms) in &demo {
         md.push_str(&format!(
