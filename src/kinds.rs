@@ -47,6 +47,17 @@ switch_enum!(
 );
 
 switch_enum!(
+    /// SPH smoothing kernel, one for densities and pressure gradients alike (src/sph/kernel.rs):
+    /// Mueller 2003's poly6 densities with spiky gradients (the thesis's), the cubic
+    /// spline, or Wendland's C2.
+    Kernel {
+        Muller,
+        Cubic,
+        Wendland
+    }
+);
+
+switch_enum!(
     /// The metaball lists: none, the A-buffer's linked lists, the S-buffer's ranges (the
     /// thesis's), or per-tile ranges sorted by (tile, depth) after tile-based splatting.
     ListKind {

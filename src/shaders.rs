@@ -137,7 +137,7 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
             ));
             v.push(with::<neighbors::NbQueryIo>("primitives/nb_query.comp", &d));
             let mut sph = d.clone();
-            sph.extend(crate::sph::params::Eos::defines());
+            sph.extend(crate::sph::params::defines());
             sph.extend(crate::sph::pressure::solver_defines());
             for f in ["sph/density.comp", "sph/forces.comp", "sph/integrate.comp"] {
                 v.push(with::<crate::sph::solver::SphIo>(f, &sph));

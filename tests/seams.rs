@@ -331,7 +331,8 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             tension, tension_threshold, gamma, eos, clamp_negative, colliders, live, poly6,
             poly6_grad, spiky_grad, visc_lap, solver, min_iter, max_iter, density_target,
             divergence_target, proto_grad2, pbf_relaxation, scorr_k, scorr_n, scorr_inv_w,
-            xsph, vorticity, list_max, pad0, pad1, pad2),
+            xsph, vorticity, list_max, kernel, kernel_k, min_neighbors, div_min_iter,
+            dt_prev, cfl, dt_max, cfl_speed, wall_offset, pad1, pad2),
         ),
         (
             "sph/solve_loop.comp",

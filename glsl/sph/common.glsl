@@ -45,7 +45,16 @@ struct SphParams {
     float xsph;
     float vorticity;
     uint list_max;            // dfsph: neighbour list length (0: off)
-    uint pad0, pad1, pad2;
+    uint kernel;              // KERNEL_MULLER, _CUBIC, _WENDLAND (kernel.glsl)
+    float kernel_k;           // cubic's or wendland's normalisation
+    uint min_neighbors;       // dfsph: fewer, and the divergence solve leaves a particle out
+    uint div_min_iter;        // dfsph: the divergence solve's least iterations
+    float dt_prev;            // the previous step's dt (warm starts rescale by it)
+    float cfl;                // > 0: the step's dt from its own velocities (cfl.comp)
+    float dt_max;             // with cfl: the largest step
+    float cfl_speed;          // with cfl: the least speed it divides by (wcsph: c)
+    float wall_offset;        // the walls' terms take a particle this much farther
+    uint pad1, pad2;
 };
 struct Collider {
     vec4 a;    // plane: normal, w = offset (fluid where dot(n, x) >= w); sphere/capsule: point, w = radius

@@ -1,5 +1,5 @@
 #version 450
-// Forces: pressure (spiky gradient, symmetric; the solid boundary's, boundary.glsl),
+// Forces: pressure (the kernel's gradient, kernel.glsl; symmetric; the solid boundary's, boundary.glsl),
 // viscosity (viscosity Laplacian), surface tension (colour field, where |n| >= threshold),
 // gravity; writes the acceleration f / rho.
 #ifdef PASS
@@ -31,7 +31,7 @@ void main() {
             float r = sqrt(r2); \
             if (r > 1e-6 * h) { \
                 float w = h - r; \
-                f_press -= vol * 0.5 * (p_i + rp.y) * P.spiky_grad * w * w * (d / r); \
+                f_press -= vol * 0.5 * (p_i + rp.y) * kernel_grad(d, r2); \
                 f_visc += vol * (vel[j].xyz - vi) * P.visc_lap * w; \
             } \
         } }

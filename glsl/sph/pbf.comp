@@ -40,8 +40,7 @@ void main() {
             vec3 d = xi - aux[j].xyz;
             float r2 = dot(d, d);
             if (r2 < h2) {
-                float q = h2 - r2;
-                sum += q * q * q;
+                sum += kernel_w(r2);
                 if (j != i) {
                     vec3 g = V * grad_w(d, r2);
                     sg += g;
@@ -53,7 +52,7 @@ void main() {
         float rate;
         float rho_b = boundary(xi, vec3(0.0), gw, rate);
         sg += gw;
-        float c = max(P.mass * P.poly6 * sum / P.rest_density + rho_b - 1.0, 0.0);
+        float c = max(P.mass * sum / P.rest_density + rho_b - 1.0, 0.0);
         float lambda = -c / (dot(sg, sg) + s2 + P.pbf_relaxation * P.proto_grad2);
         rho_p[i].y = lambda;
         aux[i].w += lambda;  // neighbours read aux.xyz only
@@ -70,7 +69,7 @@ void main() {
         float r2 = dot(d, d);
         if (j != i && r2 < h2) {
             // k relative to a full neighbourhood's constraint stiffness (lambda's units).
-            float scorr = -P.scorr_k * pow(w_poly6(r2) * P.scorr_inv_w, P.scorr_n) / P.proto_grad2;
+            float scorr = -P.scorr_k * pow(kernel_w(r2) * P.scorr_inv_w, P.scorr_n) / P.proto_grad2;
             dx += V * (li + rho_p[j].y + scorr) * grad_w(d, r2);
         }
     NB_END
@@ -101,7 +100,7 @@ void main() {
         if (j != i && r2 < h2) {
             vec3 vji = vel[j].xyz - vi;
             w += V * cross(grad_w(d, r2), vji);
-            dv += V * vji * w_poly6(r2);
+            dv += V * vji * kernel_w(r2);
         }
     NB_END
     aux[i] = vec4(w, 0.0);

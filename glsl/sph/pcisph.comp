@@ -52,11 +52,11 @@ void main() {
         NB_BEGIN(xi, P.h, j)
             vec3 d = xi - aux[j].xyz;
             float r2 = dot(d, d);
-            if (r2 < h2) { float q = h2 - r2; sum += q * q * q; }
+            sum += kernel_w(r2);
         NB_END
         vec3 gw;
         float rate;
-        float rho = P.mass * P.poly6 * sum + P.rest_density * boundary(xi, vec3(0.0), gw, rate);
+        float rho = P.mass * sum + P.rest_density * boundary(xi, vec3(0.0), gw, rate);
         float err = rho / P.rest_density - 1.0;
         // At most the pressure that resolves a 20% compression of a full neighbourhood in
         // one step: a clump the walls pin (whose density no pressure lowers) would

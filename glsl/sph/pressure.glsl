@@ -1,5 +1,5 @@
 // The pressure solvers' shared part (src/sph/pressure.rs): PressureIo's bindings past
-// SphIo's, the iteration state, the poly6 kernel and gradient, and the per-workgroup error
+// SphIo's, the iteration state, the kernel and its gradient, and the per-workgroup error
 // reduction the loop pass (solve_loop.comp) finishes. V = m / rho0 throughout.
 #ifndef SPH_PRESSURE_GLSL
 #define SPH_PRESSURE_GLSL
@@ -33,18 +33,10 @@ layout(std430, binding = SPH_B_OVERFLOW) buffer Overflow { uint list_overflows; 
 bool sph_alive(uint i) { return i < sph_live() && pos[i].w >= 0.0; }
 float vol0() { return P.mass / P.rest_density; }
 
-// Density by poly6 (as the density pass), gradients by spiky (Macklin & Mueller's choice):
-// poly6's gradient vanishes as r -> 0, so it cannot part particles the walls' projection
-// stacks together, which then pin their pressure high. Spiky's divergence reads about 0.8
-// of poly6's density change on a rest lattice: the solves over-correct compression a
-// little (measured by the density pass, the error the runs report).
-float w_poly6(float r2) { float q = P.h * P.h - r2; return P.poly6 * q * q * q; }
-vec3 grad_w(vec3 d, float r2) {
-    float r = sqrt(r2);
-    if (r <= 1e-6 * P.h) return vec3(0.0);
-    float w = P.h - r;
-    return P.spiky_grad * w * w * (d / r);
-}
+// One kernel for densities and gradients (kernel.glsl's, as the density pass), except
+// muller's poly6 with spiky, whose divergence reads about 0.8 of poly6's density change on
+// a rest lattice: with it the solves over-correct compression a little.
+vec3 grad_w(vec3 d, float r2) { return kernel_grad(d, r2); }
 
 // The velocity the collision response leaves to a particle at x moving with v for dt.
 void wall_response(vec3 x, float dt, inout vec3 v) {

@@ -21,14 +21,16 @@ void main() {
     S.iter = it;
 #if DIVERGENCE
     float target = P.divergence_target;
+    uint least = P.div_min_iter;
     S.divergence_iters = it;
     S.divergence_err = mean;
 #else
     float target = P.density_target;
+    uint least = P.min_iter;
     S.density_iters = it;
     S.density_err = mean;
 #endif
-    if ((it >= P.min_iter && mean <= target) || it >= P.max_iter) {
+    if ((it >= least && mean <= target) || it >= P.max_iter) {
         S.done = 1u;
         S.gz = 0u;
         S.lz = 0u;

@@ -214,7 +214,7 @@ impl ControlForce {
         let m = control_count(mesh, &settings, rays)?;
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
         // The passes walk the fluid's grid with the fluid search's defines.
-        let eos = crate::sph::params::Eos::defines();
+        let eos = crate::sph::params::defines();
         let mut defines = solver.search.defines();
         defines.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
         defines.extend(ControlSettings::defines(settings.adaptive));

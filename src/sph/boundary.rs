@@ -2,6 +2,7 @@
 //! walls and the colliders as solid half-spaces at rest density (their density / rho0 and
 //! sum V grad W in closed form), and common.glsl's collision response.
 use super::collider::{Collider, GpuCollider};
+use super::kernel::{wall_density, wall_push, Kernel};
 use super::params::FluidParams;
 use crate::error::Result;
 
@@ -22,6 +23,10 @@ pub struct Boundary {
     pub friction: f32,
     /// The response keeps particles this far from every surface: half the rest spacing.
     pub margin: f64,
+    /// The kernel whose wall terms the densities and gradients take, and their offset
+    /// (`kernel::wall_offset`).
+    pub kernel: Kernel,
+    pub offset: f64,
 }
 
 /// The boundary as a particle at x moving with v sees it.
@@ -35,23 +40,11 @@ pub struct Solid {
     pub rate: f64,
 }
 
-/// Density / rho0 of a solid half-space at distance d (the poly6 integral).
-pub fn solid_density(h: f64, d: f64) -> f64 {
-    let u = (d / h).clamp(0.0, 1.0);
-    let f =
-        u - 4.0 / 3.0 * u.powi(3) + 6.0 / 5.0 * u.powi(5) - 4.0 / 7.0 * u.powi(7) + u.powi(9) / 9.0;
-    0.5 - 315.0 / 256.0 * f
-}
-
-/// |sum V grad W_spiky| of a solid half-space at distance d.
-pub fn solid_push(h: f64, d: f64) -> f64 {
-    let w = 1.0 - (d / h).clamp(0.0, 1.0);
-    30.0 / h * (w.powi(4) / 4.0 - w.powi(5) / 5.0)
-}
 
 impl Boundary {
     /// The domain box alone.
     pub fn new(f: &FluidParams, min: [f32; 3], max: [f32; 3]) -> Self {
+        let f = &f.resolved().unwrap_or_else(|_| f.clone());
         Self {
             min,
             max,
@@ -59,6 +52,8 @@ impl Boundary {
             restitution: f.restitution,
             friction: f.friction,
             margin: 0.5 * f.spacing() as f64,
+            kernel: f.kernel(),
+            offset: super::kernel::wall_offset(f),
         }
     }
 
@@ -96,23 +91,16 @@ impl Boundary {
         })
     }
 
-    /// The boundary at x for a particle moving with v.
+    /// The boundary at x for a particle moving with v: the box's walls and the nearest
+    /// collider surface united as 1 - prod(1 - I_k) (boundary.glsl says why).
     pub fn solid(&self, h: f64, x: V3, v: V3) -> Solid {
-        let mut s = Solid::default();
-        let mut add = |n: V3, d: f64, vb: V3| {
-            if d < h {
-                let a = solid_push(h, d);
-                s.rho += solid_density(h, d);
-                s.g = axpy(-a, n, s.g);
-                s.rate -= a * dot(axpy(-1.0, vb, v), n);
-            }
-        };
+        let mut near: Vec<(V3, f64, V3)> = Vec::new();
         for k in 0..3 {
             let mut n = [0.0; 3];
             n[k] = 1.0;
-            add(n, x[k] - self.min[k] as f64, [0.0; 3]);
+            near.push((n, x[k] - self.min[k] as f64, [0.0; 3]));
             n[k] = -1.0;
-            add(n, self.max[k] as f64 - x[k], [0.0; 3]);
+            near.push((n, self.max[k] as f64 - x[k], [0.0; 3]));
         }
         // Of the colliders only the nearest surface counts; a sphere or capsule thinner
         // than h acts by the response alone (boundary.glsl).
@@ -126,8 +114,24 @@ impl Boundary {
                 Some(b) if b.1 <= p.1 => Some(b),
                 _ => Some(p),
             });
-        if let Some((n, d, vb)) = nearest {
-            add(n, d, vb);
+        near.extend(nearest);
+        near.retain(|p| p.1 + self.offset < h);
+        let terms: Vec<(f64, f64)> = near
+            .iter()
+            .map(|p| {
+                let d = p.1 + self.offset;
+                (wall_density(self.kernel, h, d), wall_push(self.kernel, h, d))
+            })
+            .collect();
+        let keep: f64 = terms.iter().map(|t| 1.0 - t.0).product();
+        let mut s = Solid {
+            rho: 1.0 - keep,
+            ..Default::default()
+        };
+        for ((n, _, vb), (i, a)) in near.iter().zip(&terms) {
+            let a = a * keep / (1.0 - i);
+            s.g = axpy(-a, *n, s.g);
+            s.rate -= a * dot(axpy(-1.0, *vb, v), *n);
         }
         s
     }

@@ -1,5 +1,6 @@
 //! CPU reference in f64 with brute-force neighbours: density, pressure and acceleration
-//! by the same formulas as glsl/sph (self term in density and colour Laplacian; pairs
+//! by the same formulas as glsl/sph (the fluid's kernel for densities and the pressure
+//! force, Mueller's for viscosity and the colour field; self term in density and colour Laplacian; pairs
 //! closer than 1e-6 h skip the spiky and viscosity terms; the solid boundary of
 //! boundary.rs in the densities and, mirroring p_i, in the pressure force).
 use super::boundary::Boundary;
@@ -27,16 +28,17 @@ pub fn pressure(f: &FluidParams, rho: f64) -> f64 {
 }
 
 pub fn evaluate(f: &FluidParams, b: &Boundary, pos: &[[f32; 4]], vel: &[[f32; 4]]) -> Reference {
+    let f = &f.resolved().unwrap_or_else(|_| f.clone());
     let n = pos.len();
     let h = f.h as f64;
     let h2 = h * h;
     let m = f.mass as f64;
     let super::params::Kernels {
-        poly6,
         poly6_grad,
-        spiky_grad,
         visc_lap,
+        ..
     } = super::params::Kernels::new(h);
+    let sm = super::kernel::Smoothing::of(f);
     let p3 = |p: &[f32; 4]| [p[0] as f64, p[1] as f64, p[2] as f64];
     let x: Vec<[f64; 3]> = pos.iter().map(p3).collect();
     let v: Vec<[f64; 3]> = vel.iter().map(p3).collect();
@@ -44,15 +46,8 @@ pub fn evaluate(f: &FluidParams, b: &Boundary, pos: &[[f32; 4]], vel: &[[f32; 4]
     let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let density: Vec<f64> = (0..n)
         .map(|i| {
-            let mut s = 0.0;
-            for j in 0..n {
-                let d = sub(&x[i], &x[j]);
-                let r2 = dot(&d, &d);
-                if r2 < h2 {
-                    s += (h2 - r2).powi(3);
-                }
-            }
-            m * poly6 * s + f.rest_density as f64 * b.solid(h, x[i], [0.0; 3]).rho
+            let s: f64 = (0..n).map(|j| sm.w(sub(&x[i], &x[j]))).sum();
+            m * s + f.rest_density as f64 * b.solid(h, x[i], [0.0; 3]).rho
         })
         .collect();
     let pressure: Vec<f64> = density.iter().map(|&r| pressure(f, r)).collect();
@@ -85,10 +80,9 @@ pub fn evaluate(f: &FluidParams, b: &Boundary, pos: &[[f32; 4]], vel: &[[f32; 4]
             }
             lap += vol * poly6_grad * q * (3.0 * h2 - 7.0 * r2);
             if r > 1e-6 * h {
-                let w = h - r;
+                let (w, gw) = (h - r, sm.grad(d));
                 for k in 0..3 {
-                    fp[k] -=
-                        vol * 0.5 * (pressure[i] + pressure[j]) * spiky_grad * w * w * d[k] / r;
+                    fp[k] -= vol * 0.5 * (pressure[i] + pressure[j]) * gw[k];
                     fv[k] += vol * (v[j][k] - v[i][k]) * visc_lap * w;
                 }
             }

@@ -1,7 +1,7 @@
 //! CPU reference in f64 of one step of the incompressible solvers, brute-force neighbours,
 //! by the formulas of glsl/sph/{pcisph,dfsph,pbf}.comp, with a fixed iteration count,
 //! the solid boundary (boundary.rs) in the densities and solves and the collision
-//! response where the shaders apply it. Starts from a state with no warm-start stiffness
+//! response where the shaders apply it (DFSPH: once, after the positions). Starts from a state with no warm-start stiffness
 //! (a scene's first step).
 use super::boundary::{Boundary, Solid};
 use super::params::{Eos, FluidParams};
@@ -61,10 +61,11 @@ pub fn step(
     vel: &[[f32; 4]],
     iterations: u32,
 ) -> (Vec<V3>, Vec<V3>) {
+    let f = &f.resolved().unwrap_or_else(|_| f.clone());
     let n = pos.len();
     let kk = K {
         h: f.h as f64,
-        sm: Smoothing::new(f.h as f64),
+        sm: Smoothing::of(f),
         v: f.mass as f64 / f.rest_density as f64,
         rho0: f.rest_density as f64,
         m: f.mass as f64,
@@ -94,6 +95,7 @@ pub fn step(
         proto,
         dt,
         iterations,
+        min_neighbors: super::params::SphGpuParams::new(f, [0.0; 3], [0.0; 3], 0.0, 0).min_neighbors,
     };
     match f.solver {
         Solver::Wcsph => panic!("cpu_pressure covers the incompressible solvers"),
@@ -117,6 +119,8 @@ struct Common<'a> {
     proto: f64,
     dt: f64,
     iterations: u32,
+    /// DFSPH's divergence solve leaves out particles with fewer fluid neighbours.
+    min_neighbors: u32,
 }
 
 /// PCISPH: pressures predicted and corrected on the predicted positions (collided); delta
@@ -193,26 +197,28 @@ fn dfsph(
                 .map(|j| dot(sub(v[i], v[j]), kk.vg(sub(x[i], x[j]))))
                 .sum::<f64>()
     };
+    // Fluid neighbours: fewer than min_neighbors, and the divergence solve leaves it out.
+    let sparse: Vec<bool> = (0..n)
+        .map(|i| {
+            let near = (0..n)
+                .filter(|&j| j != i && dot(sub(x[i], x[j]), sub(x[i], x[j])) < kk.h * kk.h)
+                .count();
+            near < c.min_neighbors as usize
+        })
+        .collect();
+    // Projected Jacobi on the signed residual, from no stiffness (a first step).
     let solve = |v: &mut Vec<V3>, divergence: bool| {
-        // The warm start's pass (no stiffness yet) answers velocities into walls.
-        for i in 0..n {
-            v[i] = walls.response(x[i], dt, v[i]);
-        }
-        let source = |v: &[V3]| -> Vec<f64> {
-            (0..n)
-                .map(|i| {
-                    if divergence {
-                        rate(v, i).max(0.0)
-                    } else {
-                        (rho[i] / kk.rho0 + dt * rate(v, i) - 1.0).max(0.0)
-                    }
-                })
-                .collect()
+        let residual = |v: &[V3], i: usize| match divergence {
+            true if sparse[i] => 0.0,
+            true => rate(v, i),
+            false => rho[i] / kk.rho0 + dt * rate(v, i) - 1.0,
         };
-        let mut s = source(v);
         let scale = if divergence { dt } else { dt * dt };
+        let mut kappa = vec![0.0; n];
         for _ in 0..c.iterations {
-            let k: Vec<f64> = (0..n).map(|i| s[i] * alpha[i] / scale).collect();
+            let k: Vec<f64> = (0..n)
+                .map(|i| (kappa[i] + 0.5 * residual(v, i) * alpha[i] / scale).max(0.0) - kappa[i])
+                .collect();
             let old = v.clone();
             for i in 0..n {
                 let mut vi = axpy(-dt * k[i], gb[i], old[i]);
@@ -221,15 +227,15 @@ fn dfsph(
                         vi = axpy(-dt * (k[i] + k[j]), kk.vg(sub(x[i], x[j])), vi);
                     }
                 }
-                v[i] = walls.response(x[i], dt, vi);
+                v[i] = vi;
+                kappa[i] += k[i];
             }
-            s = source(v);
         }
     };
     solve(&mut v, true);
     let a = a_np(&v);
     for i in 0..n {
-        v[i] = walls.response(x[i], dt, axpy(dt, a[i], v[i]));
+        v[i] = axpy(dt, a[i], v[i]);
     }
     solve(&mut v, false);
     let mut x: Vec<V3> = (0..n).map(|i| axpy(dt, v[i], x[i])).collect();

@@ -1,4 +1,6 @@
-//! DFSPH (Bender & Koschier 2015): the divergence-free solve on the step's start velocities
+//! DFSPH (Bender & Koschier 2015): each solve a projected Jacobi on the signed residual (its
+//! kappa may fall, never below 0), warm-started where the particle compresses. The
+//! divergence-free solve on the step's start velocities
 //! (after the neighbourhoods and densities are new; the paper's end-of-step solve, moved to
 //! the next step's start), then the non-pressure forces, then the constant-density solve on
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
@@ -27,9 +29,16 @@ pub struct DfsphParams {
     pub density_error: f32,
     /// Iterate the divergence solve until the mean compression rate times dt is at most this.
     pub divergence_error: f32,
-    /// Iterations each solve takes at least and at most.
+    /// Iterations each solve takes at most, and the density solve at least.
     pub min_iterations: u32,
     pub max_iterations: u32,
+    /// Iterations the divergence solve takes at least (SPlisHSPlasH's 1).
+    pub divergence_min_iterations: u32,
+    /// A particle with fewer fluid neighbours is left out of the divergence solve (its
+    /// source 0: spray and thin sheets, whose divergence the kernel cannot estimate);
+    /// default 5/8 of a rest lattice's (20 of the cubic's 32 at 2 spacings, as
+    /// SPlisHSPlasH's 20).
+    pub min_neighbors: Option<u32>,
     /// Neighbours kept per particle and step (0: none). The solves' iterations then read a
     /// list instead of searching 27 grid cells; a particle with more neighbours is searched
     /// as before (exact; counted in `stats.density_error.list_overflows`).
@@ -51,6 +60,8 @@ impl Default for DfsphParams {
             divergence_error: 0.001,
             min_iterations: 2,
             max_iterations: 100,
+            divergence_min_iterations: 1,
+            min_neighbors: None,
             neighbor_list: DEFAULT_NEIGHBOR_LIST,
             cfl: super::params::OWN_CFL,
             dt_max: OWN_DT_MAX,
@@ -64,6 +75,13 @@ impl DfsphParams {
         let d = self.divergence_error;
         check_range("dfsph", "divergence_error", d, (1e-6, 0.5))?;
         check_iterations("dfsph", self.min_iterations, self.max_iterations)?;
+        let least = self.divergence_min_iterations;
+        check_iterations("dfsph", least.max(1), self.max_iterations)?;
+        if least == 0 {
+            return Err(crate::error::Error::Param(
+                "fluid.dfsph.divergence_min_iterations must be at least 1".into(),
+            ));
+        }
         check_step("dfsph", self.cfl, self.dt_max)?;
         if self.neighbor_list > MAX_NEIGHBOR_LIST {
             return Err(crate::error::Error::Param(format!(
@@ -156,7 +174,7 @@ impl Dfsph {
         Pipelines::new(ctx, Solver::Dfsph, &PASSES, base).map(Self)
     }
 
-    /// Warm start, sources, iterations of one solve.
+    /// Warm start (gated, applied), sources, iterations of one solve.
     fn solve(
         &self,
         ctx: &Context,
@@ -170,6 +188,7 @@ impl Dfsph {
         let body = [s.velocity as usize, s.source as usize];
         let r = p
             .run(ctx, cmd, st, s.warm as usize)
+            .and_then(|_| p.run(ctx, cmd, st, s.velocity as usize))
             .and_then(|_| p.run(ctx, cmd, st, s.source as usize))
             .and_then(|_| {
                 let check = s.check as usize;

@@ -8,6 +8,7 @@ pub mod dfsph;
 pub mod errors;
 pub mod health;
 pub mod hooks;
+pub mod kernel;
 pub mod paper_dfsph;
 pub mod paper_pbf;
 pub mod paper_pcisph;

@@ -35,9 +35,10 @@ pub fn step(
     vel: &[[f32; 4]],
     tol: f64,
 ) -> PaperStep {
+    let f = &f.resolved().unwrap_or_else(|_| f.clone());
     let n = pos.len();
     let (h, m, rho0) = (f.h as f64, f.mass as f64, f.rest_density as f64);
-    let sm = Smoothing::new(h);
+    let sm = Smoothing::new(f.kernel(), h);
     let (w, grad) = (|d: V3| sm.w(d), |d: V3| sm.grad(d));
     let x = xyz(pos);
     let mut v = xyz(vel);

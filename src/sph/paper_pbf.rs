@@ -30,9 +30,10 @@ pub fn step(
     iterations: u32,
     requery: bool,
 ) -> (Vec<V3>, Vec<V3>) {
+    let f = &f.resolved().unwrap_or_else(|_| f.clone());
     let n = pos.len();
     let (h, m, rho0) = (f.h as f64, f.mass as f64, f.rest_density as f64);
-    let sm = Smoothing::new(h);
+    let sm = Smoothing::new(f.kernel(), h);
     let (w, grad) = (|d: V3| sm.w(d), |d: V3| sm.grad(d));
     let c = m / rho0;
     let eps = f.pbf.relaxation as f64 * super::params::proto_grad2(f);

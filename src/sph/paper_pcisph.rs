@@ -34,9 +34,10 @@ pub fn step(
     tol: f64,
     omega: f64,
 ) -> (Vec<V3>, Vec<V3>, u32) {
+    let f = &f.resolved().unwrap_or_else(|_| f.clone());
     let n = pos.len();
     let (h, m, rho0) = (f.h as f64, f.mass as f64, f.rest_density as f64);
-    let sm = Smoothing::new(h);
+    let sm = Smoothing::new(f.kernel(), h);
     let (w, grad) = (|d: V3| sm.w(d), |d: V3| sm.grad(d));
     // The prototype's sum |grad W|^2 (its sum grad W vanishes): proto_grad2 is it times
     // (m / rho0)^2.

@@ -8,6 +8,7 @@ pub use super::collider::{Collider, GpuCollider, MAX_COLLIDERS};
 pub use super::dfsph::{DfsphParams, DEFAULT_NEIGHBOR_LIST, MAX_NEIGHBOR_LIST};
 pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
+pub use super::kernel::{proto_grad2, Kernel, Kernels};
 pub use super::pressure::Convergence;
 
 /// DFSPH's and PBF's own CFL number (with each table's `dt_max`: the setup `bench
@@ -22,6 +23,13 @@ pub enum Eos {
     Ideal = 0,
     /// p = B ((rho / rho_0)^gamma - 1), B = rho_0 c^2 / gamma (weakly compressible).
     Tait = 1,
+}
+
+/// The fluid's enum defines for glsl/sph/common.glsl: `EOS_*` and `KERNEL_*`.
+pub fn defines() -> Vec<(String, String)> {
+    let mut v = Eos::defines();
+    v.extend(super::kernel::defines());
+    v
 }
 
 impl Eos {
@@ -79,6 +87,14 @@ pub struct FluidParams {
     pub pcisph: PcisphParams,
     pub dfsph: DfsphParams,
     pub pbf: PbfParams,
+    /// The smoothing kernel (`--kernel`, src/sph/kernel.rs): default muller (the thesis's)
+    /// for wcsph, cubic for the incompressible solvers (their error targets then hold:
+    /// one kernel for densities and gradients).
+    pub kernel: Option<Kernel>,
+    /// Support of the cubic and Wendland kernels in rest spacings (default: cubic 2,
+    /// wendland 3; see `kernel::default_support`): h becomes support times the spacing.
+    /// Muller's support is `h` (set, it too follows `support`).
+    pub support: Option<f32>,
     /// Particle spacing at rest, m (`--fluid spacing=S`): when set, the mass becomes
     /// rho_0 S^3 and h, dt and the steps per frame scale with S from the values given, so
     /// the frame time, h in spacings and the CFL number stay as they were.
@@ -110,6 +126,8 @@ impl Default for FluidParams {
             pcisph: PcisphParams::default(),
             dfsph: DfsphParams::default(),
             pbf: PbfParams::default(),
+            kernel: None,
+            support: None,
             spacing: None,
         }
     }
@@ -223,6 +241,16 @@ impl FluidParams {
         let mut out = out.with_own_step();
         out.validate()?;
         out.resolve_spacing()?;
+        if overrides.iter().any(|o| o.split('=').next().map(str::trim) == Some("h"))
+            && out.kernel() != Kernel::Muller
+        {
+            return Err(Error::Param(format!(
+                "--fluid h= sets the muller kernel's support; the {} kernel's is --fluid \
+                 support= (in rest spacings)",
+                out.kernel().as_str()
+            )));
+        }
+        out.resolve_support()?;
         Ok(out)
     }
 
@@ -323,6 +351,36 @@ impl FluidParams {
             Solver::Dfsph => self.dfsph.neighbor_list,
             Solver::Wcsph | Solver::Pcisph | Solver::Pbf => 0,
         }
+    }
+
+    /// The kernel in use: `kernel`, else muller for wcsph and cubic for the others.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel.unwrap_or(match self.solver {
+            Solver::Wcsph => Kernel::Muller,
+            _ => Kernel::Cubic,
+        })
+    }
+
+    /// h = support x spacing where the kernel has a support in spacings (`support`, else
+    /// its default); muller without `support` keeps h. Applying it again changes nothing.
+    pub fn resolve_support(&mut self) -> Result<()> {
+        let Some(k) = self.support.or(super::kernel::default_support(self.kernel())) else {
+            return Ok(());
+        };
+        if !(1.0..=4.0).contains(&k) {
+            return Err(Error::Param(format!(
+                "fluid.support must be in 1..=4 rest spacings, got {k}"
+            )));
+        }
+        self.h = k * self.spacing();
+        Ok(())
+    }
+
+    /// The parameters with the kernel's support applied (see `resolve_support`).
+    pub fn resolved(&self) -> Result<Self> {
+        let mut f = self.clone();
+        f.resolve_support()?;
+        Ok(f)
     }
 
     /// Lattice spacing at rest density: (m / rho_0)^(1/3).
@@ -426,17 +484,32 @@ pub struct SphGpuParams {
     pub pbf_relaxation: f32,
     pub scorr_k: f32,
     pub scorr_n: f32,
-    /// 1 / W_poly6(scorr_dq h)
+    /// 1 / W(scorr_dq h), the fluid's kernel
     pub scorr_inv_w: f32,
     pub xsph: f32,
     pub vorticity: f32,
     /// DFSPH's neighbour list length (0: off; see `FluidParams::list_len`).
     pub list_max: u32,
-    pub pad0: u32,
+    /// `Kernel` as u32, and cubic's or wendland's normalisation (`kernel::norm`).
+    pub kernel: u32,
+    pub kernel_k: f32,
+    /// DFSPH: a particle with fewer fluid neighbours is left out of the divergence solve.
+    pub min_neighbors: u32,
+    /// DFSPH: the divergence solve's least iterations.
+    pub div_min_iter: u32,
+    /// The previous step's dt (the warm starts rescale by it; cfl.comp keeps it).
+    pub dt_prev: f32,
+    /// > 0: each step's dt comes from its own velocities on the GPU (glsl/sph/cfl.comp):
+    /// min(dt_max, cfl h / max(v_max, cfl_speed)).
+    pub cfl: f32,
+    pub dt_max: f32,
+    pub cfl_speed: f32,
+    /// The walls' terms take a particle this much farther than it is (`kernel::wall_offset`).
+    pub wall_offset: f32,
     pub pad1: u32,
     pub pad2: u32,
 }
-const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 176);
+const _: () = assert!(std::mem::size_of::<SphGpuParams>() == 208);
 
 impl SphGpuParams {
     /// Byte offset of `live` (the emitter copies its GPU-side count there).
@@ -448,7 +521,7 @@ impl SphGpuParams {
         let incompressible = f.solver != crate::kinds::Solver::Wcsph;
         let c = f.convergence();
         let dq = (f.pbf.scorr_dq * h) as f64;
-        let w_dq = k.poly6 * (h as f64 * h as f64 - dq * dq).powi(3);
+        let w_dq = super::kernel::Smoothing::of(f).w_r2(dq * dq);
         Self {
             gravity: [f.gravity[0], f.gravity[1], f.gravity[2], dt],
             domain_min: [lo[0], lo[1], lo[2], f.restitution],
@@ -496,55 +569,20 @@ impl SphGpuParams {
             xsph: f.pbf.xsph,
             vorticity: f.pbf.vorticity,
             list_max: f.list_len(),
-            pad0: 0,
+            kernel: f.kernel() as u32,
+            kernel_k: super::kernel::norm(f.kernel(), h as f64) as f32,
+            min_neighbors: f
+                .dfsph
+                .min_neighbors
+                .unwrap_or(5 * super::kernel::lattice_neighbours(f) as u32 / 8),
+            div_min_iter: f.dfsph.divergence_min_iterations,
+            dt_prev: dt,
+            cfl: f.cfl.unwrap_or(0.0),
+            dt_max: f.dt_max.unwrap_or(f.dt),
+            cfl_speed: f.sound(),
+            wall_offset: super::kernel::wall_offset(f) as f32,
             pad1: 0,
             pad2: 0,
-        }
-    }
-}
-
-/// sum_j |V grad W_spiky(x_i - x_j)|^2 over a full neighbourhood: a cubic lattice at the
-/// rest spacing (V = m / rho_0). The pressure solvers' prototype particle.
-pub fn proto_grad2(f: &FluidParams) -> f64 {
-    let h = f.h as f64;
-    let s = f.spacing() as f64;
-    let k = Kernels::new(h);
-    let v = f.mass as f64 / f.rest_density as f64;
-    let r = (h / s).ceil() as i32;
-    let mut sum = 0.0;
-    for a in -r..=r {
-        for b in -r..=r {
-            for c in -r..=r {
-                let r2 = s * s * (a * a + b * b + c * c) as f64;
-                if r2 > 0.0 && r2 < h * h {
-                    let g = v * k.spiky_grad * (h - r2.sqrt()).powi(2);
-                    sum += g * g;
-                }
-            }
-        }
-    }
-    sum
-}
-
-/// The smoothing kernels' constants (Müller 2003), for the GPU parameters and the CPU
-/// reference alike: W_poly6 = poly6 (h^2 - r^2)^3, grad W_poly6 = poly6_grad r (h^2 - r^2)^2,
-/// grad W_spiky = spiky_grad (h - r)^2 r/|r|, lap W_visc = visc_lap (h - r).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Kernels {
-    pub poly6: f64,
-    pub poly6_grad: f64,
-    pub spiky_grad: f64,
-    pub visc_lap: f64,
-}
-
-impl Kernels {
-    pub fn new(h: f64) -> Self {
-        use std::f64::consts::PI;
-        Self {
-            poly6: 315.0 / (64.0 * PI * h.powi(9)),
-            poly6_grad: -945.0 / (32.0 * PI * h.powi(9)),
-            spiky_grad: -45.0 / (PI * h.powi(6)),
-            visc_lap: 45.0 / (PI * h.powi(6)),
         }
     }
 }

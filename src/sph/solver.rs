@@ -254,7 +254,7 @@ impl SphSolver {
             .into_iter()
             .map(|(k, v)| (k.to_string(), v))
             .collect();
-        defines.extend(super::params::Eos::defines());
+        defines.extend(super::params::defines());
         defines.extend(super::pressure::solver_defines());
         let refs = crate::gpu::pipeline::as_refs(&defines);
         let pipeline = |name, shader| {
@@ -309,7 +309,9 @@ impl SphSolver {
         if n as u64 > MAX_PARTICLES {
             return Err(Error::Param(format!("{n} particles: at most 2^26")));
         }
-        let f = scene.fluid;
+        // The kernel's support applied here too: a FluidParams made without
+        // with_overrides (a test's, a library user's) gets the same h.
+        let f = &scene.fluid.resolved()?;
         let grid = GridSpec::covering(scene.domain.min, scene.domain.max, f.h)?;
         let colliders: Vec<GpuCollider> = scene
             .colliders

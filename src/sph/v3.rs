@@ -27,45 +27,7 @@ pub fn xyz(v: &[[f32; 4]]) -> Vec<V3> {
         .collect()
 }
 
-/// Poly6 densities and spiky gradients at support h, in f64 (the paper references').
-pub struct Smoothing {
-    h: f64,
-    k: super::params::Kernels,
-}
-
-impl Smoothing {
-    pub fn new(h: f64) -> Self {
-        Self {
-            h,
-            k: super::params::Kernels::new(h),
-        }
-    }
-
-    /// W(d), poly6.
-    pub fn w(&self, d: V3) -> f64 {
-        self.w_r2(dot(d, d))
-    }
-
-    /// W at squared distance r2, poly6.
-    pub fn w_r2(&self, r2: f64) -> f64 {
-        let q = self.h * self.h - r2;
-        if q > 0.0 {
-            self.k.poly6 * q * q * q
-        } else {
-            0.0
-        }
-    }
-
-    /// grad W(d), spiky (0 at d = 0).
-    pub fn grad(&self, d: V3) -> V3 {
-        let r = dot(d, d).sqrt();
-        if r >= self.h || r <= 1e-6 * self.h {
-            return [0.0; 3];
-        }
-        let s = self.k.spiky_grad * (self.h - r) * (self.h - r) / r;
-        [s * d[0], s * d[1], s * d[2]]
-    }
-}
+pub use super::kernel::Smoothing;
 
 /// For each point, the others within h of it (brute force).
 pub fn neighbours(p: &[V3], h: f64) -> Vec<Vec<usize>> {
