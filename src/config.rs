@@ -86,12 +86,19 @@ pub struct FluidArgs {
     /// SPH pressure solver (default: the scene's [fluid] solver, else wcsph)
     #[arg(long, value_enum)]
     pub solver: Option<Solver>,
+    /// SPH smoothing kernel, one for densities and pressure gradients: muller (the
+    /// thesis's poly6 with spiky; wcsph's default), cubic (the incompressible solvers'
+    /// default, support 2 spacings) or wendland (3 spacings); --fluid support= changes it
+    #[arg(long, value_enum)]
+    pub kernel: Option<Kernel>,
 }
 
 impl FluidArgs {
-    /// `fluid` with `--fluid KEY=VALUE` and `--solver` applied.
+    /// `fluid` with `--fluid KEY=VALUE`, `--kernel` and `--solver` applied.
     pub fn apply(&self, fluid: &crate::sph::FluidParams) -> Result<crate::sph::FluidParams> {
-        fluid.with_overrides(&self.fluid, self.solver)
+        let mut over = self.fluid.clone();
+        over.extend(self.kernel.map(|k| format!("kernel=\"{}\"", k.as_str())));
+        fluid.with_overrides(&over, self.solver)
     }
 }
 

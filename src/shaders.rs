@@ -26,6 +26,7 @@ pub fn variants() -> Vec<Variant> {
         with::<morton::MortonIo>("primitives/morton.comp", &[]),
         with::<counting::CountIo>("primitives/count.comp", &[]),
         with::<counting::ScatterIo>("primitives/scatter.comp", &[]),
+        with::<counting::OrderIo>("primitives/cell_order.comp", &[]),
         with::<counting::GatherIo>("primitives/gather.comp", &[]),
         with::<sort::SortIo>("primitives/oddeven.comp", &[]),
         with::<sort::SortIo>("primitives/bitonic.comp", &[]),

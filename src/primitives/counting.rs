@@ -1,6 +1,8 @@
 //! Atomic-grid counting sort (seed 002): count per cell with atomicAdd (each element keeps
 //! its in-cell rank), exclusive prefix sum of the counts gives cell starts, scatter to
-//! start + rank. O(N + cells); order inside a cell is arbitrary.
+//! start + rank, then each cell's values in ascending order (cell_order.comp): the
+//! atomics' ranks follow the scheduling, and a permutation that changed from run to run
+//! changed every sum over a cell's elements. O(N + cells + sum of squared cell counts).
 use super::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
@@ -27,6 +29,11 @@ crate::gpu_interface! {
 }
 
 crate::gpu_interface! {
+    /// glsl/primitives/cell_order.comp
+    pub OrderIo / OrderBufs: "ORDER", push CountPush { counts = 0, starts = 1, sorted_vals = 2 }
+}
+
+crate::gpu_interface! {
     /// glsl/primitives/gather.comp; push: n.
     pub GatherIo / GatherBufs: "GATHER", push u32 { perm = 0, src = 1, dst = 2 }
 }
@@ -34,6 +41,7 @@ crate::gpu_interface! {
 pub struct CountingSort {
     count: ComputePipeline<CountIo>,
     scatter: ComputePipeline<ScatterIo>,
+    order: ComputePipeline<OrderIo>,
 }
 
 /// Buffers for up to `capacity` elements and `cells` cells.
@@ -79,15 +87,20 @@ impl CountingBuffers {
 impl CountingSort {
     pub fn new(ctx: &Context) -> Result<Self> {
         let desc = |name, shader| ComputeDesc::plain(name, shader, &[], 256);
-        let count = ComputePipeline::new(ctx, &desc("count", "primitives/count.comp"))?;
-        match ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp")) {
-            Ok(scatter) => Ok(Self { count, scatter }),
-            Err(e) => {
-                let mut count = count;
-                count.destroy(ctx);
-                Err(e)
-            }
-        }
+        let count = Guard::new(
+            ctx,
+            ComputePipeline::new(ctx, &desc("count", "primitives/count.comp"))?,
+        );
+        let scatter = Guard::new(
+            ctx,
+            ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp"))?,
+        );
+        let order = ComputePipeline::new(ctx, &desc("cell order", "primitives/cell_order.comp"))?;
+        Ok(Self {
+            count: count.take(),
+            scatter: scatter.take(),
+            order,
+        })
     }
 
     /// Record the sort of `n` keys (< cells) with their values into sorted_keys/sorted_vals.
@@ -139,12 +152,19 @@ impl CountingSort {
             sorted_vals,
         };
         self.scatter.dispatch(ctx, cmd, &bufs, &push, n);
+        let bufs = OrderBufs {
+            counts: &b.counts,
+            starts: &b.starts,
+            sorted_vals,
+        };
+        self.order.dispatch(ctx, cmd, &bufs, &push, b.cells as u64);
         Ok(())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.count.destroy(ctx);
         self.scatter.destroy(ctx);
+        self.order.destroy(ctx);
     }
 }
 

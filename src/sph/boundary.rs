@@ -40,7 +40,6 @@ pub struct Solid {
     pub rate: f64,
 }
 
-
 impl Boundary {
     /// The domain box alone.
     pub fn new(f: &FluidParams, min: [f32; 3], max: [f32; 3]) -> Self {
@@ -120,7 +119,10 @@ impl Boundary {
             .iter()
             .map(|p| {
                 let d = p.1 + self.offset;
-                (wall_density(self.kernel, h, d), wall_push(self.kernel, h, d))
+                (
+                    wall_density(self.kernel, h, d),
+                    wall_push(self.kernel, h, d),
+                )
             })
             .collect();
         let keep: f64 = terms.iter().map(|t| 1.0 - t.0).product();

@@ -95,7 +95,8 @@ pub fn step(
         proto,
         dt,
         iterations,
-        min_neighbors: super::params::SphGpuParams::new(f, [0.0; 3], [0.0; 3], 0.0, 0).min_neighbors,
+        min_neighbors: super::params::SphGpuParams::new(f, [0.0; 3], [0.0; 3], 0.0, 0)
+            .min_neighbors,
     };
     match f.solver {
         Solver::Wcsph => panic!("cpu_pressure covers the incompressible solvers"),

@@ -6,9 +6,9 @@ use serde::{Deserialize, Serialize};
 
 pub use super::collider::{Collider, GpuCollider, MAX_COLLIDERS};
 pub use super::dfsph::{DfsphParams, DEFAULT_NEIGHBOR_LIST, MAX_NEIGHBOR_LIST};
+pub use super::kernel::{proto_grad2, Kernel, Kernels};
 pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
-pub use super::kernel::{proto_grad2, Kernel, Kernels};
 pub use super::pressure::Convergence;
 
 /// DFSPH's and PBF's own CFL number (with each table's `dt_max`: the setup `bench
@@ -241,7 +241,9 @@ impl FluidParams {
         let mut out = out.with_own_step();
         out.validate()?;
         out.resolve_spacing()?;
-        if overrides.iter().any(|o| o.split('=').next().map(str::trim) == Some("h"))
+        if overrides
+            .iter()
+            .any(|o| o.split('=').next().map(str::trim) == Some("h"))
             && out.kernel() != Kernel::Muller
         {
             return Err(Error::Param(format!(
@@ -364,7 +366,10 @@ impl FluidParams {
     /// h = support x spacing where the kernel has a support in spacings (`support`, else
     /// its default); muller without `support` keeps h. Applying it again changes nothing.
     pub fn resolve_support(&mut self) -> Result<()> {
-        let Some(k) = self.support.or(super::kernel::default_support(self.kernel())) else {
+        let Some(k) = self
+            .support
+            .or(super::kernel::default_support(self.kernel()))
+        else {
             return Ok(());
         };
         if !(1.0..=4.0).contains(&k) {

@@ -15,6 +15,7 @@ const STRATEGIES: [(Neighbors, SortAlgo); 4] = [
     (Neighbors::Morton, SortAlgo::OddEven),
 ];
 
+mod kernels;
 mod scenes;
 mod solvers;
 
