@@ -87,7 +87,7 @@ pub struct FluidArgs {
     #[arg(long, value_enum)]
     pub solver: Option<Solver>,
     /// SPH smoothing kernel, one for densities and pressure gradients: muller (the
-    /// thesis's poly6 with spiky; wcsph's default), cubic (the incompressible solvers'
+    /// thesis's poly6 with spiky; wcsph's and pbf's default), cubic (pcisph's and dfsph's
     /// default, support 2 spacings) or wendland (3 spacings); --fluid support= changes it
     #[arg(long, value_enum)]
     pub kernel: Option<Kernel>,

@@ -35,6 +35,7 @@ pub fn variants() -> Vec<Variant> {
         with::<crate::sph::hooks::ConstantForceIo>("sph/constant_force.comp", &[]),
         with::<crate::sph::health::HealthIo>("sph/health.comp", &[]),
         with::<crate::sph::errors::StepErrorIo>("sph/step_error.comp", &[]),
+        with::<crate::sph::cfl::CflIo>("sph/cfl.comp", &[]),
         with::<crate::scene::orbits::OrbitsIo>("scene/orbits.comp", &[]),
         with::<crate::render::points::PointsIo>("render/points.vert", &[]),
         with::<crate::render::points::PointsIo>("render/points.frag", &[]),

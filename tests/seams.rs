@@ -286,8 +286,7 @@ fn failed_construction_leaks_nothing() {
 }
 
 /// Rust mirrors of GPU structs against the offsets the GLSL compiler gave each member: every
-/// `#[repr(C)]` struct in src (a test below counts them). Long because it is a table: one
-/// entry per struct.
+/// `#[repr(C)]` struct in src (a test below counts them); one entry per struct.
 #[test]
 fn gpu_struct_mirrors_match_glsl_field_offsets() {
     use fluidform::gpu::interface::member_offsets;
@@ -420,7 +419,12 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         (
             "sph/step_error.comp",
             "Push",
-            fields!(fluidform::sph::errors::StepErrorPush; n, mode, step, rest_density, dt),
+            fields!(fluidform::sph::errors::StepErrorPush; n, mode, step, rest_density),
+        ),
+        (
+            "sph/cfl.comp",
+            "Push",
+            fields!(fluidform::sph::cfl::CflPush; n, mode, cfl, dt_max, speed, dt_prev),
         ),
         (
             "sph/constant_force.comp",
@@ -540,11 +544,8 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
     );
 }
 
-/// `--validation` includes synchronization validation: a dispatch that reads a buffer a
-/// fill just wrote, with no barrier between them, is reported as a hazard (and the barrier
-/// tracker places the one a fill recorded through the context needs). (The layer of
-/// Debian 12, 1.3.239, does not record accesses made through push descriptors, so it sees
-/// hazards between transfers and dispatches but not between two dispatches.)
+/// Synchronization validation reports a fill's missing barrier (the tracker places it);
+/// Debian 12's layer (1.3.239) sees transfer-dispatch hazards, not dispatch-dispatch ones.
 #[test]
 fn sync_validation_reports_a_missing_barrier() {
     let ctx = common::ctx();

@@ -96,6 +96,9 @@ void main() {
 #else
     float kept = vel[i].w * ratio * ratio;
 #endif
+    // All of it: with SPlisHSPlasH's half the 16K dam break's measured error at 1.33 ms
+    // steps rose from 0.057% to 0.107% at a 0.1% target (a solve stops as soon as its
+    // estimate is in; a better start leaves a better step).
     aux[i].y = residual(i, dt, h2, V) > 0.0 ? max(kept, 0.0) : 0.0;
     aux2[i].KAPPA = 0.0;
 #elif PASS == PASS_SOURCE

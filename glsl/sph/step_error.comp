@@ -3,7 +3,7 @@
 // e = max(rho / rho0 - 1, 0), compression only (surface particles lack neighbours, as in
 // SPlisHSPlasH's solvers). Two levels: mode 0 reduces each block of WG * ITEMS particles to
 // a (sum, max, count) partial; mode 1 (one workgroup) reduces the partials into
-// records[2 step] = (mean, max, count, dt) and copies the pressure solve's iterations and
+// records[2 step] = (mean, max, count, dt: the step's, as the parameters hold it) and copies the pressure solve's iterations and
 // errors into records[2 step + 1] (SolveState in sph/pressure.glsl; zeros for wcsph).
 #include "common/index.glsl"
 #include "common/reduce.glsl"
@@ -12,6 +12,7 @@ layout(std430, binding = SERR_B_POS) readonly buffer Pos { vec4 pos[]; };
 layout(std430, binding = SERR_B_RHO_P) readonly buffer RhoP { vec2 rho_p[]; };
 layout(std430, binding = SERR_B_PARTIALS) buffer Partials { vec4 partials[]; };
 layout(std430, binding = SERR_B_RECORDS) buffer Records { vec4 records[]; };
+layout(std430, binding = SERR_B_PARAMS) readonly buffer Params { vec4 gravity; } params;  // w = dt
 layout(std430, binding = SERR_B_SOLVE) readonly buffer Solve {
     uvec4 args_iter;
     uvec4 done_pad;
@@ -23,7 +24,6 @@ layout(push_constant) uniform Push {
     uint mode;
     uint step;   // the record written in mode 1
     float rest_density;
-    float dt;
 } pc;
 void main() {
     uint wg = gl_WorkGroupSize.x, lid = gl_LocalInvocationIndex;
@@ -46,7 +46,7 @@ void main() {
     if (lid != 0u) return;
     if (pc.mode == 0u) partials[group_id()] = vec4(s, 0.0);
     else {
-        records[2u * pc.step] = vec4(s.x / max(s.z, 1.0), s.y, s.z, pc.dt);
+        records[2u * pc.step] = vec4(s.x / max(s.z, 1.0), s.y, s.z, params.gravity.w);
         records[2u * pc.step + 1u] = vec4(uintBitsToFloat(solve.iters.x),
                                           uintBitsToFloat(solve.iters.y), solve.errs);
     }

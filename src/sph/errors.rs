@@ -20,13 +20,12 @@ pub struct StepErrorPush {
     pub mode: u32,
     pub step: u32,
     pub rest_density: f32,
-    pub dt: f32,
 }
 
 crate::gpu_interface! {
     /// glsl/sph/step_error.comp
     pub StepErrorIo / StepErrorBufs: "SERR", push StepErrorPush {
-        pos = 0, rho_p = 1, partials = 2, records = 3, solve = 4,
+        pos = 0, rho_p = 1, partials = 2, records = 3, solve = 4, params = 5,
     }
 }
 
@@ -175,7 +174,6 @@ impl StepErrors {
             mode: 0,
             step,
             rest_density: st.fluid.rest_density,
-            dt: st.dt,
         };
         let bufs = StepErrorBufs {
             pos: st.pos(),
@@ -183,6 +181,7 @@ impl StepErrors {
             partials: &self.partials,
             records: &self.records[slot],
             solve: st.pressure.as_ref().map_or(&self.no_solve, |p| p.solve()),
+            params: st.params(),
         };
         self.pipeline
             .dispatch_groups(ctx, cmd, &bufs, &push, groups);

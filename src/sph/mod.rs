@@ -1,6 +1,7 @@
 //! Weakly compressible SPH after Müller et al. 2003 and Kelager 2006, on the GPU, with
 //! switchable neighbour search, boundaries and colliders, and an f64 CPU reference.
 pub mod boundary;
+pub mod cfl;
 pub mod collider;
 pub mod cpu;
 pub mod cpu_pressure;

@@ -70,9 +70,9 @@ pub struct FluidParams {
     pub dt: f32,
     /// Steps per frame: a frame advances dt * substeps
     pub substeps: u32,
-    /// CFL number: when set, a step never exceeds cfl * h / max(c, v_max, v_fall) (v_max
-    /// from the previous frame, c the speed of sound, v_fall = sqrt(2 |g| H) for the
-    /// domain's height H: `run::Stepper`) and the frame takes more steps to keep its time
+    /// CFL number: when set, each step is min(dt_max, cfl * h / max(c, v_max)) with v_max
+    /// the step's own largest speed, on the GPU (c: wcsph's speed of sound; sph/cfl.rs), and
+    /// a frame takes as many steps as cover it (leftover time carries: `run::Stepper`)
     pub cfl: Option<f32>,
     pub gravity: [f32; 3],
     /// Normal velocity kept (reversed) at a wall, 0..1
@@ -88,8 +88,8 @@ pub struct FluidParams {
     pub dfsph: DfsphParams,
     pub pbf: PbfParams,
     /// The smoothing kernel (`--kernel`, src/sph/kernel.rs): default muller (the thesis's)
-    /// for wcsph, cubic for the incompressible solvers (their error targets then hold:
-    /// one kernel for densities and gradients).
+    /// for wcsph and pbf (its paper's), cubic for pcisph and dfsph (their error targets
+    /// then hold: one kernel for densities and gradients).
     pub kernel: Option<Kernel>,
     /// Support of the cubic and Wendland kernels in rest spacings (default: cubic 2,
     /// wendland 3; see `kernel::default_support`): h becomes support times the spacing.
@@ -355,11 +355,13 @@ impl FluidParams {
         }
     }
 
-    /// The kernel in use: `kernel`, else muller for wcsph and cubic for the others.
+    /// The kernel in use: `kernel`, else muller for wcsph and pbf, cubic for the others.
     pub fn kernel(&self) -> Kernel {
         self.kernel.unwrap_or(match self.solver {
-            Solver::Wcsph => Kernel::Muller,
-            _ => Kernel::Cubic,
+            // PBF keeps its paper's pair: with the cubic its step strayed 3% from its f64
+            // reference (its neighbour sets are the step's start's; tests/solvers.rs).
+            Solver::Wcsph | Solver::Pbf => Kernel::Muller,
+            Solver::Pcisph | Solver::Dfsph => Kernel::Cubic,
         })
     }
 

@@ -1,5 +1,6 @@
-//! Playing an SPH scene: steps per frame (fixed, or CFL-limited from the previous
-//! frame's largest speed), the state's health every frame, and end-of-run statistics.
+//! Playing an SPH scene: steps per frame (fixed, or as many as the GPU's own CFL-limited
+//! steps take to cover the frame: sph/cfl.rs), the state's health every frame, and
+//! end-of-run statistics.
 use super::errors::{DensityErrorStats, StepError, StepErrors};
 use super::health::Health;
 use super::setup::Domain;
@@ -9,33 +10,32 @@ use crate::gpu::{Context, Profiler};
 use ash::vk;
 use serde::{Deserialize, Serialize};
 
-/// Chooses steps per frame and watches the state's health. With `cfl`, a step never
-/// exceeds cfl * h / max(c, v_max, v_fall) (c: wcsph's speed of sound; 0 for the
-/// incompressible solvers) nor `dt_max` (default `dt`), v_max read back from the latest
-/// finished frame and, where it grows, carried on at that rate over the frames in flight.
-/// v_fall = sqrt(2 |g| H), the speed of a fall through the domain's height
-/// H: v_max lags a frame and is 0 at the start, and a step sized for a fluid at rest broke
-/// the incompressible solves once it moved (DFSPH at 6.7 ms on the 64K dam break: densities
-/// to 1.7 rho0 within 0.1 s; at 3 ms, the floor's step there, 1.05).
+/// Chooses steps per frame and watches the state's health. With `cfl`, each step's dt is
+/// the GPU's, from the step's own velocities (sph/cfl.rs); a frame records as many steps
+/// as the last finished frame's last dt takes to cover the frame and the time the
+/// simulation trails the frames by (less what the frames in flight already make up): no
+/// step is snapped to the frame grid, and leftover time carries into the next frame.
 pub struct Stepper {
     health: Health,
     errors: StepErrors,
-    /// Per slot: the steps recorded into it, the scene time before them, and the
+    /// Per slot: the steps recorded into it and the
     /// iterations each solve recorded (density, divergence; 0: max_iter).
-    pending: Vec<(u32, f64, [u32; 2])>,
+    pending: Vec<(u32, [u32; 2])>,
     /// Iterations the next frame records per solve (see `retire_slot`).
     bound: [u32; 2],
+    /// Per slot: the time its steps were expected to cover beyond the frame (with cfl).
+    extra: Vec<f64>,
+    /// The last finished step's dt (the GPU's), 0 before any.
+    dt_seen: f32,
+    /// Simulated time of the finished frames, and their frames' time.
+    retired_time: f64,
+    retired_frames: u64,
     /// Every step's density error: (frame, step in the frame, time after it, error).
     pub steps: Vec<(u64, u32, f64, StepError)>,
     pub density_error: DensityErrorStats,
     pub frame_time: f64,
     pub steps_taken: u64,
     pub sim_time: f64,
-    v_max: f32,
-    /// The largest speed of the frame retired before v_max's.
-    v_prev: f32,
-    /// The floor of the CFL's speed (see the type).
-    v_fall: f32,
     rest_density: f32,
     /// The fluid's (min, max) iterations.
     iterations: (u32, u32),
@@ -53,16 +53,17 @@ impl Stepper {
         Ok(Self {
             health: Health::new(ctx, slots)?,
             errors: errors.take(),
-            pending: vec![(0, 0.0, [0; 2]); slots],
+            pending: vec![(0, [0; 2]); slots],
             bound: [0; 2],
+            extra: vec![0.0; slots],
+            dt_seen: 0.0,
+            retired_time: 0.0,
+            retired_frames: 0,
             steps: Vec::new(),
             density_error: DensityErrorStats::default(),
             frame_time: st.fluid.dt as f64 * st.fluid.substeps as f64,
             steps_taken: 0,
             sim_time: 0.0,
-            v_max: 0.0,
-            v_prev: 0.0,
-            v_fall: fall_speed(st),
             rest_density: st.fluid.rest_density,
             iterations: {
                 let c = st.fluid.convergence();
@@ -71,24 +72,24 @@ impl Stepper {
         })
     }
 
-    /// (steps, dt) for the next frame.
+    /// (steps, dt) for the next frame (with cfl: dt the host's estimate, the first
+    /// frame's dt_max: a fluid at rest).
     pub fn plan(&self, st: &SphState) -> (u32, f32) {
         let f = &st.fluid;
         match f.cfl {
             None => (f.substeps, f.dt),
-            Some(cfl) => {
-                // v_max is as old as the frames in flight: where it grows, it is carried
-                // on at its last frame's rate over them.
-                let lag = self.pending.len() as f32;
-                let v_est = self.v_max + (self.v_max - self.v_prev).max(0.0) * lag;
-                let v = f.sound().max(v_est).max(self.v_fall);
-                let limit = cfl * f.h / v.max(1e-6);
-                let dt = f.dt_max.unwrap_or(f.dt).min(limit);
-                let steps = (self.frame_time / dt as f64)
+            Some(_) => {
+                let dt = match self.dt_seen {
+                    0.0 => f.dt_max.unwrap_or(f.dt),
+                    d => d,
+                };
+                let behind = self.retired_frames as f64 * self.frame_time - self.retired_time;
+                let want = self.frame_time + behind - self.extra.iter().sum::<f64>();
+                let steps = (want / dt as f64)
                     .ceil()
                     .clamp(1.0, super::params::MAX_SUBSTEPS as f64)
                     as u32;
-                (steps, (self.frame_time / steps as f64) as f32)
+                (steps, dt)
             }
         }
     }
@@ -107,7 +108,10 @@ impl Stepper {
         let (steps, dt) = self.plan(st);
         st.dt = dt;
         st.iteration_bound = self.bound;
-        self.pending[slot] = (steps, self.sim_time, self.bound);
+        self.pending[slot] = (steps, self.bound);
+        if st.fluid.cfl.is_some() {
+            self.extra[slot] = steps as f64 * dt as f64 - self.frame_time;
+        }
         for k in 0..steps {
             solver.record_hooked_step(ctx, cmd, prof, st, hooks)?;
             prof.begin(ctx, cmd, StepErrors::NAME);
@@ -144,10 +148,9 @@ impl Stepper {
     /// iteration recorded (it may have stopped above its target) is counted in
     /// `bounded_steps`, and the next frame records twice as many.
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
-        let h = self.health.check(slot, frame, self.rest_density)?;
-        self.v_prev = self.v_max;
-        self.v_max = h.max_speed();
-        let (steps, mut t, recorded) = self.pending[slot];
+        self.health.check(slot, frame, self.rest_density)?;
+        let (steps, recorded) = self.pending[slot];
+        let mut t = self.retired_time;
         let (_, max_iter) = self.iterations;
         let cap = |b: u32| if b == 0 { max_iter } else { b.min(max_iter) };
         let mut most = [0u32; 2];
@@ -164,12 +167,24 @@ impl Stepper {
             }
             self.density_error.add(&e);
             self.steps.push((frame, k as u32, t, e));
+            self.dt_seen = e.dt;
         }
+        // The frame's time as the GPU took it, in place of the estimate it was recorded with.
+        let span = t - self.retired_time;
+        self.sim_time += span - self.frame_span(slot);
+        self.extra[slot] = 0.0;
+        self.retired_time = t;
+        self.retired_frames += 1;
         self.bound = match hit {
             true => recorded.map(|r| (2 * cap(r)).min(max_iter)),
             false => most.map(|m| (2 * m + 4).min(max_iter)),
         };
         Ok(())
+    }
+
+    /// The time the slot's frame was recorded to cover (steps x the planned dt).
+    fn frame_span(&self, slot: usize) -> f64 {
+        self.frame_time + self.extra[slot]
     }
 
     /// `steps.csv`: one row per step.
@@ -220,15 +235,6 @@ pub struct PhysicsStats {
     pub density_max: f64,
     #[serde(with = "crate::report::non_finite_as_null")]
     pub max_speed: f64,
-}
-
-/// sqrt(2 |g| H): the speed a particle gains falling through the domain's height along g
-/// (the fluid's gravity; a hook's extra acceleration is not counted).
-fn fall_speed(st: &SphState) -> f32 {
-    let (lo, hi) = st.domain;
-    let g = st.fluid.gravity;
-    let drop: f32 = (0..3).map(|k| g[k].abs() * (hi[k] - lo[k]).abs()).sum();
-    (2.0 * drop).sqrt()
 }
 
 /// Physics checks of a state: NaNs, particles outside the domain, density statistics.

@@ -88,6 +88,8 @@ pub struct SphSolver {
     density: ComputePipeline<SphIo>,
     forces: ComputePipeline<SphIo>,
     integrate: ComputePipeline<SphIo>,
+    /// The step's dt from its velocities (with `fluid.cfl`).
+    cfl: super::cfl::CflPass,
     /// The pressure solvers built so far (`state` builds its fluid's).
     pressure: Vec<Box<dyn PressureSolver>>,
     /// The neighbour search's and the EOS's defines (for those passes).
@@ -105,8 +107,11 @@ pub struct SphState {
     pub fluid: FluidParams,
     pub domain: ([f32; 3], [f32; 3]),
     collider_list: Vec<GpuCollider>,
-    /// Current step size (the CFL limit may lower it below fluid.dt).
+    /// Current step size (the CFL limit may lower it below fluid.dt; with `fluid.cfl` the
+    /// GPU's is the step's own and this the host's estimate of it).
     pub dt: f32,
+    /// The GPU's clock (sph/cfl.rs): the last step's dt and the simulated time.
+    pub clock: Buffer,
     /// The incompressible solvers' buffers (None for wcsph).
     pub pressure: Option<PressureBuffers>,
     /// Iterations the next steps record per solve (density, divergence); 0: max_iter.
@@ -199,6 +204,7 @@ impl SphState {
     pub fn destroy(&mut self, ctx: &Context) {
         self.particles.destroy(ctx);
         ctx.destroy_buffer(&mut self.params);
+        ctx.destroy_buffer(&mut self.clock);
         ctx.destroy_buffer(&mut self.colliders);
         self.nb.destroy(ctx);
         if let Some(p) = &mut self.pressure {
@@ -263,11 +269,13 @@ impl SphSolver {
         let density = Guard::new(ctx, pipeline("density", "sph/density.comp")?);
         let forces = Guard::new(ctx, pipeline("forces", "sph/forces.comp")?);
         let integrate = Guard::new(ctx, pipeline("integrate", "sph/integrate.comp")?);
+        let cfl = Guard::new(ctx, super::cfl::CflPass::new(ctx)?);
         let gather = GatherPass::new(ctx)?;
         Ok(Self {
             density: density.take(),
             forces: forces.take(),
             integrate: integrate.take(),
+            cfl: cfl.take(),
             gather,
             search: search.take(),
             pressure: Vec::new(),
@@ -346,6 +354,7 @@ impl SphSolver {
             true => Some(PressureBuffers::new(ctx, n as u64, f.list_len())?),
         };
         let pressure = Guard::new(ctx, pressure);
+        let clock = Guard::new(ctx, super::cfl::clock_buffer(ctx)?);
         let nb = self.search.buffers(ctx, n as u64, &grid, 0)?;
         Ok(SphState {
             particles: store.take(),
@@ -358,6 +367,7 @@ impl SphSolver {
             domain: (scene.domain.min, scene.domain.max),
             collider_list: colliders,
             dt: f.dt,
+            clock: clock.take(),
             pressure: pressure.take(),
             iteration_bound: [0; 2],
         })
@@ -481,6 +491,9 @@ impl SphSolver {
         }
         scopes.begin(ctx, cmd, "sph");
         self.record_params(ctx, cmd, st);
+        scopes.begin(ctx, cmd, super::cfl::CflPass::NAME);
+        self.cfl.record(ctx, cmd, st);
+        scopes.end(ctx, cmd);
         Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
         p.record_forces(self, ctx, cmd, scopes, st)?;
@@ -496,6 +509,7 @@ impl SphSolver {
         self.density.destroy(ctx);
         self.forces.destroy(ctx);
         self.integrate.destroy(ctx);
+        self.cfl.destroy(ctx);
         for p in &mut self.pressure {
             p.destroy(ctx);
         }

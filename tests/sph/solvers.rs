@@ -102,8 +102,9 @@ fn incompressible_solvers_report_iterations(dir: &std::path::Path, cfl: &str) {
             "{name}: {err}"
         );
         let dfsph = name == "dfsph";
+        // DFSPH's divergence solve takes at least one iteration (SPlisHSPlasH's).
         assert_eq!(
-            err["divergence_iterations_mean"].as_f64().unwrap() >= 2.0,
+            err["divergence_iterations_mean"].as_f64().unwrap() >= 1.0,
             dfsph,
             "{err}"
         );
