@@ -338,7 +338,7 @@ fn dfsph_converges_to_the_papers_step() {
         let (ours, paper) = (err(&after.pos), err(&f4(&r.pos)));
         let (dv, before) = (most(&vel, &r.vel), err(&pos));
         eprintln!(
-            "{what}: paper's iterations {:?}, velocity changes up to {dv:.3e} m/s; mean compression after the step {ours:.3e}, the paper's {paper:.3e}, before {:.3e}",
+            "{what}: paper's iterations {:?}, velocity changes up to {dv:.3e} m/s; mean compression after the step {ours:.3e}, the paper's {paper:.3e}, before {before:.3e}",
             r.iterations,
         );
         bad.push((what, dv, ours, before));

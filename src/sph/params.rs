@@ -506,7 +506,7 @@ pub struct SphGpuParams {
     pub div_min_iter: u32,
     /// The previous step's dt (the warm starts rescale by it; cfl.comp keeps it).
     pub dt_prev: f32,
-    /// > 0: each step's dt comes from its own velocities on the GPU (glsl/sph/cfl.comp):
+    /// Above 0: each step's dt comes from its own velocities on the GPU (glsl/sph/cfl.comp),
     /// min(dt_max, cfl h / max(v_max, cfl_speed)).
     pub cfl: f32,
     pub dt_max: f32,

@@ -73,14 +73,20 @@ impl Stepper {
     }
 
     /// (steps, dt) for the next frame (with cfl: dt the host's estimate, the first
-    /// frame's dt_max: a fluid at rest).
+    /// frame's a fluid at rest's).
     pub fn plan(&self, st: &SphState) -> (u32, f32) {
         let f = &st.fluid;
         match f.cfl {
             None => (f.substeps, f.dt),
             Some(_) => {
                 let dt = match self.dt_seen {
-                    0.0 => f.dt_max.unwrap_or(f.dt),
+                    // Before any step: the GPU's limit for a fluid at rest.
+                    0.0 => {
+                        let speed = f.sound().max(1e-6);
+                        f.dt_max
+                            .unwrap_or(f.dt)
+                            .min(f.cfl.unwrap_or(1.0) * f.h / speed)
+                    }
                     d => d,
                 };
                 let behind = self.retired_frames as f64 * self.frame_time - self.retired_time;

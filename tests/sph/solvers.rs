@@ -112,7 +112,7 @@ fn incompressible_solvers_report_iterations(dir: &std::path::Path, cfl: &str) {
         for row in csv.lines().skip(1) {
             let c: Vec<&str> = row.split(',').collect();
             assert!(c[4].parse::<u32>().unwrap() >= 2, "{name}: {row}");
-            assert_eq!(c[7].parse::<u32>().unwrap() >= 2, dfsph, "{name}: {row}");
+            assert_eq!(c[7].parse::<u32>().unwrap() >= 1, dfsph, "{name}: {row}");
         }
     }
 }
@@ -148,15 +148,20 @@ fn solver_switch_and_per_step_density_errors() {
     let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len() as u64, steps);
-    // CFL: 11 steps per frame, their dts summing to the frame time (0.01 s).
-    let frame0: f64 = rows
+    // CFL: each step the GPU's, never snapped to the frame; the first frame's steps cover
+    // its 0.01 s to within one step (the rest carries into the next frame).
+    let dts: Vec<f64> = rows
         .iter()
         .filter(|r| r.starts_with("0,"))
         .map(|r| r.split(',').nth(3).unwrap().parse::<f64>().unwrap())
-        .sum();
+        .collect();
+    let (frame0, most) = (
+        dts.iter().sum::<f64>(),
+        dts.iter().cloned().fold(0.0, f64::max),
+    );
     assert!(
-        (frame0 - 0.01).abs() < 1e-6,
-        "frame 0 steps sum to {frame0}"
+        frame0 >= 0.01 - 1e-6 && frame0 < 0.01 + most + 1e-6,
+        "frame 0 steps sum to {frame0} (steps up to {most})"
     );
     incompressible_solvers_report_iterations(dir.path(), &cfl);
     for args in [
