@@ -29,6 +29,8 @@ fn control_and_groups_work_with_every_solver() {
             "max_iterations=8",
             "--fluid",
             "pbf_iterations=8",
+            "--fluid",
+            "dfsph.divergence_min_iterations=8",
             // The thesis's kernel at h = 0.0457 m, the reach the groups' gap is checked
             // against (the cubic's 2 spacings reach farther).
             "--kernel",
