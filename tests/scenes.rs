@@ -148,8 +148,12 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         (Solver::Dfsph, f.dfsph.cfl, f.dfsph.dt_max),
         (Solver::Pbf, f.pbf.cfl, f.pbf.dt_max),
     ] {
-        // PCISPH's own CFL number is 0.2, the others' 0.4.
-        let want = if s == Solver::Pcisph { 0.2 } else { 0.4 };
+        // The own CFL numbers: PCISPH 0.2, DFSPH 0.15 (of the cubic's 2 spacings), PBF 0.4.
+        let want = match s {
+            Solver::Pcisph => 0.2,
+            Solver::Dfsph => 0.15,
+            _ => 0.4,
+        };
         assert_eq!(cfl, want, "{s:?}");
         let g = o(&[], Some(s));
         assert_eq!((g.cfl, g.dt_max), (Some(cfl), Some(own)), "{s:?}");
@@ -183,7 +187,7 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         ..FluidParams::default()
     };
     let g = d.with_overrides(&[], None).unwrap();
-    assert_eq!((g.cfl, g.dt_max), (Some(0.4), Some(f.dfsph.dt_max)));
+    assert_eq!((g.cfl, g.dt_max), (Some(f.dfsph.cfl), Some(f.dfsph.dt_max)));
     // wcsph with dt_max alone is still refused.
     let e = f
         .with_overrides(&["dt_max=0.001".to_string()], None)
