@@ -14,6 +14,15 @@ macro_rules! switch_enum {
                     .map(|v| v.get_name().to_string())
                     .unwrap_or_default()
             }
+            /// `PREFIX_NAME` = value for every variant, for a shader's runtime switch.
+            pub fn defines(prefix: &str) -> Vec<(String, String)> {
+                let names: Vec<(String, u32)> = <Self as clap::ValueEnum>::value_variants()
+                    .iter()
+                    .map(|v| (v.as_str(), *v as u32))
+                    .collect();
+                let refs: Vec<(&str, u32)> = names.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+                crate::gpu::interface::enum_defines(prefix, &refs)
+            }
         }
     };
 }

@@ -26,13 +26,7 @@ pub fn default_support(k: Kernel) -> Option<f32> {
 
 /// `KERNEL_MULLER`, ... for glsl/sph/kernel.glsl, one per `Kernel` value.
 pub fn defines() -> Vec<(String, String)> {
-    use clap::ValueEnum;
-    let names: Vec<(String, u32)> = Kernel::value_variants()
-        .iter()
-        .map(|k| (k.as_str(), *k as u32))
-        .collect();
-    let refs: Vec<(&str, u32)> = names.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    crate::gpu::interface::enum_defines("KERNEL", &refs)
+    Kernel::defines("KERNEL")
 }
 
 /// Mueller 2003's kernels' constants: W_poly6 = poly6 (h^2 - r^2)^3, grad W_poly6 =

@@ -172,13 +172,7 @@ pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
 
 /// `SOLVER_WCSPH`, ... for glsl/sph/common.glsl, one per `kinds::Solver` value.
 pub fn solver_defines() -> Vec<(String, String)> {
-    use clap::ValueEnum;
-    let names: Vec<(String, u32)> = Solver::value_variants()
-        .iter()
-        .map(|s| (s.as_str(), *s as u32))
-        .collect();
-    let refs: Vec<(&str, u32)> = names.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-    crate::gpu::interface::enum_defines("SOLVER", &refs)
+    Solver::defines("SOLVER")
 }
 
 /// A solver's pipelines, built in the order of its pass table; the solver's pass enum
