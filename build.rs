@@ -20,6 +20,7 @@ const STATIC_LIBS: &[&str] = &[
 fn main() {
     embed_glsl();
     embed_commit();
+    embed_font();
     println!("cargo:rerun-if-env-changed=SHADERC_LIB_DIR");
     println!("cargo:rerun-if-changed=build.rs");
     if env::var("CARGO_FEATURE_BUILD_FROM_SOURCE").is_ok() {
@@ -118,4 +119,17 @@ fn walk(dir: &Path, files: &mut Vec<PathBuf>) {
             files.push(p);
         }
     }
+}
+
+/// Embed DejaVu Sans (fonts-dejavu-core, from scripts/setup.sh) for the benchmark plots: a
+/// GPU machine gets only the binary, and has no fonts. Absent here: an empty file, and the
+/// plots read the font at run time.
+fn embed_font() {
+    let src = Path::new("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    if src.exists() {
+        println!("cargo:rerun-if-changed={}", src.display());
+    }
+    let out = PathBuf::from(env::var("OUT_DIR").expect("OUT_DIR")).join("font.ttf");
+    let bytes = std::fs::read(src).unwrap_or_default();
+    std::fs::write(&out, bytes).expect("write the embedded font");
 }

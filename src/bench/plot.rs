@@ -8,6 +8,9 @@ use std::path::Path;
 
 /// DejaVu Sans from Debian's fonts-dejavu-core (installed by scripts/setup.sh).
 const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+/// The same font embedded at build time (build.rs; empty where the build had none): a
+/// GPU machine gets only the binary.
+const EMBEDDED: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/font.ttf"));
 
 fn err(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Image {
@@ -20,9 +23,15 @@ fn err(path: &Path, e: impl std::fmt::Display) -> Error {
 fn font() -> Result<()> {
     static DONE: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
     DONE.get_or_init(|| {
-        let bytes = std::fs::read(FONT)
-            .map_err(|e| format!("{FONT}: {e} (install fonts-dejavu-core: scripts/setup.sh)"))?;
-        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+        let bytes: &'static [u8] = match EMBEDDED.is_empty() {
+            false => EMBEDDED,
+            true => {
+                let b = std::fs::read(FONT).map_err(|e| {
+                    format!("{FONT}: {e} (install fonts-dejavu-core: scripts/setup.sh)")
+                })?;
+                Box::leak(b.into_boxed_slice())
+            }
+        };
         plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
             .map_err(|_| format!("{FONT}: not a usable TrueType font"))
     })

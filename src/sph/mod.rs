@@ -7,6 +7,7 @@ pub mod cpu;
 pub mod cpu_pressure;
 pub mod dfsph;
 pub mod errors;
+pub mod gpu_params;
 pub mod health;
 pub mod hooks;
 pub mod kernel;

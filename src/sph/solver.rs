@@ -4,7 +4,7 @@
 //! its own attribute with one `register` call; its pass is an `SphHook` lent to each step
 //! (hooks.rs).
 use super::hooks::{Hooks, SphHook};
-use super::params::{FluidParams, GpuCollider, SphGpuParams, MAX_COLLIDERS};
+use super::params::{FluidParams, GpuCollider, LatticeTerms, SphGpuParams, MAX_COLLIDERS};
 use super::pressure::{PressureBuffers, PressureSolver};
 use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
@@ -117,6 +117,8 @@ pub struct SphState {
     /// Iterations the next steps record per solve (density, divergence); 0: max_iter.
     /// The Stepper lowers it from the counts it reads back (see `Stepper::retire_slot`).
     pub iteration_bound: [u32; 2],
+    /// `fluid`'s rest-lattice sums, once (recomputed by `gpu_params` if `fluid` changed).
+    lattice: LatticeTerms,
 }
 
 impl SphState {
@@ -177,10 +179,10 @@ impl SphState {
     }
 
     pub fn gpu_params(&self) -> SphGpuParams {
-        SphGpuParams::new(
+        SphGpuParams::with_lattice(
             &self.fluid,
-            self.domain.0,
-            self.domain.1,
+            &self.lattice,
+            self.domain,
             self.dt,
             self.collider_list.len() as u32,
         )
@@ -370,6 +372,7 @@ impl SphSolver {
             clock: clock.take(),
             pressure: pressure.take(),
             iteration_bound: [0; 2],
+            lattice: LatticeTerms::of(f),
         })
     }
 
