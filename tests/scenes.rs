@@ -148,11 +148,11 @@ fn each_solver_takes_its_own_step_unless_told_otherwise() {
         (Solver::Dfsph, f.dfsph.cfl, f.dfsph.dt_max),
         (Solver::Pbf, f.pbf.cfl, f.pbf.dt_max),
     ] {
-        // The own CFL numbers: PCISPH 0.2, DFSPH 0.15 (of the cubic's 2 spacings), PBF 0.4.
+        // The own CFL numbers (of the cubic's 2 spacings for PCISPH and DFSPH).
         let want = match s {
-            Solver::Pcisph => 0.2,
+            Solver::Pcisph => 0.05,
             Solver::Dfsph => 0.15,
-            _ => 0.4,
+            _ => 0.2,
         };
         assert_eq!(cfl, want, "{s:?}");
         let g = o(&[], Some(s));

@@ -332,6 +332,52 @@ pub fn over_time(
     root.present().map_err(|e| err(path, e))
 }
 
+/// The surge front Z against T per solver (lines) with Martin & Moyce's points (black).
+pub fn front(
+    path: &Path,
+    device: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+    paper: &[(f64, f64)],
+) -> Result<()> {
+    font()?;
+    let caption = format!(
+        "collapsing column against Martin & Moyce: {device}, {}",
+        today()
+    );
+    let all = series.iter().flat_map(|s| s.1.iter()).chain(paper);
+    let (tmax, zmax) = all.fold((1.0f64, 1.0f64), |m, p| (m.0.max(p.0), m.1.max(p.1)));
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..tmax * 1.05, 1.0..zmax * 1.05)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("T = t sqrt(2 g / a)")
+        .y_desc("front Z = z / a")
+        .draw()
+        .map_err(|e| err(path, e))?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        chart
+            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+            .map_err(|e| err(path, e))?
+            .label(name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
+    }
+    chart
+        .draw_series(paper.iter().map(|p| Circle::new(*p, 4, BLACK.filled())))
+        .map_err(|e| err(path, e))?
+        .label("Martin & Moyce 1952")
+        .legend(|(x, y)| Circle::new((x + 9, y), 4, BLACK.filled()));
+    legend(&mut chart, path, Some(SeriesLabelPosition::LowerRight))?;
+    root.present().map_err(|e| err(path, e))
+}
+
 /// Grouped bars on a log axis: one group per label, one bar per series (missing values
 /// leave a gap). `subtitle` names the device and date.
 pub fn grouped_bars(

@@ -358,9 +358,15 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 }
                 let (f, o) = best.expect("a ladder has candidates");
                 let mut r = row(format!("{} <= {}%", s.as_str(), target * 100.0), &f, &o)?;
-                if o.unstable.is_none() && !o.meets(target) {
-                    let status = r.extra.iter_mut().find(|(k, _)| k == "status");
-                    status.expect("status column").1 = "target not reached".into();
+                // A matched row answers to the row's target, not the candidate's own.
+                let status = match (o.unstable.is_none(), o.meets(target)) {
+                    (true, false) => Some("target not reached"),
+                    (_, true) => Some("ok"),
+                    _ => None,
+                };
+                if let Some(v) = status {
+                    let c = r.extra.iter_mut().find(|(k, _)| k == "status");
+                    c.expect("status column").1 = v.into();
                 }
                 if o.meets(target) {
                     points.push((

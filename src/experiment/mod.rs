@@ -9,6 +9,7 @@ pub mod findings;
 pub mod lists;
 pub mod measure;
 pub mod surfaces;
+pub mod surge;
 pub mod sweeps;
 pub mod tables;
 pub mod thesis;
@@ -25,7 +26,7 @@ use std::time::Instant;
 
 pub const NAMES: &[&str] = &[
     "table2", "table3", "table4", "table5", "table6", "table7", "table8", "fig9", "adaptive",
-    "scaling", "fidelity", "surfaces", "lists",
+    "scaling", "fidelity", "surfaces", "lists", "surge",
 ];
 
 pub struct ExperimentOptions {
@@ -348,6 +349,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>>
             "fidelity" => fidelity::fidelity(env)?,
             "surfaces" => surfaces::surfaces(env)?,
             "lists" => lists::lists(ctx, env)?,
+            "surge" => surge::surge(ctx, env)?,
             table => {
                 let def = tables::def(table).expect("a table name");
                 measure::table(ctx, env, def)?

@@ -158,7 +158,7 @@ impl SphGpuParams {
             solver: f.solver as u32,
             min_iter: c.min_iterations,
             max_iter: c.max_iterations,
-            density_target: c.density_error,
+            density_target: c.density_error * c.stop_fraction,
             divergence_target: c.divergence_error,
             proto_grad2: t.proto_grad2,
             pbf_relaxation: f.pbf.relaxation,

@@ -10,8 +10,8 @@ pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
 pub use super::pressure::Convergence;
 
-/// DFSPH's and PBF's own CFL number (with each table's `dt_max`: the setup `bench
-/// solvers` found stable on the dam break; PCISPH's is its own).
+/// The CFL number a configuration without a table of its own takes (each pressure solver
+/// has its own: pcisph.rs, dfsph.rs, pbf.rs).
 pub const OWN_CFL: f32 = 0.4;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -27,13 +27,15 @@ pub struct PcisphParams {
     pub dt_max: f32,
 }
 
-/// PCISPH's largest own step: at 4 ms on the dam break its iterations hit the limit and
-/// particles were flung (results/<device>/solvers.md).
-pub const OWN_DT_MAX: f32 = 0.002;
+/// PCISPH's largest own step. On H100 (results/nvidia-h100-80gb-hbm3/solvers.md, the
+/// cubic kernel) the 256K dam break flung a particle at 2 ms steps; at 0.5 ms its
+/// measured error met the 0.1% target at 16K, 64K and 256K (0.079, 0.095, 0.099%) in 2
+/// to 3 iterations, faster per simulated second than 1 ms (6 to 12 iterations) or 2 ms
+/// (24 to 34).
+pub const OWN_DT_MAX: f32 = 0.0005;
 
-/// PCISPH's own CFL number, half the others': at 0.4 (2 ms steps) the 64K dam break's
-/// solves hit their bound and flung particles within 0.12 s; at 0.2 (1.4 ms) it held.
-pub const OWN_CFL: f32 = 0.2;
+/// PCISPH's own CFL number (of the cubic's 2 spacings), with `OWN_DT_MAX` above.
+pub const OWN_CFL: f32 = 0.05;
 
 impl Default for PcisphParams {
     fn default() -> Self {
@@ -57,6 +59,7 @@ impl PcisphParams {
     pub fn convergence(&self) -> Convergence {
         Convergence {
             density_error: self.density_error,
+            stop_fraction: 1.0,
             // No divergence solve: the GPU field keeps the default target.
             divergence_error: 0.001,
             min_iterations: self.min_iterations,

@@ -438,6 +438,9 @@ pub struct Convergence {
     pub divergence_error: f32,
     pub min_iterations: u32,
     pub max_iterations: u32,
+    /// The density solve stops once its own estimate is at most this fraction of
+    /// `density_error` (1: at the target; DFSPH's [`stop_fraction`](super::dfsph::DfsphParams)).
+    pub stop_fraction: f32,
 }
 
 /// `fluid.TABLE.NAME` must lie in lo..=hi.
