@@ -189,7 +189,7 @@ fn a_collapsing_column_follows_martin_and_moyce() {
     let mut solver = SphSolver::new(&ctx, Neighbors::Grid, Some(SortAlgo::Counting)).unwrap();
     let mut bad = Vec::new();
     for s in ALL {
-        let f = surge::front(&ctx, &mut solver, s, 16).unwrap();
+        let f = surge::front(&ctx, &mut solver, s, (16, surge::MARTIN_MOYCE.len())).unwrap();
         let line: String = f
             .points
             .iter()

@@ -120,8 +120,14 @@ impl Front {
 
 /// The column a = 0.1 m wide, 2a high, `across` particles across and 6 deep in a slab as
 /// wide as the tank, in a tank 5a long, each solver's default water; the front is the
-/// nearest of the 6 leading particles (one per row across the slab).
-pub fn front(ctx: &Context, solver: &mut SphSolver, kind: Solver, across: u32) -> Result<Front> {
+/// nearest of the 6 leading particles (one per row across the slab), at the first `upto`
+/// of Martin & Moyce's times.
+pub fn front(
+    ctx: &Context,
+    solver: &mut SphSolver,
+    kind: Solver,
+    (across, upto): (u32, usize),
+) -> Result<Front> {
     let sp = A / across as f32;
     let slab = 6.0 * sp;
     let scale = (2.0 * G / A as f64).sqrt();
@@ -134,7 +140,7 @@ pub fn front(ctx: &Context, solver: &mut SphSolver, kind: Solver, across: u32) -
     let dt = f.dt as f64;
     let (mut now, mut points) = (0u64, Vec::new());
     let mut run = || -> Result<()> {
-        for (t_star, z) in MARTIN_MOYCE {
+        for &(t_star, z) in MARTIN_MOYCE.iter().take(upto) {
             let steps = (t_star / scale / dt).round() as u64;
             while now < steps {
                 let k = (steps - now).min(50);
@@ -165,16 +171,21 @@ pub fn front(ctx: &Context, solver: &mut SphSolver, kind: Solver, across: u32) -
     })
 }
 
-/// Every solver's front (8 particles across with --quick, else 16).
+/// Every solver's front (--quick: 8 particles across and the first 4 times, else 16 and
+/// all 13).
 pub fn surge(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
-    let across = if env.quick { 8 } else { 16 };
+    let (across, upto) = if env.quick {
+        (8, 4)
+    } else {
+        (16, MARTIN_MOYCE.len())
+    };
     let kinds = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
     let mut solver = SphSolver::new(ctx, Neighbors::Grid, Some(SortAlgo::Counting))?;
     let mut steps = Steps::new("surge", kinds.len() as u64, env.switches.common.quiet);
     let mut fronts = Vec::new();
     for kind in kinds {
         steps.start(&kind.as_str());
-        match front(ctx, &mut solver, kind, across) {
+        match front(ctx, &mut solver, kind, (across, upto)) {
             Ok(f) => fronts.push(f),
             Err(e) => {
                 solver.destroy(ctx);
@@ -247,7 +258,8 @@ fn tables(fronts: &[Front], across: u32) -> (String, String) {
         ));
     }
     md.push_str(&format!("\n|---|---|{}\n", "---|".repeat(fronts.len())));
-    for (k, (t, z)) in MARTIN_MOYCE.iter().enumerate() {
+    let upto = fronts.iter().map(|f| f.points.len()).max().unwrap_or(0);
+    for (k, (t, z)) in MARTIN_MOYCE.iter().take(upto).enumerate() {
         md.push_str(&format!("| {t:.2} | {z:.2} |"));
         for f in fronts {
             let p = f.points.get(k).copied().unwrap_or((*t, f64::NAN, *z));
