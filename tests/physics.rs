@@ -74,22 +74,14 @@ fn slope(pts: &[(f64, f64)]) -> f64 {
 /// spacings 1.020, Wendland at 3 1.001). A pressure that holds the fluid up rises by
 /// rho0 g / kappa per metre of depth: the discrete hydrostatic line.
 fn lattice_gradient_scale(f: &FluidParams) -> f64 {
-    let (h, s) = (f.h as f64, f.spacing() as f64);
-    let sm = fluidform::sph::kernel::Smoothing::of(f);
-    let r = (h / s).ceil() as i32;
-    let mut sum = 0.0;
-    for a in -r..=r {
-        for b in -r..=r {
-            for c in -r..=r {
-                let o = [a as f64 * s, b as f64 * s, c as f64 * s];
-                if (a, b, c) != (0, 0, 0) {
-                    // x_j = x_i + o: f_j - f_i = o_y, grad_i W(x_i - x_j) = grad(-o).
-                    sum += s.powi(3) * o[1] * sm.grad([-o[0], -o[1], -o[2]])[1];
-                }
-            }
-        }
-    }
-    sum
+    use fluidform::sph::kernel::{lattice, Smoothing};
+    let v = (f.spacing() as f64).powi(3);
+    let sm = Smoothing::of(f);
+    // x_j = x_i + o: f_j - f_i = o_y, grad_i W(x_i - x_j) = grad(-o) (0 at o = 0).
+    lattice(f)
+        .iter()
+        .map(|o| v * o[1] * sm.grad([-o[0], -o[1], -o[2]])[1])
+        .sum()
 }
 
 /// A pool 0.1 m deep filling a 0.2 m box's floor (4000 particles at 1 cm), after 0.5 s,

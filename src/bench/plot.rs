@@ -3,6 +3,7 @@
 //! modes, materials). Axes carry units; the title names the device and the date.
 use super::Row;
 use crate::error::{Error, Result};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -302,20 +303,47 @@ pub fn over_time(
         .fold(0.0f64, f64::max)
         .max(1e-3);
     let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    let axes = (0.0..tmax, 0.0..1.0);
+    let mut chart = line_chart(&root, path, &caption, axes, ("scene time (s)", y_desc))?;
+    draw_lines(&mut chart, path, series)?;
+    let gray = RGBColor(150, 150, 150);
+    chart
+        .draw_series(LineSeries::new(vec![(0.0, 0.9), (tmax, 0.9)], gray))
+        .map_err(|e| err(path, e))?;
+    legend(&mut chart, path, Some(SeriesLabelPosition::LowerRight))?;
+    root.present().map_err(|e| err(path, e))
+}
+
+type Lines<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A white 900 x 560 ground with linear axes over `x` and `y`, described by `desc`.
+fn line_chart<'a, 'b>(
+    root: &'a Area<'b>,
+    path: &Path,
+    caption: &str,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<Lines<'a, 'b>> {
     root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&caption, ("sans-serif", 20))
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(48)
         .y_label_area_size(72)
-        .build_cartesian_2d(0.0..tmax, 0.0..1.0)
+        .build_cartesian_2d(x, y)
         .map_err(|e| err(path, e))?;
     chart
         .configure_mesh()
-        .x_desc("scene time (s)")
+        .x_desc(x_desc)
         .y_desc(y_desc)
         .draw()
         .map_err(|e| err(path, e))?;
+    Ok(chart)
+}
+
+/// One labelled line per series, in the palette's order.
+fn draw_lines(chart: &mut Lines, path: &Path, series: &[(String, Vec<(f64, f64)>)]) -> Result<()> {
     for (i, (name, pts)) in series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
         chart
@@ -324,12 +352,7 @@ pub fn over_time(
             .label(name.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
     }
-    let gray = RGBColor(150, 150, 150);
-    chart
-        .draw_series(LineSeries::new(vec![(0.0, 0.9), (tmax, 0.9)], gray))
-        .map_err(|e| err(path, e))?;
-    legend(&mut chart, path, Some(SeriesLabelPosition::LowerRight))?;
-    root.present().map_err(|e| err(path, e))
+    Ok(())
 }
 
 /// The surge front Z against T per solver (lines) with Martin & Moyce's points (black).
@@ -347,28 +370,10 @@ pub fn front(
     let all = series.iter().flat_map(|s| s.1.iter()).chain(paper);
     let (tmax, zmax) = all.fold((1.0f64, 1.0f64), |m, p| (m.0.max(p.0), m.1.max(p.1)));
     let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&caption, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(72)
-        .build_cartesian_2d(0.0..tmax * 1.05, 1.0..zmax * 1.05)
-        .map_err(|e| err(path, e))?;
-    chart
-        .configure_mesh()
-        .x_desc("T = t sqrt(2 g / a)")
-        .y_desc("front Z = z / a")
-        .draw()
-        .map_err(|e| err(path, e))?;
-    for (i, (name, pts)) in series.iter().enumerate() {
-        let c = PALETTE[i % PALETTE.len()];
-        chart
-            .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
-            .map_err(|e| err(path, e))?
-            .label(name.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
-    }
+    let axes = (0.0..tmax * 1.05, 1.0..zmax * 1.05);
+    let desc = ("T = t sqrt(2 g / a)", "front Z = z / a");
+    let mut chart = line_chart(&root, path, &caption, axes, desc)?;
+    draw_lines(&mut chart, path, series)?;
     chart
         .draw_series(paper.iter().map(|p| Circle::new(*p, 4, BLACK.filled())))
         .map_err(|e| err(path, e))?

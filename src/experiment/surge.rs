@@ -7,7 +7,7 @@ use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Labels};
 use crate::kinds::Solver;
-use crate::scene::schema::{Block, Domain, Scene};
+use crate::scene::schema::{Block, Scene};
 use crate::sph::{Eos, FluidParams, SphSolver};
 use std::path::PathBuf;
 
@@ -67,23 +67,14 @@ pub fn water(solver: Solver, spacing: f32, dt: f32) -> Result<FluidParams> {
 
 /// A box from the origin to `domain` with water filling `block` from its floor corner.
 pub fn box_scene(fluid: FluidParams, domain: [f32; 3], block: [f32; 3]) -> Result<Scene> {
-    let mut s = Scene::built_in("dam-break")?;
-    s.name = "water box".into();
-    s.domain = Domain {
-        min: [0.0; 3],
-        max: domain,
-    };
-    s.fluid = fluid;
-    s.blocks = vec![Block {
+    let water = Block {
         min: [0.0; 3],
         max: block,
         group: 0,
         color: [0.2, 0.5, 1.0],
         velocity: [0.0; 3],
-    }];
-    s.balls.clear();
-    s.colliders.clear();
-    Ok(s)
+    };
+    Scene::water_box(fluid, domain, vec![water])
 }
 
 /// One solver's front: (T, ours, theirs) per measurement.

@@ -101,6 +101,26 @@ impl Scene {
         }
     }
 
+    /// The dam break's scene reduced to a box from the origin to `domain` holding `blocks`
+    /// of `fluid`, with no balls or colliders (experiments and tests).
+    pub fn water_box(
+        fluid: crate::sph::FluidParams,
+        domain: [f32; 3],
+        blocks: Vec<super::schema::Block>,
+    ) -> Result<Self> {
+        let mut s = Self::built_in("dam-break")?;
+        s.name = "water box".into();
+        s.domain = super::schema::Domain {
+            min: [0.0; 3],
+            max: domain,
+        };
+        s.fluid = fluid;
+        s.blocks = blocks;
+        s.balls.clear();
+        s.colliders.clear();
+        Ok(s)
+    }
+
     /// A scene from its TOML `text`; character files are named relative to `dir`.
     pub fn from_text(origin: &str, text: &str, dir: Option<&Path>) -> Result<Self> {
         let mut s: Scene = parse(origin, text)?;

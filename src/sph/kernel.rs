@@ -161,7 +161,7 @@ pub fn wall_push(kind: Kernel, h: f64, d: f64) -> f64 {
 
 /// The points of a cubic lattice at the rest spacing within h of a lattice point (itself
 /// included), as offsets.
-fn lattice(f: &FluidParams) -> Vec<[f64; 3]> {
+pub fn lattice(f: &FluidParams) -> Vec<[f64; 3]> {
     let (h, s) = (f.h as f64, f.spacing() as f64);
     let r = (h / s).ceil() as i32;
     let mut out = Vec::new();

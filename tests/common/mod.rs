@@ -130,15 +130,8 @@ pub fn box_scene(
     domain: [f32; 3],
     blocks: Vec<fluidform::scene::schema::Block>,
 ) -> fluidform::scene::schema::Scene {
-    use fluidform::scene::schema::{Block, Domain, Scene};
-    let mut s = Scene::built_in("dam-break").expect("built-in");
-    s.name = "solver test".into();
-    s.domain = Domain {
-        min: [0.0; 3],
-        max: domain,
-    };
-    s.fluid = fluid;
-    s.blocks = if blocks.is_empty() {
+    use fluidform::scene::schema::{Block, Scene};
+    let blocks = if blocks.is_empty() {
         vec![Block {
             min: [0.0; 3],
             max: [0.1; 3],
@@ -149,7 +142,7 @@ pub fn box_scene(
     } else {
         blocks
     };
-    s.balls.clear();
-    s.colliders.clear();
+    let mut s = Scene::water_box(fluid, domain, blocks).expect("the dam break is built in");
+    s.name = "solver test".into();
     s
 }
