@@ -101,6 +101,12 @@ enum Command {
         /// Print JSON instead of text
         #[arg(long)]
         json: bool,
+        /// The file's up axis: y (default), -y, z, -z, x, -x
+        #[arg(long)]
+        up: Option<fluidform::character::anim::Up>,
+        /// Draw the rest pose from the front and the side, with its skeleton, into this PNG
+        #[arg(long)]
+        picture: Option<PathBuf>,
     },
     /// Reproduce a table or figure of the papers: table2..table8, fig9, adaptive,
     /// scaling, fidelity, surfaces, or all (list: their names); writes <out>/<name>.csv,
@@ -477,9 +483,17 @@ fn real_main() -> Result<()> {
             }
             Ok(())
         }
-        Command::Inspect { file, json } => {
-            let ch = fluidform::character::load(&file)?;
-            let report = fluidform::character::inspect::inspect(&ch)?;
+        Command::Inspect {
+            file,
+            json,
+            up,
+            picture,
+        } => {
+            let (ch, u) = (fluidform::character::load(&file)?, up.unwrap_or_default());
+            let report = fluidform::character::inspect::inspect(&ch, u, up.is_some())?;
+            if let Some(p) = &picture {
+                fluidform::bench::picture::inspect_png(&ch, u, p)?;
+            }
             match json {
                 true => println!("{}", serde_json::to_string_pretty(&report)?),
                 false => print!("{}", report.text()),
@@ -535,10 +549,9 @@ fn run_command(opts: RunOptions) -> Result<()> {
         0 => String::new(),
         k => format!(", {k} particle files and particles.csv"),
     };
-    let control = match &r.summary.stats {
-        fluidform::run::RunStats::Sph(s) if s.control.is_some() => ", control.csv",
-        _ => "",
-    };
+    use fluidform::run::RunStats::Sph;
+    let control = matches!(&r.summary.stats, Sph(s) if s.control.is_some());
+    let control = if control { ", control.csv" } else { "" };
     println!(
         "wrote {} frame PNGs{anim}{exports}{control}, timings.csv and summary.json to {}",
         r.pngs.len(),

@@ -34,7 +34,11 @@ fn spacing_and_pool_follow_the_character() {
     let (lo, hi) = ch.rest_bounds().unwrap();
     let scale = 1.2 / (hi.y - lo.y);
     assert!((anim.placement.x_axis.length() - scale).abs() < 1e-4);
-    let d = thinnest(&ch).unwrap().diameter * scale;
+    let d = thinnest(&ch, glam::Mat3::IDENTITY)
+        .unwrap()
+        .unwrap()
+        .diameter
+        * scale;
     let want = (d / ACROSS).clamp(1.2 / FINEST, 1.2 / COARSEST);
     let (got, why) = f.spacing.clone().unwrap();
     assert!((got - want).abs() < 1e-6, "spacing {got} against {want}");
@@ -172,7 +176,11 @@ fn the_spacing_keeps_the_pool_within_the_budget() {
     let (ch, _) = s.character.as_ref().unwrap().load().unwrap();
     let (lo, hi) = ch.rest_bounds().unwrap();
     let scale = 1.2 / (hi.y - lo.y);
-    let d = thinnest(&ch).unwrap().diameter * scale;
+    let d = thinnest(&ch, glam::Mat3::IDENTITY)
+        .unwrap()
+        .unwrap()
+        .diameter
+        * scale;
     assert!(
         sp > (d / ACROSS).clamp(1.2 / FINEST, 1.2 / COARSEST),
         "coarser than the thinnest part asks"

@@ -31,6 +31,10 @@ fn camera() -> Camera {
 }
 
 fn gpu(ctx: &Context, s: MetaballSettings, centers: &[[f32; 4]]) -> Vec<u8> {
+    gpu_from(ctx, s, centers, &camera())
+}
+
+fn gpu_from(ctx: &Context, s: MetaballSettings, centers: &[[f32; 4]], cam: &Camera) -> Vec<u8> {
     let mut buf = ctx
         .storage_buffer("centers", (centers.len() * 16) as u64)
         .unwrap();
@@ -38,7 +42,7 @@ fn gpu(ctx: &Context, s: MetaballSettings, centers: &[[f32; 4]]) -> Vec<u8> {
     let mut r = MetaballRenderer::new(ctx, s).unwrap();
     let mut b = r.buffers(ctx, centers.len() as u64, 1, false).unwrap();
     let (st, _) = r
-        .render_sync(ctx, &mut b, &buf, centers.len() as u32, &camera(), 0)
+        .render_sync(ctx, &mut b, &buf, centers.len() as u32, cam, 0)
         .unwrap();
     assert_eq!(
         st.budget_pixels, 0,
@@ -166,6 +170,7 @@ fn the_renderer_matches_the_independent_reference_per_material() {
                 look: look(&s),
                 depth: s.depth,
                 env: env.clone(),
+                cone_radius: R as f64,
             };
             let want = reference.render(&camera(), SIZE, SIZE);
             let got = gpu(&ctx, s, &centers);
@@ -244,6 +249,65 @@ fn absorption_grows_with_the_path_through_the_water() {
             "T {t}: {c:?} after {last:?}"
         );
         last = c;
+    }
+    common::finish(&ctx);
+}
+
+#[test]
+fn the_filtered_floor_matches_the_reference() {
+    // The procedural sky's checkered ground seen directly and through a tinted and a clear
+    // sphere, looking down on it: the renderer filters the checks over each ray's cone as
+    // the reference does (render::trace::env::environment). Unfiltered, a check's edge
+    // flips a whole pixel between 0.25 and 0.45 grey, which is far more than the
+    // tolerance; filtered, both sides blend the edge, and only rays bent slightly
+    // differently at the rim differ.
+    let ctx = common::ctx();
+    let cam = Camera::look_at(
+        Vec3::new(0.0, 0.35, 0.3),
+        Vec3::new(0.0, -0.05, 0.0),
+        40.0,
+        1.0,
+    );
+    for m in [Material::Tinted, Material::Glass] {
+        let s = settings(m);
+        let r = iso_radius(DensityFn::Wyvill, R as f64, s.threshold as f64, 1.0).unwrap();
+        let reference = |cone_radius: f64, env: Env| Reference {
+            spheres: vec![Sphere {
+                center: DVec3::ZERO,
+                radius: r,
+            }],
+            look: look(&s),
+            depth: s.depth,
+            env,
+            cone_radius,
+        };
+        let want = reference(R as f64, Env::Procedural).render(&cam, SIZE, SIZE);
+        let got = gpu_from(&ctx, s.clone(), &[[0.0; 4]], &cam);
+        let (close, mean) = compare(&got, &want, 2);
+        let tag = format!("floor-{}", m.as_str());
+        if close < 0.99 || mean > 0.25 || std::env::var("FLUIDFORM_SAVE_SHADING").is_ok() {
+            save(&format!("{tag}-gpu"), &got);
+            save(&format!("{tag}-ref"), &want);
+        }
+        assert!(
+            close >= 0.99 && mean <= 0.25,
+            "{tag}: {:.2}% of pixels within 2/255 (need 99%), mean {mean:.3}/255 (need 0.25)",
+            close * 100.0
+        );
+        // The filter is seen: the reference without it (point-sampled checks) is further
+        // from the renderer than the filtered one.
+        let sharp = reference(f64::INFINITY, Env::Procedural);
+        let sharp = sharp.render_with_cones(&cam, SIZE, SIZE, false);
+        let (close_sharp, mean_sharp) = compare(&got, &sharp, 2);
+        eprintln!(
+            "{tag}: filtered {:.1}% within 2/255, mean {mean:.3}; point-sampled {:.1}%, mean {mean_sharp:.3}",
+            100.0 * close,
+            100.0 * close_sharp
+        );
+        assert!(
+            mean_sharp > 4.0 * mean,
+            "{tag}: point-sampled checks {mean_sharp:.3}/255 from the renderer, filtered {mean:.3}"
+        );
     }
     common::finish(&ctx);
 }

@@ -5,8 +5,26 @@
 #define RENDER_SHADING_GLSL
 vec3 unpack_rgb(uint v) { return unpackUnorm4x8(v).rgb; }
 
-// Procedural sky (gradient, sun, checkered ground) or an equirectangular image.
-vec3 sky_color(vec3 d) {
+// The checks' parity at p (one check per unit), box-filtered over a square of side w
+// (Quilez's analytic integral of the checker): 0 or 1 when w -> 0, 0.5 when w covers many.
+float filtered_check(vec2 p, float w) {
+    w = max(w, 1e-4);
+    vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+    return 0.5 - 0.5 * i.x * i.y;
+}
+
+// A ray cone (Akenine-Moller et al. 2019, "Texture level of detail strategies for
+// real-time ray tracing"): x its width at the ray's origin, y its spread angle. Carried
+// along a path: the width grows by spread x distance; at a surface curved no tighter than
+// radius rc (the metaball radius) the normal turns by up to width / rc across the cone,
+// which a reflection doubles in the spread and a refraction passes about once.
+vec2 cone_at(vec2 c, float t) { return vec2(c.x + c.y * t, c.y); }
+vec2 cone_bent(vec2 c, float rc, float turns) { return vec2(c.x, c.y + turns * c.x / rc); }
+
+// Procedural sky (gradient, sun, checkered ground) or an equirectangular image. The ground
+// is filtered over the ray cone's footprint on it: the spread through the plane one
+// metre down (d(tan)/d(angle) = 1 + tan^2) plus the cone's width seen at the ray's slope.
+vec3 sky_color(vec3 d, vec2 cone) {
     if (P.sky_w > 0u) {
         // Bilinear lookup, wrapping in longitude and clamping in latitude.
         float u = atan(d.z, d.x) / (2.0 * 3.14159265) + 0.5;
@@ -24,8 +42,10 @@ vec3 sky_color(vec3 d) {
         return pow(mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y), vec3(2.2));
     }
     if (d.y < 0.0) {
-        vec2 g = d.xz / max(-d.y, 1e-3);
-        float check = mod(floor(g.x * 2.0) + floor(g.y * 2.0), 2.0);
+        float down = max(-d.y, 1e-3);
+        vec2 g = d.xz / down;
+        float foot = cone.y * (1.0 + dot(g, g)) + cone.x / down;
+        float check = filtered_check(g * 2.0, foot * 2.0);
         return mix(vec3(0.25, 0.23, 0.2), vec3(0.45, 0.42, 0.38), check) * (0.6 + 0.4 * min(-d.y * 4.0, 1.0));
     }
     vec3 c = mix(vec3(0.75, 0.82, 0.9), vec3(0.25, 0.45, 0.8), pow(d.y, 0.6));

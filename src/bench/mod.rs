@@ -5,6 +5,7 @@ pub mod control;
 pub mod emission;
 pub mod floor;
 pub mod particles;
+pub mod picture;
 pub mod plot;
 pub mod primitives;
 pub mod render;

@@ -2,7 +2,7 @@
 //! slerp) and CUBICSPLINE (Hermite with tangents scaled by the key interval), looping or
 //! clamped; then node globals and joint matrices.
 use super::model::{Channel, Clip, Interp, Property, Skeleton, Trs};
-use glam::{Mat4, Quat, Vec3, Vec4};
+use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 
 /// Where `t` falls in a clip of length `duration`.
 pub fn clip_time(t: f32, duration: f32, looping: bool) -> f32 {
@@ -117,13 +117,84 @@ impl Animator {
     }
 }
 
-/// Placement: scale, then rotation (XYZ Euler degrees), then translation.
-pub fn placement(scale: f32, rotation_deg: Vec3, position: Vec3) -> Mat4 {
+/// A file's up axis (OBJ has no convention; many are Z-up), turned to +Y before the
+/// scene's `rotation`: Z-up by -90 degrees about X (so +Y, the file's depth, faces back).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Up {
+    #[default]
+    #[serde(rename = "y")]
+    Y,
+    #[serde(rename = "-y")]
+    NegY,
+    #[serde(rename = "z")]
+    Z,
+    #[serde(rename = "-z")]
+    NegZ,
+    #[serde(rename = "x")]
+    X,
+    #[serde(rename = "-x")]
+    NegX,
+}
+
+impl Up {
+    pub const ALL: [Up; 6] = [Up::Y, Up::NegY, Up::Z, Up::NegZ, Up::X, Up::NegX];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Up::Y => "y",
+            Up::NegY => "-y",
+            Up::Z => "z",
+            Up::NegZ => "-z",
+            Up::X => "x",
+            Up::NegX => "-x",
+        }
+    }
+
+    /// The rotation taking this axis to +Y.
+    pub fn matrix(self) -> Mat3 {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        match self {
+            Up::Y => Mat3::IDENTITY,
+            Up::NegY => Mat3::from_rotation_z(PI),
+            Up::Z => Mat3::from_rotation_x(-FRAC_PI_2),
+            Up::NegZ => Mat3::from_rotation_x(FRAC_PI_2),
+            Up::X => Mat3::from_rotation_z(FRAC_PI_2),
+            Up::NegX => Mat3::from_rotation_z(-FRAC_PI_2),
+        }
+    }
+}
+
+impl std::str::FromStr for Up {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Up::ALL.into_iter().find(|u| u.name() == s).ok_or_else(|| {
+            let all: Vec<&str> = Up::ALL.iter().map(|u| u.name()).collect();
+            format!("up axis '{s}' is not one of {}", all.join(", "))
+        })
+    }
+}
+
+/// The placement's orientation: the up axis to +Y, then `rotation` (XYZ Euler degrees).
+pub fn orientation(up: Up, rotation_deg: Vec3) -> Mat3 {
     let r = Quat::from_euler(
         glam::EulerRot::XYZ,
         rotation_deg.x.to_radians(),
         rotation_deg.y.to_radians(),
         rotation_deg.z.to_radians(),
     );
-    Mat4::from_scale_rotation_translation(Vec3::splat(scale), r, position)
+    Mat3::from_quat(r) * up.matrix()
+}
+
+/// The placement that stands the rest pose `rest` (file coordinates), oriented by
+/// `orient`, with the bottom centre of its oriented bounds at `position`, scaled by
+/// `scale` about that point: one pivot, so the fitted domain, the pool and the control
+/// particles all see the character where it stands.
+pub fn stand(rest: &[Vec3], orient: Mat3, scale: f32, position: Vec3) -> Mat4 {
+    let turned: Vec<Vec3> = rest.iter().map(|p| orient * *p).collect();
+    let (lo, hi) = super::check::bounds(&turned);
+    let bottom = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+    Mat4::from_translation(position)
+        * Mat4::from_scale(Vec3::splat(scale))
+        * Mat4::from_translation(-bottom)
+        * Mat4::from_mat3(orient)
 }

@@ -1,6 +1,9 @@
 //! `fluidform inspect FILE`: what a character or mesh file holds.
+use super::anim::Up;
+use super::thickness::{regions, Region};
 use super::Character;
 use crate::error::Result;
+use glam::Mat3;
 use serde::Serialize;
 
 #[derive(Clone, Debug, Serialize)]
@@ -32,16 +35,25 @@ pub struct Inspection {
     pub flipped: bool,
     pub normals: &'static str,
     pub uvs: bool,
-    /// The thinnest part: the narrowest bone capsule (None: no capsules).
+    /// The up axis assumed (turned to +Y) and why.
+    pub up: &'static str,
+    pub up_note: String,
+    /// The thinnest part: the thinnest region of the surface (None: nothing measured).
     pub thinnest: Option<Thinnest>,
+    /// The thinnest regions (at most [`REGIONS`]), thinnest first.
+    pub regions: Vec<Region>,
     pub warnings: Vec<String>,
 }
 
-/// The narrowest bone capsule of a character, in the file's units, against the fluid's
-/// default particle spacing.
+/// Regions listed by `inspect`.
+pub const REGIONS: usize = 5;
+
+/// The thinnest region of a character's surface (`thickness::regions`), in the file's
+/// units, against the fluid's default particle spacing.
 #[derive(Clone, Debug, Serialize)]
 pub struct Thinnest {
-    pub joint: String,
+    /// The joint (skinned) or the grid cell (static mesh) it lies in.
+    pub region: String,
     pub diameter: f32,
     /// The diameter in default particle spacings (fluid at the file's own scale).
     pub spacings_at_default: f32,
@@ -49,21 +61,36 @@ pub struct Thinnest {
     pub spacing_for_three: f32,
 }
 
-/// The thinnest part of `ch` (its narrowest capsule; see `capsules::of`).
-pub fn thinnest(ch: &Character) -> Option<Thinnest> {
-    let caps = super::capsules::of(ch);
-    let c = caps.iter().min_by(|a, b| a.r.total_cmp(&b.r))?;
-    let d = 2.0 * c.r;
-    Some(Thinnest {
-        joint: ch.joint_name(c.joint),
-        diameter: d,
-        spacings_at_default: d / crate::sph::FluidParams::default().spacing(),
-        spacing_for_three: d / 3.0,
-    })
+impl Thinnest {
+    fn of(r: &Region) -> Self {
+        Self {
+            region: r.name.clone(),
+            diameter: r.thickness,
+            spacings_at_default: r.thickness / crate::sph::FluidParams::default().spacing(),
+            spacing_for_three: r.thickness / 3.0,
+        }
+    }
 }
 
-pub fn inspect(ch: &Character) -> Result<Inspection> {
-    let (lo, hi) = ch.rest_bounds()?;
+/// The thinnest part of `ch` with its rest pose turned by `orient` (names a static
+/// mesh's regions by where they lie).
+pub fn thinnest(ch: &Character, orient: Mat3) -> Result<Option<Thinnest>> {
+    Ok(regions(ch, orient)?.first().map(Thinnest::of))
+}
+
+/// The report on `ch` with its up axis `up` (turned to +Y: bounds and regions after it).
+pub fn inspect(ch: &Character, up: Up, up_given: bool) -> Result<Inspection> {
+    let rest = ch.rest_positions()?;
+    let turned: Vec<glam::Vec3> = rest.iter().map(|p| up.matrix() * *p).collect();
+    let (lo, hi) = super::check::bounds(&turned);
+    let regions = regions(ch, up.matrix())?;
+    let obj = ch.source.to_ascii_lowercase().ends_with(".obj");
+    let up_note = match (up_given, obj) {
+        (true, _) => "as given".to_string(),
+        (false, true) => "assumed: OBJ has no up convention; if it lies or stands on its nose, set [character] up = \"z\" (or -z, x, -x, -y) and check with --up AXIS --picture PNG".into(),
+        (false, false) if ch.source.starts_with("builtin:") => "built in, Y-up".into(),
+        (false, false) => "glTF is Y-up by its specification".into(),
+    };
     let c = &ch.check;
     Ok(Inspection {
         file: ch.source.clone(),
@@ -101,7 +128,10 @@ pub fn inspect(ch: &Character) -> Result<Inspection> {
             "from the file"
         },
         uvs: !ch.mesh.uvs.is_empty(),
-        thinnest: thinnest(ch),
+        up: up.name(),
+        up_note,
+        thinnest: regions.first().map(Thinnest::of),
+        regions: regions.into_iter().take(REGIONS).collect(),
         warnings: ch.warnings.clone(),
     })
 }
@@ -139,6 +169,7 @@ impl Inspection {
             );
         }
         let f = |v: [f32; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
+        line("up axis", format!("{} ({})", self.up, self.up_note));
         line(
             "bounds at rest",
             format!("{} .. {}", f(self.bounds_min), f(self.bounds_max)),
@@ -172,8 +203,20 @@ impl Inspection {
             line(
                 "thinnest part",
                 format!(
-                    "{:.4} across at joint '{}': {:.2} spacings at the default spacing; --fluid spacing={:.4} puts three particles across (at the file's scale)",
-                    t.diameter, t.joint, t.spacings_at_default, t.spacing_for_three
+                    "{:.4} across in '{}': {:.2} spacings at the default spacing; --fluid spacing={:.4} puts three particles across (at the file's scale)",
+                    t.diameter, t.region, t.spacings_at_default, t.spacing_for_three
+                ),
+            );
+        }
+        for (i, r) in self.regions.iter().enumerate() {
+            line(
+                if i == 0 { "thin regions" } else { "" },
+                format!(
+                    "'{}' {:.4} across ({} vertices, {:.0}th percentile of the inward rays)",
+                    r.name,
+                    r.thickness,
+                    r.vertices,
+                    100.0 * super::thickness::PERCENTILE
                 ),
             );
         }

@@ -9,9 +9,11 @@ pub mod gltf_load;
 pub mod inspect;
 pub mod model;
 pub mod obj_load;
+pub mod picture;
 pub mod pose;
 pub mod procedural;
 pub mod skin;
+pub mod thickness;
 
 pub use anim::Animator;
 pub use check::MeshCheck;

@@ -97,7 +97,7 @@ pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Re
     let mut work = CharacterWork {
         character: character.take(),
         view,
-        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+        frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);

@@ -131,6 +131,8 @@ pub(crate) struct Frames {
     /// The newest picture (RGBA8, width, height), when every frame is kept.
     pub(crate) latest: Option<(Vec<u8>, u32, u32)>,
     keep: bool,
+    /// The sample grid's side: pictures come rendered this many times larger.
+    grid: u32,
 }
 
 impl Frames {
@@ -143,6 +145,15 @@ impl Frames {
             animation: None,
             latest: None,
             keep: false,
+            grid: 1,
+        }
+    }
+
+    /// Pictures rendered with `frame`'s sample grid (`--samples`), saved at its size.
+    pub(crate) fn sampled(self, frame: &crate::config::FrameArgs) -> Self {
+        Self {
+            grid: frame.grid(),
+            ..self
         }
     }
 
@@ -169,6 +180,18 @@ impl Frames {
             (l.1, l.2) = (pic.width, pic.height);
             return Ok(());
         }
+        let down;
+        let pic = match self.grid {
+            1 => pic,
+            k => {
+                down = box_filter(pic.rgba, (pic.width, pic.height), k);
+                Picture {
+                    rgba: &down,
+                    width: pic.width / k,
+                    height: pic.height / k,
+                }
+            }
+        };
         let path = self.out.join(format!("frame_{f:04}.png"));
         save_rgba(&path, pic.width, pic.height, pic.rgba)?;
         self.pngs.push(path);
@@ -192,6 +215,33 @@ impl Frames {
     fn finish(&mut self) -> Result<Option<PathBuf>> {
         self.animation.take().map(Animation::finish).transpose()
     }
+}
+
+/// RGBA8 (gamma 2.2) `size` averaged over k x k blocks in linear light.
+fn box_filter(rgba: &[u8], (w, h): (u32, u32), k: u32) -> Vec<u8> {
+    let lin: Vec<f32> = (0..256).map(|v| (v as f32 / 255.0).powf(2.2)).collect();
+    let (ow, oh) = (w / k, h / k);
+    let mut out = Vec::with_capacity((ow * oh * 4) as usize);
+    for y in 0..oh {
+        for x in 0..ow {
+            let mut sum = [0.0f32; 4];
+            for dy in 0..k {
+                for dx in 0..k {
+                    let i = (((y * k + dy) * w + x * k + dx) * 4) as usize;
+                    for (c, v) in sum.iter_mut().zip(&rgba[i..i + 3]) {
+                        *c += lin[*v as usize];
+                    }
+                    sum[3] += rgba[i + 3] as f32;
+                }
+            }
+            let n = (k * k) as f32;
+            for c in 0..3 {
+                out.push(((sum[c] / n).powf(1.0 / 2.2) * 255.0).round() as u8);
+            }
+            out.push((sum[3] / n).round() as u8);
+        }
+    }
+    out
 }
 
 /// The metaball radius at the default particle spacing (MetaballSettings' default).

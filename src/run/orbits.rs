@@ -72,7 +72,7 @@ pub(super) fn run_orbits(opts: &RunOptions) -> Result<RunResult> {
         pass: pass.take(),
         view,
         scene: scene.take(),
-        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+        frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);

@@ -343,7 +343,7 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
         scene: systems.take(),
         target,
         background: scene.background,
-        frames: Frames::new(&opts.out, opts.save_every, frame_count),
+        frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
     let timings = play(&ctx, frame_count, &mut work, &scene.name, sw.common.quiet);

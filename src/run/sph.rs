@@ -197,7 +197,7 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
     let frame_count = opts.frames.unwrap_or(scene.frames);
     let ctx = open(sw)?;
     fits(&ctx, &scene)?;
-    let frames = Frames::new(&opts.out, opts.save_every, frame_count);
+    let frames = Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame);
     let mut work = SphWork::new(&ctx, (&opts.out, frames), &scene, sw, render, neighbors)?;
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
     let how = (sw, render, neighbors);

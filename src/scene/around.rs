@@ -34,8 +34,8 @@ pub fn fit_around(scene: &mut Scene) -> Result<()> {
     }
     let (ch, anim) = desc.load()?;
     let (lo, hi) = swept(scene, &desc, &ch, &anim)?;
-    let (rlo, rhi) = ch.rest_bounds()?;
-    let height = (rhi.y - rlo.y) * anim.placement.x_axis.truncate().length();
+    let (rlo, rhi) = super::character::placed_rest_bounds(&ch, &anim)?;
+    let height = rhi.y - rlo.y;
     if !(height.is_finite() && height > 0.0) {
         return Err(Error::Param(format!(
             "scene {}: the character has no height to fit a domain around",

@@ -1,6 +1,6 @@
 //! A character in a scene (TOML `[character]`): which file and clip, where it stands, how
 //! fast it plays; skinned every frame on the GPU (`skin` scope) and drawn by the view.
-use crate::character::{self, anim, skin::Skinner, Animator, Character};
+use crate::character::{self, anim, anim::Up, skin::Skinner, Animator, Character};
 use crate::config::{ShowMesh, Skinning};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, Guard};
@@ -28,7 +28,12 @@ pub struct CharacterDesc {
     /// Loop the clip (else hold its last pose).
     #[serde(default = "yes")]
     pub looping: bool,
-    /// Scale the rest pose to this height in metres (Y up) ...
+    /// The file's up axis ("y", glTF's; "z" for a Z-up OBJ; "-z", "x", "-x", "-y"),
+    /// turned to +Y before `rotation` and `height`.
+    #[serde(default)]
+    pub up: Up,
+    /// Scale the rest pose to this height in metres (standing as `up` and `rotation` turn
+    /// it) ...
     #[serde(default)]
     pub height: Option<f32>,
     /// ... or by this factor (default 1: the file's units, metres for glTF).
@@ -37,7 +42,8 @@ pub struct CharacterDesc {
     /// Where the rest pose's bottom centre stands.
     #[serde(default)]
     pub position: [f32; 3],
-    /// XYZ Euler angles in degrees, about the bottom centre.
+    /// XYZ Euler angles in degrees after `up`; the turned rest pose's bottom centre then
+    /// stands at `position`.
     #[serde(default)]
     pub rotation: [f32; 3],
     /// Playback rate (1: the clip's own timing).
@@ -116,6 +122,7 @@ impl CharacterDesc {
             height: None,
             scale: None,
             position: [0.0; 3],
+            up: Up::Y,
             rotation: [0.0; 3],
             speed: 1.0,
             path: Vec::new(),
@@ -169,6 +176,11 @@ impl CharacterDesc {
         Ok(())
     }
 
+    /// The file's up axis then `rotation`, as one rotation.
+    pub fn orientation(&self) -> glam::Mat3 {
+        anim::orientation(self.up, self.rotation.into())
+    }
+
     /// The loaded character and its animator (clip chosen, placement made).
     pub fn load(&self) -> Result<(Character, Animator)> {
         let ch = character::load(&self.file)?;
@@ -179,19 +191,20 @@ impl CharacterDesc {
             Some(sel) => Some(ch.clip_index(sel)?),
             None => (!ch.clips.is_empty()).then_some(0),
         };
-        let (lo, hi) = ch.rest_bounds()?;
+        let rest = ch.rest_positions()?;
+        let orient = self.orientation();
+        let turned: Vec<Vec3> = rest.iter().map(|p| orient * *p).collect();
+        let (lo, hi) = character::check::bounds(&turned);
         let s = match (self.height, self.scale) {
             (Some(h), _) => h / (hi.y - lo.y).max(1e-9),
             (_, Some(s)) => s,
             _ => 1.0,
         };
-        let bottom = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
         let at = match self.path.is_empty() {
             true => self.position.into(),
             false => Vec3::ZERO, // the path places it each frame
         };
-        let placement =
-            anim::placement(s, self.rotation.into(), at) * Mat4::from_translation(-bottom);
+        let placement = anim::stand(&rest, orient, s, at);
         let animator = Animator {
             clip,
             looping: self.looping,
@@ -199,6 +212,16 @@ impl CharacterDesc {
         };
         Ok((ch, animator))
     }
+}
+
+/// The bounds of `ch`'s rest pose as `anim` places it.
+pub fn placed_rest_bounds(ch: &Character, anim: &Animator) -> Result<(Vec3, Vec3)> {
+    let p = ch.rest_positions()?;
+    let placed: Vec<Vec3> = p
+        .iter()
+        .map(|v| anim.placement.transform_point3(*v))
+        .collect();
+    Ok(character::check::bounds(&placed))
 }
 
 /// `stats.character` of summary.json.

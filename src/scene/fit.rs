@@ -1,19 +1,20 @@
 //! A liquid character's scene fitted to its character: the particle spacing from the
 //! character's thinnest part when the scene and the switches give none, and `[pool]`, the
 //! water it is made of, sized from its volume and laid under its first pose.
-use super::character::placed_matrices;
-use crate::character::inspect::thinnest;
+use super::character::{placed_matrices, placed_rest_bounds};
+use crate::character::thickness::{regions, Region};
 use crate::error::{Error, Result};
 use crate::scene::schema::{white, Block, Scene};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// Particles across the thinnest part at the chosen spacing.
-pub const ACROSS: f32 = 2.5;
+pub const ACROSS: f32 = 3.0;
 /// The chosen spacing stays within [height / FINEST, height / COARSEST].
 pub const FINEST: f32 = 70.0;
 pub const COARSEST: f32 = 35.0;
-/// The chosen spacing puts at most about this many particles in the pool: a character whose
+/// The chosen spacing puts at most about this many particles in the pool (`[pool]
+/// particles` sets it per scene): a character whose
 /// thinnest part is thin for its size (a quadruped's feet) would otherwise take tens of
 /// thousands of particles and tiny steps (the fox: 28.7K at 74 steps a frame), beyond what
 /// a 2-core machine plays in minutes. `--fluid spacing=S` goes finer.
@@ -35,6 +36,13 @@ pub struct PoolDesc {
     pub volume: f32,
     #[serde(default = "white")]
     pub color: [f32; 3],
+    /// At most about this many particles: a fitted spacing coarsens to hold it.
+    #[serde(default = "budget")]
+    pub particles: f32,
+}
+
+fn budget() -> f32 {
+    BUDGET
 }
 
 impl Default for PoolDesc {
@@ -42,6 +50,7 @@ impl Default for PoolDesc {
         Self {
             volume: volume(),
             color: white(),
+            particles: BUDGET,
         }
     }
 }
@@ -53,6 +62,8 @@ pub struct Fitted {
     pub spacing: Option<(f32, String)>,
     /// The pool's block and particle count.
     pub pool: Option<(Block, u64)>,
+    /// The parts the chosen spacing leaves under [`WANT`] spacings across, in one line.
+    pub thin: Option<String>,
 }
 
 impl Fitted {
@@ -63,6 +74,7 @@ impl Fitted {
                 "spacing {s:.4} m ({why}; --fluid spacing=S overrides)"
             ));
         }
+        out.extend(self.thin.clone());
         if let Some((b, n)) = &self.pool {
             let d: Vec<String> = (0..3)
                 .map(|k| format!("{:.3}", b.max[k] - b.min[k]))
@@ -80,6 +92,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let mut out = Fitted {
         spacing: None,
         pool: None,
+        thin: None,
     };
     let Some(desc) = scene.character.clone() else {
         if scene.pool.is_some() {
@@ -94,40 +107,53 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         return Ok(out);
     }
     let (ch, anim) = desc.load()?;
-    let (lo, hi) = ch.rest_bounds()?;
+    let (lo, hi) = placed_rest_bounds(&ch, &anim)?;
     let scale = anim.placement.x_axis.truncate().length();
-    let height = (hi.y - lo.y) * scale;
+    let height = hi.y - lo.y;
     let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
+    // The placed skin at scene time 0 (the path's start included).
+    let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
+    let first = ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0;
+    inside(scene, &first, height)?;
     // (A mass other than the default's already says the spacing: mass = rho_0 S^3.)
     let default_mass = scene.fluid.mass == crate::sph::FluidParams::default().mass;
     if scene.fluid.spacing.is_none() && default_mass {
-        let pool = scene.pool.as_ref().map_or(1.0, |p| p.volume);
-        // The spacing the thinnest part asks for, and that part's name and width.
-        let (s, part) = match thinnest(&ch) {
-            Some(t) => {
-                let d = t.diameter * scale;
-                let s = (d / ACROSS).clamp(height / FINEST, height / COARSEST);
-                (s, Some((t.joint, d)))
-            }
-            None => (height / COARSEST, None),
+        let (pool, most) = scene
+            .pool
+            .as_ref()
+            .map_or((1.0, BUDGET), |p| (p.volume, p.particles));
+        if !(most.is_finite() && most >= 64.0) {
+            return Err(Error::Param(format!(
+                "scene {}: [pool] particles is the most the fitted spacing allows, at least 64, got {most}",
+                scene.name
+            )));
+        }
+        let parts = regions(&ch, desc.orientation())?;
+        // The spacing the thinnest part asks for.
+        let s = match parts.first() {
+            Some(t) => (t.thickness * scale / ACROSS).clamp(height / FINEST, height / COARSEST),
+            None => height / COARSEST,
         };
         // (A spacing the budget coarsens still stays within height / COARSEST.)
-        let budget = (volume * pool / BUDGET).cbrt().min(height / COARSEST);
-        let why = match (budget > s, part) {
+        let budget = (volume * pool / most).cbrt().min(height / COARSEST);
+        let why = match (budget > s, parts.first()) {
             (true, _) => format!(
-                "the pool held to about {BUDGET} particles: {s:.4} m would give {:.0}",
+                "the pool held to about {most} particles ([pool] particles): {s:.4} m would give {:.0}",
                 volume * pool / s.powi(3)
             ),
             (false, None) => format!("height / {COARSEST}"),
-            (false, Some((joint, d))) => format!(
-                "{:.2} across the thinnest part, '{joint}' {d:.4} m, within height / {FINEST} .. height / {COARSEST}",
-                d / s
+            (false, Some(t)) => format!(
+                "{:.2} across the thinnest part, '{}' {:.4} m, within height / {FINEST} .. height / {COARSEST}",
+                t.thickness * scale / s,
+                t.name,
+                t.thickness * scale
             ),
         };
         let s = s.max(budget);
         scene.fluid.spacing = Some(s);
         scene.fluid.resolve_spacing()?;
         out.spacing = Some((s, why));
+        out.thin = thin(&parts, scale, s, volume * pool);
     }
     if let Some(pool) = scene.pool.take() {
         if !(pool.volume.is_finite() && pool.volume > 0.0 && pool.volume <= 20.0) {
@@ -136,9 +162,6 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
                 scene.name, pool.volume
             )));
         }
-        // The placed skin at scene time 0 (the path's start included).
-        let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
-        let first = ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0;
         // Under the lower half of the body only: arms held out (a T-pose) would spread the
         // pool beyond the attraction's reach of the legs, leaving puddles under the hands.
         let (lo, _) = crate::character::check::bounds(&first);
@@ -158,6 +181,67 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         out.pool = Some((b, n));
     }
     Ok(out)
+}
+
+/// Parts are wanted at least this many spacings across (fewer: the fit says so).
+pub const WANT: f32 = 3.0;
+
+/// One line naming the parts under [`WANT`] spacings at spacing `s` (thickness in the
+/// file's units times `scale`), with the spacing that would fit the thinnest and its
+/// pool's particles (`water` m^3).
+fn thin(parts: &[Region], scale: f32, s: f32, water: f32) -> Option<String> {
+    let under: Vec<&Region> = parts
+        .iter()
+        .filter(|r| r.thickness * scale < WANT * s)
+        .collect();
+    let shown: Vec<String> = under
+        .iter()
+        .take(SHOWN)
+        .map(|r| {
+            let fits = r.thickness * scale / WANT;
+            format!(
+                "'{}' {:.1} ({WANT} at {fits:.4} m: {:.1}K particles)",
+                r.name,
+                r.thickness * scale / s,
+                water / fits.powi(3) / 1000.0
+            )
+        })
+        .collect();
+    let more = match under.len().saturating_sub(SHOWN) {
+        0 => String::new(),
+        k => format!(" and {k} more (inspect FILE lists them)"),
+    };
+    (!under.is_empty()).then(|| {
+        format!(
+            "under {WANT} spacings across at {s:.4} m: {}{more}; --fluid spacing=S or [pool] particles=N goes finer",
+            shown.join(", ")
+        )
+    })
+}
+
+/// Parts named by the fit's line on thin parts.
+const SHOWN: usize = 3;
+
+/// The character's first pose `first` must stand in the domain: a clear error naming the
+/// key to change when it does not (a foot may dip a tenth of its height into the floor).
+fn inside(scene: &Scene, first: &[Vec3], height: f32) -> Result<()> {
+    let (lo, hi) = crate::character::check::bounds(first);
+    let (dlo, dhi) = (Vec3::from(scene.domain.min), Vec3::from(scene.domain.max));
+    let name = &scene.name;
+    if lo.y < dlo.y - 0.1 * height {
+        return Err(Error::Param(format!(
+            "scene {name}: the character reaches {:.3} m below the domain's floor (y = {}): raise [character] position's y, or set [character] up if the file is not Y-up (inspect FILE --up z --picture PNG shows it standing)",
+            dlo.y - lo.y,
+            dlo.y
+        )));
+    }
+    let slack = Vec3::new(0.0, 0.1 * height, 0.0);
+    if lo.cmplt(dlo - slack).any() || hi.cmpgt(dhi).any() {
+        return Err(Error::Param(format!(
+            "scene {name}: the character's first pose spans {lo:.3}..{hi:.3}, outside the domain {dlo}..{dhi}: move [character] position, widen [domain], or leave [domain] out to fit it"
+        )));
+    }
+    Ok(())
 }
 
 /// A block on the domain's floor under [lo, hi] (grown by h) deep enough for `want` m^3

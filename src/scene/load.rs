@@ -139,6 +139,9 @@ impl Scene {
                 }
             }
         }
+        if s.character.is_some() {
+            s.look.water();
+        }
         super::around::fit_around(&mut s)?;
         s.validate()?;
         Ok(s)

@@ -87,13 +87,14 @@ pub struct TargetDesc {
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
+/// A scene with a `[character]` looks like water unless it says otherwise (`Look::water`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Look {
     pub material: Option<crate::config::Material>,
     /// [width, height] in pixels.
     pub size: Option<[u32; 2]>,
-    /// Draw the domain as a glass tank (default on).
+    /// Draw the domain as a glass tank (default on; off in a scene with a `[character]`).
     pub tank: Option<bool>,
     /// Metaballs (default) or points (coloured by particle, as groups need).
     pub render: Option<crate::config::RenderKind>,
@@ -102,6 +103,13 @@ pub struct Look {
 }
 
 impl Look {
+    /// A character scene's defaults: water (tinted, under the sky) and no tank, for each
+    /// key its `[look]` leaves out.
+    pub fn water(&mut self) {
+        self.material.get_or_insert(crate::config::Material::Tinted);
+        self.tank.get_or_insert(false);
+    }
+
     /// `sw` with this look's values where the switches leave them unset.
     pub fn apply(&self, sw: &crate::config::Switches) -> crate::config::Switches {
         let mut sw = sw.clone();

@@ -102,6 +102,12 @@ pub fn view(opts: ViewOptions) -> Result<()> {
     let mut event_loop = winit::event_loop::EventLoop::new().map_err(no_display)?;
     let display = event_loop.display_handle().map_err(no_display)?.as_raw();
     let sw = &opts.switches;
+    if sw.frame.grid() > 1 {
+        return Err(Error::Param(
+            "--samples supersamples saved pictures (run); the window draws one sample a pixel"
+                .into(),
+        ));
+    }
     let size = match (sw.frame.width, sw.frame.height) {
         (None, None) => DEFAULT_SIZE,
         _ => (sw.frame.width(), sw.frame.height()),

@@ -355,7 +355,7 @@ void add_counters() {
     ADD64(candidates, n_candidates)
 }
 
-struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; };
+struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; vec2 cone; };
 
 const int STACK = 8;
 
@@ -375,6 +375,10 @@ void main() {
     vec4 b = P.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 o = P.eye.xyz;
     vec3 d = normalize(b.xyz / b.w - a.xyz / a.w);
+    // The pixel's ray cone: no width at the eye, the angle to the next pixel's ray.
+    vec4 a1 = P.inv_view_proj * vec4(ndc + vec2(2.0 / float(P.width), 0.0), 0.0, 1.0);
+    vec4 b1 = P.inv_view_proj * vec4(ndc + vec2(2.0 / float(P.width), 0.0), 1.0, 1.0);
+    vec2 cone = vec2(0.0, length(normalize(b1.xyz / b1.w - a1.xyz / a1.w) - d));
 
 #if LIST == LIST_NONE
     vec2 iv = ray_box(o, d, box_lo(), box_hi());
@@ -392,7 +396,7 @@ void main() {
     vec4 dbg = vec4(-1.0, 0.0, 0.0, 0.0);
     Path stack[STACK];
     int sp = 0;
-    stack[sp++] = Path(o, d, vec3(1.0), 0u, false);
+    stack[sp++] = Path(o, d, vec3(1.0), 0u, false, cone);
     while (sp > 0) {
         Path r = stack[--sp];
         bool primary = r.depth == 0u;
@@ -412,12 +416,13 @@ void main() {
             // opaque layer for a primary ray that reached it. Secondary rays see the sky.
             vec3 behind = primary && t_opaque < 1e30
                 ? pow(unpackUnorm4x8(opaque[id]).rgb, vec3(2.2))
-                : sky_color(r.d);
+                : sky_color(r.d, r.cone);
             color += r.w * behind;
             continue;
         }
         vec3 x = r.o + r.d * t;
         vec3 n = normal_at(x, primary ? id : NIL);
+        vec2 hit_cone = cone_at(r.cone, t);
         if (primary) dbg = vec4(t, n);
 #if MATERIAL == MATERIAL_PHONG
         color += r.w * phong(n, -r.d);
@@ -434,19 +439,19 @@ void main() {
         float eps = 1.5 * P.sun.w / float(1u << min(P.refine, 20u));
 #if MATERIAL == MATERIAL_METAL
         vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
-        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
-        if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd);
+        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside, cone_bent(hit_cone, P.eye.w, 2.0));
+        if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd, refl.cone);
         else stack[sp++] = refl;
 #else
         float n1 = r.inside ? P.absorb.w : 1.0, n2 = r.inside ? 1.0 : P.absorb.w;
         vec3 td = refract(r.d, nn, n1 / n2);
         float F = dot(td, td) == 0.0 ? 1.0 : fresnel_dielectric(cos_i, n1, n2);
-        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside);
-        Path refr = Path(x - nn * eps, normalize(td), w * (1.0 - F), r.depth + 1u, !r.inside);
+        Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside, cone_bent(hit_cone, P.eye.w, 2.0));
+        Path refr = Path(x - nn * eps, normalize(td), w * (1.0 - F), r.depth + 1u, !r.inside, cone_bent(hit_cone, P.eye.w, 1.0));
         bool deep = r.depth + 1u > P.depth;
-        if (deep || sp >= STACK) color += refl.w * sky_color(rd); else stack[sp++] = refl;
+        if (deep || sp >= STACK) color += refl.w * sky_color(rd, refl.cone); else stack[sp++] = refl;
         if (F < 1.0) {
-            if (deep || sp >= STACK) color += refr.w * sky_color(refr.d); else stack[sp++] = refr;
+            if (deep || sp >= STACK) color += refr.w * sky_color(refr.d, refr.cone); else stack[sp++] = refr;
         }
 #endif
 #else

@@ -14,6 +14,8 @@ void main() {
     uvec2 pix = uvec2(id % P.width, id / P.width);
     vec2 ndc = (vec2(pix) + 0.5) / vec2(P.width, P.height) * 2.0 - 1.0;
     vec3 o = P.eye.xyz, d = primary_dir(vec2(pix));
+    // The pixel's ray cone (render/shading.glsl), then at the hit, bent once or twice.
+    vec2 cone = vec2(0.0, length(primary_dir(vec2(pix) + vec2(1.0, 0.0)) - d));
     vec4 g = gbuf[2u * id];
     float t_opaque = opaque_t(id, ndc, o, d);
     float t = g.x > 0.0 ? g.x / depth_rate(d) : -1.0;
@@ -21,8 +23,9 @@ void main() {
     vec3 opaque_rgb = t_opaque < 1e30 ? pow(unpackUnorm4x8(opaque[id]).rgb, vec3(2.2)) : vec3(0.0);
     vec3 color;
     if (t < 0.0) {
-        color = t_opaque < 1e30 ? opaque_rgb : sky_color(d);
+        color = t_opaque < 1e30 ? opaque_rgb : sky_color(d, cone);
     } else {
+        vec2 hit = cone_at(cone, t);
         vec3 n = normalize(g.yzw);
         float cos_i = clamp(-dot(d, n), 0.0, 1.0);
         vec3 rd = reflect(d, n);
@@ -30,15 +33,15 @@ void main() {
         color = phong(n, -d);
 #elif MATERIAL == MATERIAL_METAL
         vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
-        color = F * sky_color(rd);
+        color = F * sky_color(rd, cone_bent(hit, P.eye.w, 2.0));
 #elif MATERIAL == MATERIAL_GLASS || MATERIAL == MATERIAL_TINTED
         float F = fresnel_dielectric(cos_i, 1.0, P.absorb.w);
         vec3 td = refract(d, n, 1.0 / P.absorb.w);
-        vec3 behind = t_opaque < 1e30 ? opaque_rgb : sky_color(normalize(td));
+        vec3 behind = t_opaque < 1e30 ? opaque_rgb : sky_color(normalize(td), cone_bent(hit, P.eye.w, 1.0));
 #if MATERIAL == MATERIAL_TINTED
         behind *= exp(-P.absorb.rgb * gbuf[2u * id + 1u].x);  // Beer-Lambert
 #endif
-        color = F * sky_color(rd) + (1.0 - F) * behind;
+        color = F * sky_color(rd, cone_bent(hit, P.eye.w, 2.0)) + (1.0 - F) * behind;
 #else
 #error "MATERIAL names no material"
 #endif

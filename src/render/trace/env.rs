@@ -2,7 +2,7 @@
 //! specification gives it (README, "Metaball renderer"): a sky graded from a pale horizon
 //! to blue at the zenith with a sun (a sharp disc and a soft halo), and below the horizon
 //! a ground of 0.5 m checks on the plane one metre under the ray's origin, darkening
-//! towards the horizon; or an equirectangular image (`--sky`), read bilinearly (wrapping in
+//! towards the horizon and box-filtered over the ray's cone; or an equirectangular image (`--sky`), read bilinearly (wrapping in
 //! longitude, clamped in latitude, interpolated in its stored sRGB then made linear with
 //! gamma 2.2, as the renderer documents). Linear colour, f64.
 use glam::DVec3;
@@ -25,9 +25,10 @@ pub enum Env {
 }
 
 impl Env {
-    pub fn color(&self, d: DVec3) -> DVec3 {
+    /// The colour seen along `d` by a ray cone `(width, spread)` (`filtered_check`).
+    pub fn color(&self, d: DVec3, cone: (f64, f64)) -> DVec3 {
         match self {
-            Env::Procedural => environment(d),
+            Env::Procedural => environment(d, cone),
             Env::Image(w, h, px) => image(*w as i64, *h as i64, px, d),
         }
     }
@@ -53,12 +54,26 @@ fn image(w: i64, h: i64, px: &[[u8; 3]], d: DVec3) -> DVec3 {
     DVec3::new(c.x.powf(2.2), c.y.powf(2.2), c.z.powf(2.2))
 }
 
-/// The procedural environment's colour in direction `d` (unit).
-pub fn environment(d: DVec3) -> DVec3 {
+/// The checks' parity at (x, y) (one check per unit) box-filtered over a square of side
+/// `w`: the integral of the checker over it, in closed form (Quilez): the floor / 2
+/// parity as w -> 0, 0.5 when w covers many checks.
+pub fn filtered_check(x: f64, y: f64, w: f64) -> f64 {
+    let w = w.max(1e-4);
+    let tri = |v: f64| ((v * 0.5).rem_euclid(1.0) - 0.5).abs();
+    let i = |v: f64| 2.0 * (tri(v - 0.5 * w) - tri(v + 0.5 * w)) / w;
+    0.5 - 0.5 * i(x) * i(y)
+}
+
+/// The procedural environment's colour in direction `d` (unit) for a ray cone `(width,
+/// spread)`: the ground's checks filtered over the cone's footprint on the plane one
+/// metre down (the spread times d(tan)/d(angle) = 1 + tan^2, plus the width over the
+/// ray's slope), as the renderer's `sky_color`.
+pub fn environment(d: DVec3, (width, spread): (f64, f64)) -> DVec3 {
     if d.y < 0.0 {
         let down = (-d.y).max(1e-3);
         let (gx, gz) = (d.x / down, d.z / down);
-        let check = ((gx * 2.0).floor() + (gz * 2.0).floor()).rem_euclid(2.0);
+        let foot = spread * (1.0 + gx * gx + gz * gz) + width / down;
+        let check = filtered_check(gx * 2.0, gz * 2.0, foot * 2.0);
         let dark = DVec3::new(0.25, 0.23, 0.2);
         let light = DVec3::new(0.45, 0.42, 0.38);
         return mix(dark, light, check) * (0.6 + 0.4 * (-d.y * 4.0).min(1.0));

@@ -30,6 +30,10 @@ pub struct Reference {
     /// Recursion depth D.
     pub depth: u32,
     pub env: Env,
+    /// The radius of curvature the ray cones assume at a surface (the renderer's
+    /// metaball radius R): a cone's spread grows by width / this per refraction, twice
+    /// that per reflection.
+    pub cone_radius: f64,
 }
 
 /// The radius at which `k` coincident metaballs of `density`, radius `r`, sum to `t`
@@ -90,16 +94,28 @@ impl Reference {
         best
     }
 
-    /// Radiance along the ray (o, d) carrying weight `w`, at recursion `depth`.
-    fn trace(&self, o: DVec3, d: DVec3, w: DVec3, depth: u32, inside: bool) -> DVec3 {
+    /// Radiance along the ray (o, d) carrying weight `w`, at recursion `depth`, with the
+    /// ray cone (width at o, spread).
+    fn trace(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        w: DVec3,
+        (depth, inside): (u32, bool),
+        cone: (f64, f64),
+    ) -> DVec3 {
         let Some((t, n)) = self.hit(o, d) else {
-            return w * self.env.color(d);
+            return w * self.env.color(d, cone);
         };
         let x = o + t * d;
+        let at = cone.0 + cone.1 * t;
         let deeper = |dir: DVec3, w2: DVec3, into: bool, from: DVec3| -> DVec3 {
+            // Reflected (same side) cones bend twice as much as refracted ones.
+            let turns = if into == inside { 2.0 } else { 1.0 };
+            let c = (at, cone.1 + turns * at / self.cone_radius);
             match depth + 1 > self.depth {
-                true => w2 * self.env.color(dir),
-                false => self.trace(from, dir, w2, depth + 1, into),
+                true => w2 * self.env.color(dir, c),
+                false => self.trace(from, dir, w2, (depth + 1, into), c),
             }
         };
         let nn = if inside { -n } else { n };
@@ -146,6 +162,12 @@ impl Reference {
 
     /// The picture from `cam`, `width` x `height`, RGBA8 as the renderer writes it.
     pub fn render(&self, cam: &Camera, width: u32, height: u32) -> Vec<u8> {
+        self.render_with_cones(cam, width, height, true)
+    }
+
+    /// `render`, with each pixel's ray cone or with none (`cones` false: the ground's
+    /// checks point-sampled, as the renderer drew them before it filtered them).
+    pub fn render_with_cones(&self, cam: &Camera, width: u32, height: u32, cones: bool) -> Vec<u8> {
         let eye = cam.eye.as_dvec3();
         let fwd = (cam.target.as_dvec3() - eye).normalize();
         let right = fwd.cross(cam.up.as_dvec3()).normalize();
@@ -158,8 +180,14 @@ impl Reference {
                 let nx = (x as f64 + 0.5) / width as f64 * 2.0 - 1.0;
                 // Vulkan clip space: the first row is the top of the picture.
                 let ny = (y as f64 + 0.5) / height as f64 * 2.0 - 1.0;
-                let d = (fwd + nx * tx * right - ny * ty * up).normalize();
-                let c = self.trace(eye, d, DVec3::ONE, 0, false);
+                let dir = |nx: f64| (fwd + nx * tx * right - ny * ty * up).normalize();
+                let d = dir(nx);
+                // The pixel's cone: the angle to the next pixel's ray (as the renderer).
+                let spread = match cones {
+                    true => (dir(nx + 2.0 / width as f64) - d).length(),
+                    false => 0.0,
+                };
+                let c = self.trace(eye, d, DVec3::ONE, (0, false), (0.0, spread));
                 for v in [c.x, c.y, c.z] {
                     out.push((v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0).round() as u8);
                 }

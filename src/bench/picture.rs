@@ -1,0 +1,34 @@
+//! `inspect FILE --picture PNG`: the character's rest pose from the front and the side
+//! (character::picture) with the views and the up axis named on it.
+use super::plot::{err, font};
+use crate::character::{anim::Up, picture, Character};
+use crate::error::Result;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Draw `ch` turned by `up` into `path` (PNG).
+pub fn inspect_png(ch: &Character, up: Up, path: &Path) -> Result<()> {
+    font()?;
+    let mut img = picture::draw(ch, up.matrix())?;
+    let (w, h) = img.dimensions();
+    {
+        let root = BitMapBackend::with_buffer(&mut img, (w, h)).into_drawing_area();
+        let style = ("sans-serif", 15).into_font().color(&BLACK);
+        let v = picture::VIEW as i32;
+        let labels = [
+            (8, 6, format!("front (from +Z)   up = \"{}\"", up.name())),
+            (v + 8, 6, "side (from +X, front to the left)".to_string()),
+            (
+                8,
+                v - 22,
+                "red: skeleton   brown: the floor it stands on".to_string(),
+            ),
+        ];
+        for (x, y, t) in labels {
+            root.draw(&Text::new(t, (x, y), style.clone()))
+                .map_err(|e| err(path, e))?;
+        }
+        root.present().map_err(|e| err(path, e))?;
+    }
+    img.save(path).map_err(|e| err(path, e))
+}
