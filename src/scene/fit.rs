@@ -223,7 +223,8 @@ fn thin(parts: &[Region], scale: f32, s: f32, water: f32) -> Option<String> {
 const SHOWN: usize = 3;
 
 /// The character's first pose `first` must stand in the domain: a clear error naming the
-/// key to change when it does not (a foot may dip a tenth of its height into the floor).
+/// key to change when it does not (a foot may dip a tenth of its height into the floor, a
+/// hand as far into a wall).
 fn inside(scene: &Scene, first: &[Vec3], height: f32) -> Result<()> {
     let (lo, hi) = crate::character::check::bounds(first);
     let (dlo, dhi) = (Vec3::from(scene.domain.min), Vec3::from(scene.domain.max));
@@ -235,8 +236,9 @@ fn inside(scene: &Scene, first: &[Vec3], height: f32) -> Result<()> {
             dlo.y
         )));
     }
-    let slack = Vec3::new(0.0, 0.1 * height, 0.0);
-    if lo.cmplt(dlo - slack).any() || hi.cmpgt(dhi).any() {
+    // (A hand or a nose a little past a wall stays in it, as a foot in the floor.)
+    let slack = Vec3::splat(0.1 * height);
+    if lo.cmplt(dlo - slack).any() || hi.cmpgt(dhi + slack).any() {
         return Err(Error::Param(format!(
             "scene {name}: the character's first pose spans {lo:.3}..{hi:.3}, outside the domain {dlo}..{dhi}: move [character] position, widen [domain], or leave [domain] out to fit it"
         )));
