@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Liquid characters nobody tuned for: for each FILE[:HEIGHT[:FRAMES]] given (a closed,
-# skinned .glb/.gltf or a closed .obj; height in metres, default 1.7; frames default 120),
-# write a scene that names only the file, its height, [pool] and [control] (the domain,
+# Liquid characters nobody tuned for: for each FILE[:HEIGHT[:FRAMES[:UP]]] given (a closed,
+# skinned .glb/.gltf or a closed .obj; height in metres, default 1.7; frames default 120;
+# UP the file's up axis, y by default, z for a Z-up OBJ), write a scene that names only
+# the file, its height (and up axis), [pool] and [control] (the domain,
 # camera, spacing and pool are fitted: README "Your own character"), run it with the
 # points view and print one markdown row of its fidelity metrics (mean and minimum over
-# the second half of the run). Scenes and outputs go to out/characters/<name>/.
-# Usage: scripts/characters.sh [--device N|NAME] FILE[:HEIGHT[:FRAMES]] ...
+# the second half of the run). Scenes and outputs go to out/characters/<name>/. With
+# --look, each runs with its scene's own look (water: metaballs, tinted) at 240 x 240,
+# saving every 30th frame, instead of the points view.
+# Usage: scripts/characters.sh [--device N|NAME] [--look] FILE[:HEIGHT[:FRAMES[:UP]]] ...
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${FLUIDFORM_BIN:-}
@@ -15,19 +18,22 @@ if [ -z "$bin" ]; then
 fi
 dev=()
 files=()
+view=(--render points --save-every 0)
 while [ $# -gt 0 ]; do
   case "$1" in
     --device) dev=(--device "$2"); shift 2 ;;
+    --look) view=(--width 240 --height 240 --save-every 30); shift ;;
     *) files+=("$1"); shift ;;
   esac
 done
-[ ${#files[@]} -gt 0 ] || { echo "usage: scripts/characters.sh [--device D] FILE[:HEIGHT[:FRAMES]] ..." >&2; exit 2; }
+[ ${#files[@]} -gt 0 ] || { echo "usage: scripts/characters.sh [--device D] [--look] FILE[:HEIGHT[:FRAMES[:UP]]] ..." >&2; exit 2; }
 echo "| character | height m | frames | particles | spacing m | fill | (min) | iou | (min) | spray | surface p95 | density in shape | speed excess m/s | time to 90% s | control share | wall s |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for spec in "${files[@]}"; do
-  IFS=':' read -r file height frames <<< "$spec"
+  IFS=':' read -r file height frames up <<< "$spec"
   height=${height:-1.7}
   frames=${frames:-120}
+  up=${up:-y}
   name=$(basename "$file" | sed 's/\.[^.]*$//')
   out=out/characters/$name
   mkdir -p "$out"
@@ -37,11 +43,12 @@ frames = $frames
 [character]
 file = "$(realpath "$file")"
 height = $height
+up = "$up"
 [pool]
 [control]
 EOF
   start=$(date +%s)
-  if ! "$bin" run --scene "$out/scene.toml" --render points --save-every 0 --out "$out" "${dev[@]}" > "$out/log" 2>&1; then
+  if ! "$bin" run --scene "$out/scene.toml" "${view[@]}" --out "$out" "${dev[@]}" > "$out/log" 2>&1; then
     echo "| $name | $height | $frames | FAILED: $(tail -1 "$out/log" | tr '|' '/') |"
     continue
   fi

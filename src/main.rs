@@ -489,15 +489,8 @@ fn real_main() -> Result<()> {
             up,
             picture,
         } => {
-            let (ch, u) = (fluidform::character::load(&file)?, up.unwrap_or_default());
-            let report = fluidform::character::inspect::inspect(&ch, u, up.is_some())?;
-            if let Some(p) = &picture {
-                fluidform::bench::picture::inspect_png(&ch, u, p)?;
-            }
-            match json {
-                true => println!("{}", serde_json::to_string_pretty(&report)?),
-                false => print!("{}", report.text()),
-            }
+            use fluidform::bench::picture::inspect;
+            print!("{}", inspect(&file, up, picture.as_deref(), json)?);
             Ok(())
         }
         Command::Experiment {

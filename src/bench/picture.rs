@@ -6,6 +6,25 @@ use crate::error::Result;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// `fluidform inspect FILE [--up AXIS] [--picture PNG] [--json]`: the report to print
+/// (text or JSON), the picture drawn when asked.
+pub fn inspect(file: &str, up: Option<Up>, picture: Option<&Path>, json: bool) -> Result<String> {
+    let ch = crate::character::load(file)?;
+    let u = up.unwrap_or_default();
+    let report = crate::character::inspect::inspect(&ch, u, up.is_some())?;
+    if let Some(p) = picture {
+        inspect_png(&ch, u, p)?;
+    }
+    Ok(match json {
+        true => {
+            serde_json::to_string_pretty(&report)
+                .map_err(|e| crate::error::Error::Param(e.to_string()))?
+                + "\n"
+        }
+        false => report.text(),
+    })
+}
+
 /// Draw `ch` turned by `up` into `path` (PNG).
 pub fn inspect_png(ch: &Character, up: Up, path: &Path) -> Result<()> {
     font()?;
@@ -20,7 +39,7 @@ pub fn inspect_png(ch: &Character, up: Up, path: &Path) -> Result<()> {
             (v + 8, 6, "side (from +X, front to the left)".to_string()),
             (
                 8,
-                v - 22,
+                24,
                 "red: skeleton   brown: the floor it stands on".to_string(),
             ),
         ];

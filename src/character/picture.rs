@@ -8,7 +8,7 @@ use image::{Rgb, RgbImage};
 
 /// Each view's side in pixels.
 pub const VIEW: u32 = 360;
-const MARGIN: f32 = 24.0;
+const MARGIN: f32 = 44.0;
 const BACKGROUND: Rgb<u8> = Rgb([250, 250, 250]);
 const FLOOR: Rgb<u8> = Rgb([120, 100, 80]);
 const BONE: Rgb<u8> = Rgb([220, 40, 40]);

@@ -139,7 +139,7 @@ impl Scene {
                 }
             }
         }
-        if s.character.is_some() {
+        if s.character.is_some() && s.has_fluid() {
             s.look.water();
         }
         super::around::fit_around(&mut s)?;

@@ -87,7 +87,8 @@ pub struct TargetDesc {
 }
 
 /// A scene's defaults for its picture; `--material`, `--width` and `--height` override them.
-/// A scene with a `[character]` looks like water unless it says otherwise (`Look::water`).
+/// A scene with a `[character]` and fluid looks like water unless it says otherwise
+/// (`Look::water`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Look {
@@ -103,8 +104,8 @@ pub struct Look {
 }
 
 impl Look {
-    /// A character scene's defaults: water (tinted, under the sky) and no tank, for each
-    /// key its `[look]` leaves out.
+    /// The defaults of a scene with a character and fluid: water (tinted, under the
+    /// sky) and no tank, for each key its `[look]` leaves out.
     pub fn water(&mut self) {
         self.material.get_or_insert(crate::config::Material::Tinted);
         self.tank.get_or_insert(false);
