@@ -235,8 +235,8 @@ fn box_filter(rgba: &[u8], (w, h): (u32, u32), k: u32) -> Vec<u8> {
                 }
             }
             let n = (k * k) as f32;
-            for c in 0..3 {
-                out.push(((sum[c] / n).powf(1.0 / 2.2) * 255.0).round() as u8);
+            for c in &sum[..3] {
+                out.push(((c / n).powf(1.0 / 2.2) * 255.0).round() as u8);
             }
             out.push((sum[3] / n).round() as u8);
         }
