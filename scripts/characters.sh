@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Liquid characters nobody tuned for: for each FILE[:HEIGHT[:FRAMES[:UP]]] given (a closed,
-# skinned .glb/.gltf or a closed .obj; height in metres, default 1.7; frames default 120;
+# skinned .glb/.gltf or a closed .obj; height in metres, default 1.7; frames default 180,
+# so that the metrics' window, the second half, comes after the fill (about 0.5 s);
 # UP the file's up axis, y by default, z for a Z-up OBJ), write a scene that names only
 # the file, its height (and up axis), [pool] and [control] (the domain,
 # camera, spacing and pool are fitted: README "Your own character"), run it with the
@@ -32,7 +33,7 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for spec in "${files[@]}"; do
   IFS=':' read -r file height frames up <<< "$spec"
   height=${height:-1.7}
-  frames=${frames:-120}
+  frames=${frames:-180}
   up=${up:-y}
   name=$(basename "$file" | sed 's/\.[^.]*$//')
   out=out/characters/$name
