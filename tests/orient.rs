@@ -83,6 +83,14 @@ fn quadruped(path: &Path) {
     std::fs::write(path, obj).unwrap();
 }
 
+/// A temporary folder holding the quadruped as quad.obj, and that file.
+fn with_quadruped() -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("quad.obj");
+    quadruped(&obj);
+    (dir, obj)
+}
+
 /// The five-line scene a user writes, with `extra` lines under `[character]`.
 fn five_lines(dir: &Path, file: &str, extra: &str) -> std::path::PathBuf {
     let path = dir.join(format!("scene-{}.toml", extra.len()));
@@ -105,9 +113,7 @@ fn placed(s: &Scene) -> (Vec3, Vec3) {
 
 #[test]
 fn a_z_up_quadruped_stands_by_up_or_by_rotation_with_its_legs_at_three_spacings() {
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     let file = obj.display().to_string();
     let mut fitted = Vec::new();
     for extra in ["up = \"z\"", "rotation = [-90.0, 0.0, 0.0]"] {
@@ -162,9 +168,7 @@ fn a_z_up_quadruped_stands_by_up_or_by_rotation_with_its_legs_at_three_spacings(
 
 #[test]
 fn the_z_up_quadruped_plays_from_five_lines() {
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     let scene = five_lines(dir.path(), &obj.display().to_string(), "up = \"z\"");
     let out = dir.path().join("out");
     let o = fluidform(&[
@@ -238,9 +242,7 @@ fn a_z_up_giraffe_and_a_rotated_gltf_fit_and_name_their_thin_parts() {
 
 #[test]
 fn a_character_outside_its_domain_names_the_key_to_change() {
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     let body = format!(
         "name = \"low\"\n[domain]\nmin = [-1.0, 0.0, -1.0]\nmax = [1.0, 2.0, 1.0]\n[character]\nfile = \"{}\"\nheight = 1.4\nup = \"z\"\nposition = [0.0, -0.6, 0.0]\n[pool]\n[control]\n",
         obj.display()
@@ -269,9 +271,7 @@ fn a_character_outside_its_domain_names_the_key_to_change() {
 
 #[test]
 fn character_scenes_look_like_water_unless_they_say_otherwise() {
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     use fluidform::config::Material;
     let s = load(&five_lines(
         dir.path(),
@@ -297,9 +297,7 @@ fn character_scenes_look_like_water_unless_they_say_otherwise() {
 
 #[test]
 fn inspect_names_the_up_axis_and_draws_the_rest_pose_standing() {
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     let file = obj.display().to_string();
     let mut heights = Vec::new();
     for up in [None, Some("z")] {
@@ -343,9 +341,7 @@ fn inspect_names_the_up_axis_and_draws_the_rest_pose_standing() {
 fn samples_average_a_larger_picture_in_linear_light() {
     // One frame of the Z-up quadruped at 24 px with 4 samples a pixel is the 48 px frame
     // averaged over 2 x 2 blocks (the run is deterministic: tests/repeat.rs).
-    let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("quad.obj");
-    quadruped(&obj);
+    let (dir, obj) = with_quadruped();
     let scene = five_lines(dir.path(), &obj.display().to_string(), "up = \"z\"");
     let shot = |size: &str, samples: &str| {
         let out = dir.path().join(format!("{size}-{samples}"));

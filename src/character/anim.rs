@@ -185,13 +185,17 @@ pub fn orientation(up: Up, rotation_deg: Vec3) -> Mat3 {
     Mat3::from_quat(r) * up.matrix()
 }
 
-/// The placement that stands the rest pose `rest` (file coordinates), oriented by
-/// `orient`, with the bottom centre of its oriented bounds at `position`, scaled by
-/// `scale` about that point: one pivot, so the fitted domain, the pool and the control
-/// particles all see the character where it stands.
-pub fn stand(rest: &[Vec3], orient: Mat3, scale: f32, position: Vec3) -> Mat4 {
+/// The bounds of `rest` (file coordinates) turned by `orient`.
+pub fn turned_bounds(rest: &[Vec3], orient: Mat3) -> (Vec3, Vec3) {
     let turned: Vec<Vec3> = rest.iter().map(|p| orient * *p).collect();
-    let (lo, hi) = super::check::bounds(&turned);
+    super::check::bounds(&turned)
+}
+
+/// The placement that stands a rest pose turned by `orient`, whose turned bounds are
+/// `(lo, hi)`, with the bottom centre of those bounds at `position`, scaled by `scale`
+/// about that point: one pivot, so the fitted domain, the pool and the control particles
+/// all see the character where it stands.
+pub fn stand((lo, hi): (Vec3, Vec3), orient: Mat3, scale: f32, position: Vec3) -> Mat4 {
     let bottom = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
     Mat4::from_translation(position)
         * Mat4::from_scale(Vec3::splat(scale))

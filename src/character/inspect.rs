@@ -80,9 +80,7 @@ pub fn thinnest(ch: &Character, orient: Mat3) -> Result<Option<Thinnest>> {
 
 /// The report on `ch` with its up axis `up` (turned to +Y: bounds and regions after it).
 pub fn inspect(ch: &Character, up: Up, up_given: bool) -> Result<Inspection> {
-    let rest = ch.rest_positions()?;
-    let turned: Vec<glam::Vec3> = rest.iter().map(|p| up.matrix() * *p).collect();
-    let (lo, hi) = super::check::bounds(&turned);
+    let (lo, hi) = super::anim::turned_bounds(&ch.rest_positions()?, up.matrix());
     let regions = regions(ch, up.matrix())?;
     let obj = ch.source.to_ascii_lowercase().ends_with(".obj");
     let up_note = match (up_given, obj) {

@@ -193,8 +193,7 @@ impl CharacterDesc {
         };
         let rest = ch.rest_positions()?;
         let orient = self.orientation();
-        let turned: Vec<Vec3> = rest.iter().map(|p| orient * *p).collect();
-        let (lo, hi) = character::check::bounds(&turned);
+        let (lo, hi) = anim::turned_bounds(&rest, orient);
         let s = match (self.height, self.scale) {
             (Some(h), _) => h / (hi.y - lo.y).max(1e-9),
             (_, Some(s)) => s,
@@ -204,7 +203,7 @@ impl CharacterDesc {
             true => self.position.into(),
             false => Vec3::ZERO, // the path places it each frame
         };
-        let placement = anim::stand(&rest, orient, s, at);
+        let placement = anim::stand((lo, hi), orient, s, at);
         let animator = Animator {
             clip,
             looping: self.looping,

@@ -95,7 +95,7 @@ pub struct Look {
     pub material: Option<crate::config::Material>,
     /// [width, height] in pixels.
     pub size: Option<[u32; 2]>,
-    /// Draw the domain as a glass tank (default on; off in a scene with a `[character]`).
+    /// Draw the domain as a glass tank (default on; off in a scene with a `[character]` and fluid).
     pub tank: Option<bool>,
     /// Metaballs (default) or points (coloured by particle, as groups need).
     pub render: Option<crate::config::RenderKind>,

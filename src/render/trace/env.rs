@@ -2,9 +2,10 @@
 //! specification gives it (README, "Metaball renderer"): a sky graded from a pale horizon
 //! to blue at the zenith with a sun (a sharp disc and a soft halo), and below the horizon
 //! a ground of 0.5 m checks on the plane one metre under the ray's origin, darkening
-//! towards the horizon and box-filtered over the ray's cone; or an equirectangular image (`--sky`), read bilinearly (wrapping in
-//! longitude, clamped in latitude, interpolated in its stored sRGB then made linear with
-//! gamma 2.2, as the renderer documents). Linear colour, f64.
+//! towards the horizon and box-filtered over the ray's cone; or an equirectangular image
+//! (`--sky`), read bilinearly (wrapping in longitude, clamped in latitude, interpolated in
+//! its stored sRGB then made linear with gamma 2.2, as the renderer documents). Linear
+//! colour, f64.
 use glam::DVec3;
 
 /// The sun's direction.
