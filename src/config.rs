@@ -6,8 +6,16 @@ use crate::error::{Error, Result};
 use clap::Args;
 use serde::Serialize;
 
-use crate::kinds::switch_enum;
 pub use crate::kinds::*;
+use clap::builder::TypedValueParser;
+use fluidform_gpu::switch_enum;
+
+/// The parser of a `Kind` switch: its values listed in --help and in the error for an
+/// unknown one.
+pub fn choice<K: Kind + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = K> {
+    clap::builder::PossibleValuesParser::new(K::ALL.iter().map(|k| k.as_str()))
+        .map(|s| s.parse::<K>().expect("a listed value parses"))
+}
 
 /// The device, validation, seed and size: every command takes these.
 #[derive(Args, Clone, Debug, Serialize, serde::Deserialize)]
@@ -76,7 +84,7 @@ impl FrameArgs {
 /// The sort of the neighbour search and the sort benchmark.
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct SortArgs {
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<SortAlgo>())]
     pub sort: Option<SortAlgo>,
 }
 
@@ -85,17 +93,17 @@ pub struct SortArgs {
 pub struct ParticleArgs {
     /// Particle-system integrator: euler and verlet keep state on the GPU; closed
     /// evaluates p0 + v0 t + g t^2 / 2 in the vertex shader (gravity only, no update pass)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Integrator>())]
     pub integrator: Option<Integrator>,
     /// How particle systems are drawn (default: each system's own)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<SpriteMode>())]
     pub draw: Option<SpriteMode>,
 }
 
 /// Neighbour search strategy.
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct NeighborArgs {
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Neighbors>())]
     pub neighbors: Option<Neighbors>,
 }
 
@@ -107,12 +115,12 @@ pub struct FluidArgs {
     #[arg(long = "fluid", value_name = "KEY=VALUE")]
     pub fluid: Vec<String>,
     /// SPH pressure solver (default: the scene's [fluid] solver, else wcsph)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Solver>())]
     pub solver: Option<Solver>,
     /// SPH smoothing kernel, one for densities and pressure gradients: muller (the
     /// thesis's poly6 with spiky; wcsph's and pbf's default), cubic (pcisph's and dfsph's
     /// default, support 2 spacings) or wendland (3 spacings); --fluid support= changes it
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Kernel>())]
     pub kernel: Option<Kernel>,
 }
 
@@ -129,16 +137,16 @@ impl FluidArgs {
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ViewArgs {
     /// How `run` draws particles: ray-marched metaballs (default for SPH scenes) or spheres
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<RenderKind>())]
     pub render: Option<RenderKind>,
 }
 
 /// The metaball renderer (seed 000, section 4).
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct MetaballArgs {
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<ListKind>())]
     pub list: Option<ListKind>,
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<DensityFn>())]
     pub density: Option<DensityFn>,
     /// Metaball iso threshold T
     #[arg(long)]
@@ -152,32 +160,32 @@ pub struct MetaballArgs {
     /// Recursion depth D of transparent materials
     #[arg(long)]
     pub depth: Option<u32>,
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Material>())]
     pub material: Option<Material>,
     /// Equirectangular sky image (PNG, JPEG, ...) instead of the procedural sky
     #[arg(long, value_name = "FILE")]
     pub sky: Option<String>,
     /// Secondary-ray samples off screen: use every metaball (all) or end the path (end)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Offscreen>())]
     pub offscreen: Option<Offscreen>,
     /// S-buffer ranges sorted by depth, so each sample reads only the metaballs within R of
     /// its depth (default: on for glass and tinted; off: the thesis's unsorted S-buffer)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<OnOff>())]
     pub list_sort: Option<OnOff>,
     /// The fluid's surface: ray-marched metaballs (default), screen-space fluid, or a
     /// marching-cubes mesh over the SPH density, all shaded with --material
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<SurfaceKind>())]
     pub surface: Option<SurfaceKind>,
     /// Marching-cubes cell of --surface mesh, in rest particle spacings (default 0.5)
     #[arg(long, value_name = "F")]
     pub mesh_cell: Option<f32>,
     /// The primary rays' march: every sample of the fixed step (the thesis's, default), or
     /// lipschitz: samples the field's Lipschitz bound proves outside are skipped (same hits)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<MarchKind>())]
     pub march: Option<MarchKind>,
     /// How the S-buffer's per-pixel lists are built: rasterising the billboards (the
     /// thesis's, default) or compute from the per-tile lists (already in depth order)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<BuildKind>())]
     pub build: Option<BuildKind>,
     /// Tile size in pixels of --list tiles and --build compute: 8, 16 (default) or 32
     #[arg(long, value_name = "PX")]
@@ -205,11 +213,11 @@ switch_enum!(MeshFormat { Obj, Ply });
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ExportArgs {
     /// Write the particles as binary PLY or legacy VTK files, with particles.csv
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<ExportFormat>())]
     pub export: Option<ExportFormat>,
     /// Write the fluid's surface per exported frame as a mesh: marching cubes over the SPH
     /// density (half the particle spacing, iso 0.5 rho_0), OBJ or binary PLY with normals
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<MeshFormat>())]
     pub export_mesh: Option<MeshFormat>,
     /// Export every K-th frame (default 1)
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
@@ -220,11 +228,11 @@ pub struct ExportArgs {
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct CharacterArgs {
     /// Skinning: linear blend (lbs, default) or dual quaternions (dqs, Kavan et al. 2008)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Skinning>())]
     pub skinning: Option<Skinning>,
     /// Draw the character's mesh: shaded, as a wireframe, or not at all (default shaded
     /// with no fluid, off with fluid)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<ShowMesh>())]
     pub show_mesh: Option<ShowMesh>,
 }
 
@@ -234,7 +242,7 @@ pub struct ControlArgs {
     /// Control-particle placement: one per welded vertex, Poisson-disk points inside
     /// (closed meshes), or rays: parallel rays through the skinned mesh, re-placed every
     /// frame on the GPU
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Placement>())]
     pub placement: Option<Placement>,
     /// Control-particle spacing in metres (default: the fluid's rest spacing)
     #[arg(long)]
@@ -247,7 +255,7 @@ pub struct ControlArgs {
     pub control_radius: Option<f32>,
     /// Adaptive control pressure: off, on (x2 below 80%, x0.5 above 120% of rho_0), or
     /// smooth (ours: fades from x2 to 0 between 80% and 120%)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Adaptive>())]
     pub adaptive: Option<Adaptive>,
     /// Adaptive thresholds as fractions of rho_0 (default 0.8,1.2)
     #[arg(long, value_delimiter = ',', value_name = "LOW,HIGH")]
@@ -261,7 +269,7 @@ pub struct ControlArgs {
     /// Defaults of the control techniques not set otherwise: thesis (eq. 7 alone, as seed
     /// 000) or fidelity (ours: adds the deficit attraction, velocity matching and damping;
     /// the default)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<ControlPreset>())]
     pub control_preset: Option<ControlPreset>,
     /// Deficit attraction in m/s^2 (after Thuerey et al. 2006): fluid is pulled towards the
     /// control particles within --control-reach still short of rest density (0: off)
@@ -278,12 +286,12 @@ pub struct ControlArgs {
     /// Velocity of the control particles for the velocity term and the damping: frames
     /// (the last two frames' poses, a frame behind) or skin (the skin's motion over the
     /// frame ahead)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<ControlMotion>())]
     pub control_motion: Option<ControlMotion>,
     /// What the deficit attraction measures a control particle's deficit against: rest
     /// density (default), or shape (the density fluid filling the shape exactly has there:
     /// about 0.8 at a flat surface; needs --placement random)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Deficit>())]
     pub control_deficit: Option<Deficit>,
     /// Steps between refreshes of the control's sums (control densities, eq. 7's walk; the
     /// deficit field follows each pose); the steps between apply each particle's stored
@@ -299,7 +307,7 @@ pub struct ControlArgs {
     /// Bone weights of control particles: eq8 (the thesis), eq9 (the thesis's eq. 9 is
     /// lost: normalised inverse squared distance stands in), or skin (the nearest vertex's
     /// skin weights)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<BoneWeights>())]
     pub bone_weights: Option<BoneWeights>,
 }
 
@@ -308,7 +316,7 @@ pub struct ControlArgs {
 pub struct EmissionArgs {
     /// Where particles are born: uv (random covered texels of the skinned mesh rendered
     /// into its UV atlas, seed 002) or vertices (random vertices: the baseline)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<EmitterKind>())]
     pub emitter: Option<EmitterKind>,
     /// Births per second at most (default: every due slot is born, as Algorithm 1)
     #[arg(long)]

@@ -4,9 +4,9 @@
 //! recorded into the frame's own commands, so each file holds exactly that frame's state.
 use crate::config::ExportFormat;
 use crate::error::{Error, Result};
+use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, Guard, MemoryLocation};
 use crate::sph::SphState;
-use ash::vk;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -222,7 +222,7 @@ impl ParticleExport {
         f: crate::config::MeshFormat,
     ) -> Result<PathBuf> {
         use crate::config::MeshFormat;
-        use crate::surface::{density_grid, files, march, ISO};
+        use crate::isosurface::{density_grid, files, march, ISO};
         let (h, rest, spacing) = self.fluid;
         let pos: Vec<[f32; 3]> = snap.pos.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let mesh = march(&density_grid(&pos, h, self.mass, rest, 0.5 * spacing), ISO);

@@ -1,29 +1,21 @@
-//! fluidform: a Rust + Vulkan research testbed for liquid characters.
-//! See README.md for the command line and outputs.
+//! fluidform: a Rust + Vulkan research testbed for liquid characters. This crate is the
+//! application: the command line (`config`), scenes, `run` and the window, benchmarks,
+//! experiments and their reports. The layers below are crates of their own: the GPU layer
+//! (`fluidform-gpu`, src/gpu) and the simulation and rendering (`fluidform-sim`, src/sim),
+//! re-exported here under their module names. See README.md and docs/.
 pub mod animation;
 pub mod bench;
-pub mod character;
 pub mod config;
-pub mod control;
-pub mod emission;
-pub mod error;
 pub mod experiment;
 pub mod export;
-pub mod gpu;
-pub mod kinds;
-pub mod particles;
-pub mod primitives;
 pub mod progress;
-pub mod psys;
-pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
-pub mod session;
+pub mod settings;
 pub mod shaders;
-pub mod sph;
-pub mod surface;
-pub mod viewer;
 pub mod window;
 
-pub use error::{Error, Result};
+pub use fluidform_gpu as gpu;
+pub use fluidform_gpu::{error, gpu_interface, impl_destroy, kinds, primitives, Error, Result};
+pub use fluidform_sim::{character, control, emission, isosurface, psys, render, sph};

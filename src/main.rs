@@ -1,10 +1,7 @@
 //! The command line: devices | run | bench | plot | inspect | experiment.
 use anyhow::{bail, Result};
 use clap::{Parser, Subcommand};
-use fluidform::config::{
-    CameraArgs, CharacterArgs, CommonArgs, FluidArgs, FrameArgs, MetaballArgs, NeighborArgs,
-    SortArgs, Switches,
-};
+use fluidform::config::Switches;
 use fluidform::run::{run, RunOptions, DEFAULT_SCENE};
 use std::path::PathBuf;
 
@@ -12,7 +9,8 @@ use std::path::PathBuf;
 #[command(
     name = "fluidform",
     version,
-    about = "Rust + Vulkan testbed for liquid characters"
+    about = "Rust + Vulkan testbed for liquid characters",
+    after_help = overview()
 )]
 struct Cli {
     #[command(subcommand)]
@@ -56,7 +54,7 @@ enum Command {
     /// Benchmark an algorithm. Without --particles it sweeps N = 8K..1M (scan adds 16M).
     Bench {
         #[command(subcommand)]
-        what: BenchWhat,
+        what: fluidform::bench::args::BenchWhat,
         #[arg(long, global = true, default_value = "out/bench")]
         out: PathBuf,
         /// Timed repetitions per configuration
@@ -108,10 +106,11 @@ enum Command {
         #[arg(long)]
         picture: Option<PathBuf>,
     },
-    /// Reproduce a table or figure of the papers: table2..table8, fig9, adaptive,
-    /// scaling, fidelity, surfaces, or all (list: their names); writes <out>/<name>.csv,
-    /// .md, .png and findings.md
+    /// Reproduce a table or figure of the papers, or run one of our studies; writes
+    /// <out>/<name>.csv, .md, .png and findings.md. `all` runs every one in order, `list`
+    /// prints their names
     Experiment {
+        #[arg(value_parser = experiment_names())]
         name: String,
         /// Output directory (default results/<device-slug>)
         #[arg(long)]
@@ -138,267 +137,6 @@ enum SceneWhat {
     /// Print a built-in scene's TOML (`fluidform scene show demo > my.toml`, edit, then
     /// `fluidform run --scene my.toml`)
     Show { name: String },
-}
-
-/// The benchmarks, each with only the switches it uses.
-#[derive(Subcommand)]
-enum BenchWhat {
-    /// Exclusive scan of u32, beside a copy of the same bytes
-    Scan {
-        #[command(flatten)]
-        common: CommonArgs,
-    },
-    /// Key/value sorts: odd-even merge, bitonic, counting (or --sort)
-    Sort {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-    },
-    /// Fixed-radius neighbour search per strategy (or --neighbors, --sort)
-    Neighbors {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-        #[command(flatten)]
-        search: NeighborArgs,
-    },
-    /// One SPH step of the dam break scaled to N, per neighbour strategy
-    Sph(SphBench),
-    /// The 32K dam break for 10 simulated seconds (or --seconds) with the solver's own
-    /// stable step (or --solver), with physics checkpoints
-    Stability {
-        #[command(flatten)]
-        sph: SphBench,
-        /// Simulated seconds
-        #[arg(long, default_value_t = fluidform::bench::sph::STABILITY_SECONDS)]
-        seconds: f64,
-    },
-    /// The dam break per pressure solver (or --solver) at 16K, 64K, 256K (or --particles):
-    /// each at its own stable step and at mean density error <= 1% and <= 0.1%; times
-    /// --frames frames of 20 ms after --warmup frames
-    Solvers(SphBench),
-    /// GPU skinning per method (or --skinning) on a character and on a generated mesh
-    Skin {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        character: CharacterArgs,
-        /// Character file (.glb, .gltf, .obj) or builtin:walker (the default)
-        #[arg(long = "character", value_name = "FILE")]
-        file: Option<String>,
-        /// Vertices of the generated mesh (copies of the walker; default 1048576)
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
-        vertices: Option<u32>,
-    },
-    /// How fast a control target fills per --adaptive mode (all three when unset): the
-    /// built-in giraffe (or --scene) for --frames frames (the cap); time to 90% coverage
-    Control {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        control: fluidform::config::ControlArgs,
-        #[command(flatten)]
-        character: CharacterArgs,
-        #[command(flatten)]
-        fluid_args: FluidArgs,
-        /// Scene with a [control] target (built-in name or TOML file; default giraffe)
-        #[arg(long)]
-        scene: Option<String>,
-        /// Velocity-term gains K to sweep beside the adaptive modes (default: 0, or
-        /// --control-velocity)
-        #[arg(long, value_delimiter = ',', value_name = "K,...")]
-        velocities: Vec<f32>,
-    },
-    /// Seed 002's figure 9: frames per second of an emitting scene at 8K..64K particles
-    /// (or --particles), counting grid and hash + bitonic (or --neighbors, --sort)
-    Emission {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-        #[command(flatten)]
-        search: NeighborArgs,
-        #[command(flatten)]
-        fluid_args: FluidArgs,
-        #[command(flatten)]
-        emission: fluidform::config::EmissionArgs,
-    },
-    /// Particle systems (seed 003): update, sort and draw ms at 64K, 256K and 1M sprites
-    /// (or --particles), per integrator and sort (or --integrator, --sort)
-    Particles {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        frame: FrameArgs,
-        #[command(flatten)]
-        sorting: SortArgs,
-        #[command(flatten)]
-        particle: fluidform::config::ParticleArgs,
-    },
-    /// The metaball renderer on a resting blob, per list (or --list)
-    Render {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        frame: FrameArgs,
-        #[command(flatten)]
-        metaball: MetaballArgs,
-        #[command(flatten)]
-        camera: CameraArgs,
-    },
-}
-
-/// The switches of the SPH benchmarks.
-#[derive(clap::Args)]
-struct SphBench {
-    #[command(flatten)]
-    common: CommonArgs,
-    #[command(flatten)]
-    sorting: SortArgs,
-    #[command(flatten)]
-    search: NeighborArgs,
-    #[command(flatten)]
-    fluid_args: FluidArgs,
-}
-
-impl SphBench {
-    fn switches(self) -> Switches {
-        Switches {
-            common: self.common,
-            sorting: self.sorting,
-            search: self.search,
-            fluid_args: self.fluid_args,
-            ..Switches::default()
-        }
-    }
-}
-
-impl BenchWhat {
-    /// The benchmark's name and its switches (groups it does not take at their defaults).
-    /// Long because it is a table: one arm per benchmark naming the groups it takes.
-    fn into_parts(
-        self,
-    ) -> (
-        &'static str,
-        Switches,
-        Option<String>,
-        Option<u32>,
-        Vec<f32>,
-    ) {
-        let d = Switches::default;
-        let (what, sw) = match self {
-            BenchWhat::Skin {
-                common,
-                character,
-                file,
-                vertices,
-            } => {
-                return (
-                    "skin",
-                    Switches {
-                        common,
-                        character,
-                        ..d()
-                    },
-                    file,
-                    vertices,
-                    Vec::new(),
-                )
-            }
-            BenchWhat::Control {
-                common,
-                control,
-                character,
-                fluid_args,
-                scene,
-                velocities,
-            } => {
-                let sw = Switches {
-                    common,
-                    control,
-                    character,
-                    fluid_args,
-                    ..d()
-                };
-                return ("control", sw, scene, None, velocities);
-            }
-            BenchWhat::Scan { common } => ("scan", Switches { common, ..d() }),
-            BenchWhat::Sort { common, sorting } => (
-                "sort",
-                Switches {
-                    common,
-                    sorting,
-                    ..d()
-                },
-            ),
-            BenchWhat::Neighbors {
-                common,
-                sorting,
-                search,
-            } => (
-                "neighbors",
-                Switches {
-                    common,
-                    sorting,
-                    search,
-                    ..d()
-                },
-            ),
-            BenchWhat::Sph(a) => ("sph", a.switches()),
-            BenchWhat::Emission {
-                common,
-                sorting,
-                search,
-                fluid_args,
-                emission,
-            } => (
-                "emission",
-                Switches {
-                    common,
-                    sorting,
-                    search,
-                    fluid_args,
-                    emission,
-                    ..d()
-                },
-            ),
-            BenchWhat::Stability { sph, .. } => ("stability", sph.switches()),
-            BenchWhat::Solvers(a) => ("solvers", a.switches()),
-            BenchWhat::Particles {
-                common,
-                frame,
-                sorting,
-                particle,
-            } => (
-                "particles",
-                Switches {
-                    common,
-                    frame,
-                    sorting,
-                    particle,
-                    ..d()
-                },
-            ),
-            BenchWhat::Render {
-                common,
-                frame,
-                metaball,
-                camera,
-            } => (
-                "render",
-                Switches {
-                    common,
-                    frame,
-                    metaball,
-                    camera,
-                    ..d()
-                },
-            ),
-        };
-        (what, sw, None, None, Vec::new())
-    }
 }
 
 /// Errors print as one line: the error and any cause its message does not already hold.
@@ -461,7 +199,12 @@ fn real_main() -> Result<()> {
             frames,
             warmup,
             budget_s,
-        } => bench_command(what, out, (frames, warmup, budget_s)),
+        } => {
+            let (out, rows) = fluidform::bench::args::run(what, out, (frames, warmup, budget_s))?;
+            print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
+            eprintln!("{rows} configurations; wrote {}", out.display());
+            Ok(())
+        }
         Command::Plot {
             csv,
             out,
@@ -499,17 +242,22 @@ fn real_main() -> Result<()> {
             quick,
             common,
         } => {
-            if name == "list" {
-                println!("{}", fluidform::experiment::NAMES.join("\n"));
-                return Ok(());
-            }
+            use fluidform::experiment::Experiment;
+            let experiments = match name.as_str() {
+                "list" => {
+                    Experiment::all().iter().for_each(|e| println!("{e}"));
+                    return Ok(());
+                }
+                "all" => Experiment::all().to_vec(),
+                one => vec![one.parse::<Experiment>().map_err(anyhow::Error::msg)?],
+            };
             if common.particles.is_some() {
                 bail!("experiment: --particles is not used (each experiment sets its own counts)");
             }
             let mut switches = Switches::parse_default();
             switches.common = common;
             let files = fluidform::experiment::run(&fluidform::experiment::ExperimentOptions {
-                name,
+                experiments,
                 out,
                 quick,
                 switches,
@@ -553,33 +301,28 @@ fn run_command(opts: RunOptions) -> Result<()> {
     Ok(())
 }
 
-/// `bench`: run one benchmark and print its table.
-fn bench_command(
-    what: BenchWhat,
-    out: PathBuf,
-    (frames, warmup, budget_s): (u64, u64, f64),
-) -> Result<()> {
-    let seconds = match &what {
-        BenchWhat::Stability { seconds, .. } => *seconds,
-        _ => fluidform::bench::sph::STABILITY_SECONDS,
-    };
-    let (what, switches, character, vertices, velocities) = what.into_parts();
-    let rows = fluidform::bench::run(&fluidform::bench::BenchOptions {
-        what: what.to_string(),
-        out: out.clone(),
-        frames,
-        warmup,
-        budget_s,
-        switches,
-        character,
-        vertices,
-        velocities,
-        counts: Vec::new(),
-        seconds,
-    })?;
-    print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
-    eprintln!("{} configurations; wrote {}", rows.len(), out.display());
-    Ok(())
+/// The top-level help's closing lines: what `bench` and `experiment` take.
+fn overview() -> String {
+    let names = |v: Vec<String>| v.join(", ");
+    format!(
+        "Without a command, fluidform runs the built-in liquid character (`run`).\n\
+         Benchmarks (fluidform bench NAME --help): {}\n\
+         Experiments (fluidform experiment NAME): {}, all, list\n\
+         Built-in scenes: fluidform scene list. Documentation: README.md and docs/.",
+        names(fluidform::bench::Bench::all().iter().map(|b| b.as_str()).collect()),
+        names(fluidform::experiment::Experiment::all().iter().map(|e| e.as_str()).collect()),
+    )
+}
+
+/// `experiment`'s names: every experiment, `all` and `list`, each shown in --help.
+fn experiment_names() -> clap::builder::PossibleValuesParser {
+    let mut names: Vec<clap::builder::PossibleValue> = fluidform::experiment::Experiment::all()
+        .iter()
+        .map(|e| clap::builder::PossibleValue::new(e.as_str()))
+        .collect();
+    names.push(clap::builder::PossibleValue::new("all").help("every experiment, in this order"));
+    names.push(clap::builder::PossibleValue::new("list").help("print the names"));
+    clap::builder::PossibleValuesParser::new(names)
 }
 
 trait ParseDefault {

@@ -1,8 +1,8 @@
 //! Progress of a run: a bar with frames done, rate and ETA on a terminal (indicatif), a
 //! plain line about every 10 s otherwise (CI logs), nothing with `--quiet`.
 use crate::error::Result;
+use crate::gpu::vk;
 use crate::gpu::{Context, FrameWork, Profiler};
-use ash::vk;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};

@@ -232,20 +232,18 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
     }
 }
 
-/// JSON has no NaN or infinity: a non-finite value is written as null and read back as NaN,
-/// so a summary of a broken run still round-trips through its typed form.
-pub mod non_finite_as_null {
-    use serde::{Deserialize, Deserializer, Serializer};
+pub use fluidform_sim::non_finite_as_null;
 
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        if v.is_finite() {
-            s.serialize_f64(*v)
-        } else {
-            s.serialize_none()
-        }
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
-    }
+/// The median ms of timestamp scope `key` in a summary.json's `pass_ms`; a scope the run
+/// did not record is an error naming those it did.
+pub fn pass_median(summary: &serde_json::Value, key: crate::gpu::ScopeKey) -> Result<f64> {
+    let passes = &summary["pass_ms"];
+    passes[key.path()]["median"].as_f64().ok_or_else(|| {
+        let recorded = passes
+            .as_object()
+            .into_iter()
+            .flatten()
+            .map(|(k, _)| k.as_str());
+        key.missing(recorded)
+    })
 }

@@ -4,7 +4,6 @@
 use crate::config::{DensityFn, ListKind, Material, Neighbors, SortAlgo};
 use crate::gpu::Interface;
 use crate::render::metaball::MetaballSettings;
-use clap::ValueEnum;
 
 /// (file under glsl/, defines).
 pub type Variant = (&'static str, Vec<(String, String)>);
@@ -30,7 +29,7 @@ pub fn variants() -> Vec<Variant> {
         with::<counting::GatherIo>("primitives/gather.comp", &[]),
         with::<sort::SortIo>("primitives/oddeven.comp", &[]),
         with::<sort::SortIo>("primitives/bitonic.comp", &[]),
-        with::<crate::particles::LiveArgsIo>("common/live_args.comp", &[]),
+        with::<crate::sph::store::LiveArgsIo>("common/live_args.comp", &[]),
         with::<crate::bench::floor::FmaIo>("bench/fma.comp", &[]),
         with::<crate::sph::hooks::ConstantForceIo>("sph/constant_force.comp", &[]),
         with::<crate::sph::health::HealthIo>("sph/health.comp", &[]),
@@ -146,7 +145,7 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
             }
             use crate::config::Solver;
             use crate::sph::pressure::{pass_defines, passes, PressureIo};
-            for solver in Solver::value_variants() {
+            for solver in Solver::all() {
                 for p in passes(*solver) {
                     let mut d = sph.clone();
                     d.extend(pass_defines(&p));
@@ -154,7 +153,7 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
                 }
             }
             use crate::control::force::{ControlIo, ControlSettings};
-            for a in crate::config::Adaptive::value_variants() {
+            for a in crate::config::Adaptive::all() {
                 let mut c = sph.clone();
                 c.extend(
                     ControlSettings::defines(*a)
@@ -194,14 +193,14 @@ fn metaballs(v: &mut Vec<Variant>) {
             Material::Tinted,
             Material::Gold,
         ] {
-            for density in DensityFn::value_variants() {
+            for density in DensityFn::all() {
                 // Only the S-buffer has an unsorted and a sorted form.
                 for sorted in [false, true] {
                     if sorted && list != ListKind::Sbuffer {
                         continue;
                     }
                     let d = MetaballSettings::defines_for(list, *density, material, sorted);
-                    for march in crate::kinds::MarchKind::value_variants() {
+                    for march in crate::kinds::MarchKind::all() {
                         let mut d = d.clone();
                         d.extend(MetaballSettings::march_defines(*march));
                         v.push(with::<MetaballIo>("render/metaball/march.comp", &d));

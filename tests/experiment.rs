@@ -5,8 +5,8 @@ use common::{ctx, finish, fluidform, text};
 use fluidform::config::{ListKind, Switches};
 use fluidform::control::inside::InsideTest;
 use fluidform::experiment::thesis::Body;
-use fluidform::experiment::{findings, tables, NAMES};
-use fluidform::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use fluidform::experiment::{findings, tables, Experiment};
+use fluidform::render::metaball::{blob, blob_camera, FluidRenderer};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -34,7 +34,7 @@ fn num(row: &HashMap<String, String>, k: &str) -> f64 {
 
 /// A thesis table's CSV (one row per row and list, the thesis's numbers beside ours)
 /// and markdown.
-fn thesis_table_files(dir: &std::path::Path, name: &str) {
+fn thesis_table_files(dir: &std::path::Path, name: Experiment) {
     let fragments_per_metaball = 490.0 * (128.0 * 128.0) / (512.0 * 512.0);
     let def = tables::def(name).unwrap();
     let (head, rows) = read_csv(&dir.join(format!("{name}.csv")));
@@ -77,7 +77,7 @@ fn thesis_table_files(dir: &std::path::Path, name: &str) {
     }
     // The camera is framed to the thesis's fragments per metaball (within 3%) for
     // every table at the base particle count and radius.
-    if name == "table2" {
+    if name == Experiment::Table2 {
         for r in rows.iter().filter(|r| r["list"] == "sbuffer") {
             let f = num(r, "fragments") / num(r, "particles");
             assert!(
@@ -162,7 +162,7 @@ fn quick_experiments_write_every_file_and_column() {
         dir.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", text(&out));
-    for name in NAMES {
+    for name in Experiment::all() {
         for ext in ["csv", "md", "png", "findings.json"] {
             let p = dir.join(format!("{name}.{ext}"));
             assert!(
@@ -176,7 +176,10 @@ fn quick_experiments_write_every_file_and_column() {
             md.contains("Device: ") && md.contains("built from commit ") && md.contains("--quick")
         );
     }
-    for name in tables::NAMES {
+    for &name in Experiment::all()
+        .iter()
+        .filter(|e| tables::def(**e).is_some())
+    {
         thesis_table_files(&dir, name);
     }
     for name in ["table2", "table3", "table4"] {
@@ -285,7 +288,7 @@ fn a_retuned_renderer_draws_what_a_new_one_draws() {
     let cam = blob_camera(n, spacing, 1.0);
     let mut centers = ctx.storage_buffer("centers", (n * 16) as u64).unwrap();
     ctx.upload(&mut centers, 0, &pts).unwrap();
-    let mut base = MetaballSettings::from_switches(&Switches::default()).unwrap();
+    let mut base = fluidform::settings::metaball_settings(&Switches::default()).unwrap();
     base.width = w;
     base.height = w;
     base.list = ListKind::Sbuffer;
@@ -294,7 +297,7 @@ fn a_retuned_renderer_draws_what_a_new_one_draws() {
     tuned.radius = 0.05;
     tuned.step = 0.05 / 8.0;
     tuned.refine = 4;
-    let draw = |r: &MetaballRenderer| {
+    let draw = |r: &FluidRenderer| {
         let mut b = r.buffers(&ctx, n as u64, 1, false).unwrap();
         r.render_sync(&ctx, &mut b, &centers, n as u32, &cam, 0)
             .unwrap();
@@ -302,11 +305,11 @@ fn a_retuned_renderer_draws_what_a_new_one_draws() {
         b.destroy(&ctx);
         px
     };
-    let mut reused = MetaballRenderer::new(&ctx, base.clone()).unwrap();
+    let mut reused = FluidRenderer::new(&ctx, base.clone()).unwrap();
     let before = draw(&reused);
     reused.retune(tuned.clone()).unwrap();
     let after = draw(&reused);
-    let mut fresh = MetaballRenderer::new(&ctx, tuned).unwrap();
+    let mut fresh = FluidRenderer::new(&ctx, tuned).unwrap();
     // The lists fill in atomic order, so sums may round differently: nearly every pixel
     // agrees to within 2 levels, while the old settings' image differs widely.
     assert!(

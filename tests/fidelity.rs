@@ -1,9 +1,9 @@
-//! The fidelity metrics (src/control/fidelity.rs) against independent counts on known
+//! The fidelity metrics (src/sim/control/fidelity.rs) against independent counts on known
 //! particle sets: a sphere of particles filling a sphere target, the same set shifted,
 //! spray, density in the shape, speed excess and the surface distance.
 use fluidform::character::procedural::polygonise;
 use fluidform::control::fidelity::{measure, Fluid, Frame};
-use fluidform::control::surface::{tri_distance, SurfaceDistance};
+use fluidform::control::mesh_distance::{tri_distance, SurfaceDistance};
 use glam::Vec3;
 
 const S: f32 = 0.02;

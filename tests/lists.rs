@@ -6,7 +6,7 @@
 mod common;
 use fluidform::config::{BuildKind, ListKind, MarchKind, Material, Switches};
 use fluidform::gpu::Context;
-use fluidform::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
 use std::collections::BTreeSet;
 
 const N: usize = 160;
@@ -23,7 +23,7 @@ fn switches(args: &[&str]) -> Switches {
 }
 
 fn settings(w: u32, h: u32, list: ListKind, build: BuildKind, sorted: bool) -> MetaballSettings {
-    let mut s = MetaballSettings::from_switches(&switches(&[])).unwrap();
+    let mut s = fluidform::settings::metaball_settings(&switches(&[])).unwrap();
     (s.width, s.height, s.list, s.build, s.sorted) = (w, h, list, build, sorted);
     s
 }
@@ -42,7 +42,7 @@ fn render(ctx: &Context, s: MetaballSettings, first: Option<u64>) -> Frame {
     let cam = blob_camera(N, SPACING, s.width as f32 / s.height as f32);
     let mut centers = ctx.storage_buffer("centers", (N * 16) as u64).unwrap();
     ctx.upload(&mut centers, 0, &pts).unwrap();
-    let mut r = MetaballRenderer::new(ctx, s.clone()).unwrap();
+    let mut r = FluidRenderer::new(ctx, s.clone()).unwrap();
     let mut b = match first {
         Some(c) => r.buffers_with_capacity(ctx, N as u64, 1, false, c),
         None => r.buffers(ctx, N as u64, 1, false),
@@ -231,14 +231,14 @@ fn switches_that_do_not_apply_are_refused() {
         ),
     ];
     for (args, want) in refused {
-        let e = MetaballSettings::from_switches(&switches(&args))
+        let e = fluidform::settings::metaball_settings(&switches(&args))
             .unwrap_err()
             .to_string();
         assert!(e.contains(want), "{args:?}: {e}");
         assert_eq!(e.lines().count(), 1, "{args:?}: not one line: {e}");
     }
-    let s =
-        MetaballSettings::from_switches(&switches(&["--list", "tiles", "--tile", "32"])).unwrap();
+    let s = fluidform::settings::metaball_settings(&switches(&["--list", "tiles", "--tile", "32"]))
+        .unwrap();
     assert_eq!(
         (s.build, s.tile, s.list_name().as_str()),
         (BuildKind::Compute, 32, "tiles-32")

@@ -4,9 +4,7 @@
 mod common;
 use fluidform::config::{ListKind, MarchKind, Material, Switches};
 use fluidform::render::metaball::reference::{march_counted, ray_box, MarchParams};
-use fluidform::render::metaball::{
-    blob, blob_camera, FrameStats, MetaballRenderer, MetaballSettings,
-};
+use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, FrameStats, MetaballSettings};
 use glam::Vec3;
 
 const W: u32 = 96;
@@ -16,7 +14,7 @@ const SPACING: f32 = 0.0271;
 
 /// The blob's Phong settings with `list`.
 fn settings(list: ListKind) -> MetaballSettings {
-    let mut s = MetaballSettings::from_switches(&Switches::default()).unwrap();
+    let mut s = fluidform::settings::metaball_settings(&Switches::default()).unwrap();
     s.list = list;
     s.material = Material::Phong;
     s.width = W;
@@ -33,7 +31,7 @@ fn render(
     let cam = blob_camera(N, SPACING, W as f32 / H as f32);
     let mut centers = ctx.storage_buffer("centers", (N * 16) as u64).unwrap();
     ctx.upload(&mut centers, 0, &pts).unwrap();
-    let mut r = MetaballRenderer::new(ctx, s.clone()).unwrap();
+    let mut r = FluidRenderer::new(ctx, s.clone()).unwrap();
     let mut b = r.buffers(ctx, N as u64, 1, true).unwrap();
     let (st, _) = r
         .render_sync(ctx, &mut b, &centers, N as u32, &cam, 0)

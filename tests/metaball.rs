@@ -1,5 +1,6 @@
 //! Metaball density functions and the CPU reference ray marcher.
 use fluidform::config::DensityFn;
+use fluidform::render::metaball::density::Density;
 use fluidform::render::metaball::reference::{field, march, MarchParams};
 use glam::Vec3;
 

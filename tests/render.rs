@@ -4,7 +4,7 @@ mod common;
 use fluidform::config::{DensityFn, ListKind, Material, Switches};
 use fluidform::gpu::Context;
 use fluidform::render::metaball::reference::{march, MarchParams};
-use fluidform::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
 use fluidform::render::Camera;
 use glam::Vec3;
 
@@ -14,7 +14,7 @@ const N: usize = 160;
 const SPACING: f32 = 0.0271;
 
 fn settings(list: ListKind, density: DensityFn, material: Material) -> MetaballSettings {
-    let mut s = MetaballSettings::from_switches(&switches()).unwrap();
+    let mut s = fluidform::settings::metaball_settings(&switches()).unwrap();
     s.list = list;
     s.density = density;
     s.material = material;
@@ -61,7 +61,7 @@ fn render(ctx: &Context, s: MetaballSettings, sc: &Scene, debug: bool) -> Render
         .unwrap();
     ctx.upload(&mut centers, 0, &sc.pts).unwrap();
     let list = s.list;
-    let mut r = MetaballRenderer::new(ctx, s).unwrap();
+    let mut r = FluidRenderer::new(ctx, s).unwrap();
     let mut b = r.buffers(ctx, sc.pts.len() as u64, 1, debug).unwrap();
     let (st, _) = r
         .render_sync(ctx, &mut b, &centers, sc.pts.len() as u32, &sc.cam, 0)
@@ -274,8 +274,8 @@ fn lists_grow_on_overflow_and_the_image_is_unchanged() {
         false,
     );
     for list in [ListKind::Abuffer, ListKind::Sbuffer] {
-        let mut r = MetaballRenderer::new(&ctx, settings(list, DensityFn::Wyvill, Material::Phong))
-            .unwrap();
+        let mut r =
+            FluidRenderer::new(&ctx, settings(list, DensityFn::Wyvill, Material::Phong)).unwrap();
         let mut b = r
             .buffers_with_capacity(&ctx, N as u64, 1, false, 10)
             .unwrap();
@@ -361,7 +361,7 @@ fn rays_past_llvmpipes_loop_budget_are_reported() {
         (s.width, s.height) = (24, 18);
         s.step = step;
         s.max_steps = 1 << 20;
-        let mut r = MetaballRenderer::new(&ctx, s).unwrap();
+        let mut r = FluidRenderer::new(&ctx, s).unwrap();
         let mut b = r.buffers(&ctx, N as u64, 1, false).unwrap();
         let (st, _) = r
             .render_sync(&ctx, &mut b, &centers, N as u32, &sc.cam, 0)
@@ -416,38 +416,38 @@ fn bad_renderer_settings_are_clear_errors() {
     let ctx = common::ctx();
     let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong);
     s.radius = 0.0;
-    assert!(MetaballRenderer::new(&ctx, s)
+    assert!(FluidRenderer::new(&ctx, s)
         .err()
         .unwrap()
         .to_string()
         .contains("--radius"));
     let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Glass);
     s.depth = 99;
-    assert!(MetaballRenderer::new(&ctx, s)
+    assert!(FluidRenderer::new(&ctx, s)
         .err()
         .unwrap()
         .to_string()
         .contains("--depth"));
     let mut s = settings(ListKind::Sbuffer, DensityFn::Wyvill, Material::Phong);
     s.sky = Some("no/such/sky.png".into());
-    let r = MetaballRenderer::new(&ctx, s).unwrap();
+    let r = FluidRenderer::new(&ctx, s).unwrap();
     let e = r.buffers(&ctx, 10, 1, false).err().unwrap().to_string();
     assert!(e.contains("no/such/sky.png"), "{e}");
     let mut r = r;
     r.destroy(&ctx);
     // Only the S-buffer's contiguous ranges can be sorted.
     let sw = parse_switches(&["--list", "abuffer", "--list-sort", "on"]);
-    let e = MetaballSettings::from_switches(&sw)
+    let e = fluidform::settings::metaball_settings(&sw)
         .err()
         .unwrap()
         .to_string();
     assert!(e.contains("--list-sort"), "{e}");
     // Glass sorts by default, Phong does not.
     let glass = parse_switches(&["--material", "glass"]);
-    assert!(MetaballSettings::from_switches(&glass)
+    assert!(fluidform::settings::metaball_settings(&glass)
         .unwrap()
         .sorts_lists());
-    assert!(!MetaballSettings::from_switches(&switches())
+    assert!(!fluidform::settings::metaball_settings(&switches())
         .unwrap()
         .sorts_lists());
     common::finish(&ctx);

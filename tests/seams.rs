@@ -3,9 +3,9 @@
 mod common;
 use bytemuck::{Pod, Zeroable};
 use fluidform::gpu::{ComputeDesc, ComputePipeline, Labels};
-use fluidform::particles::{AttributeDecl, LiveArgsPass, LiveCount, ParticleStore};
 use fluidform::scene::Scene;
 use fluidform::sph::hooks::{ConstantForce, Hooks, SphHook};
+use fluidform::sph::store::{AttributeDecl, LiveArgsPass, LiveCount, ParticleStore};
 use fluidform::sph::SphSolver;
 
 #[repr(C)]
@@ -256,7 +256,7 @@ fn registered_attribute_survives_reorder() {
 /// Construction that fails halfway leaves no GPU object behind.
 #[test]
 fn failed_construction_leaks_nothing() {
-    use fluidform::render::metaball::{MetaballRenderer, MetaballSettings};
+    use fluidform::render::metaball::FluidRenderer;
     let ctx = common::ctx();
     let sw = {
         use clap::Parser;
@@ -267,7 +267,8 @@ fn failed_construction_leaks_nothing() {
         }
         Only::parse_from(["t", "--list", "sbuffer", "--material", "glass"]).s
     };
-    let mut r = MetaballRenderer::new(&ctx, MetaballSettings::from_switches(&sw).unwrap()).unwrap();
+    let mut r =
+        FluidRenderer::new(&ctx, fluidform::settings::metaball_settings(&sw).unwrap()).unwrap();
     let before = ctx.live_objects();
     // Params, offsets and lists are made before the metaball-sized depths fail.
     let e = r.buffers(&ctx, 1 << 40, 2, false);
@@ -315,10 +316,10 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         let d: Vec<(&str, String)> = d.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
         c.compile(file, &d).unwrap()
     };
-    use fluidform::particles::LiveCount;
     use fluidform::render::metaball::settings::RenderParams;
     use fluidform::render::metaball::GpuStats;
     use fluidform::sph::params::{GpuCollider, SphGpuParams};
+    use fluidform::sph::store::LiveCount;
     // Every Rust field is listed (the list covers the whole struct: tested by count).
     type Fields = (usize, Vec<(&'static str, usize)>, &'static str);
     let cases: Vec<(&str, &str, Fields)> = vec![

@@ -6,7 +6,7 @@
 mod common;
 use fluidform::config::{DensityFn, ListKind, Material};
 use fluidform::gpu::Context;
-use fluidform::render::metaball::{MetaballRenderer, MetaballSettings};
+use fluidform::render::metaball::{FluidRenderer, MetaballSettings};
 use fluidform::render::trace::{iso_radius, Env, Look, Reference, Sphere};
 use fluidform::render::Camera;
 use glam::{DVec3, Vec3};
@@ -17,7 +17,8 @@ const R: f32 = 0.5;
 
 fn settings(material: Material) -> MetaballSettings {
     let mut s =
-        MetaballSettings::from_switches(&fluidform::window::flags::parse(&[]).unwrap()).unwrap();
+        fluidform::settings::metaball_settings(&fluidform::window::flags::parse(&[]).unwrap())
+            .unwrap();
     (s.list, s.density, s.material) = (ListKind::Sbuffer, DensityFn::Wyvill, material);
     (s.width, s.height, s.radius, s.depth) = (SIZE, SIZE, R, 3);
     // A fine march and many refinements: the hit is exact to ~0.1 mm, so what differs is
@@ -39,7 +40,7 @@ fn gpu_from(ctx: &Context, s: MetaballSettings, centers: &[[f32; 4]], cam: &Came
         .storage_buffer("centers", (centers.len() * 16) as u64)
         .unwrap();
     ctx.upload(&mut buf, 0, centers).unwrap();
-    let mut r = MetaballRenderer::new(ctx, s).unwrap();
+    let mut r = FluidRenderer::new(ctx, s).unwrap();
     let mut b = r.buffers(ctx, centers.len() as u64, 1, false).unwrap();
     let (st, _) = r
         .render_sync(ctx, &mut b, &buf, centers.len() as u32, cam, 0)

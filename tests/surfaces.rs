@@ -4,7 +4,7 @@
 mod common;
 use fluidform::config::{ListKind, SurfaceKind};
 use fluidform::gpu::Context;
-use fluidform::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
 use fluidform::render::surface::SurfaceFluid;
 use fluidform::render::Camera;
 use glam::Vec3;
@@ -21,7 +21,7 @@ const H_SPH: f32 = 0.0457;
 
 fn settings(surface: SurfaceKind) -> MetaballSettings {
     let sw = fluidform::window::flags::parse(&[]).unwrap();
-    let mut s = MetaballSettings::from_switches(&sw).unwrap();
+    let mut s = fluidform::settings::metaball_settings(&sw).unwrap();
     s.surface = surface;
     if surface != SurfaceKind::Metaballs {
         s.list = ListKind::None;
@@ -40,7 +40,7 @@ fn settings(surface: SurfaceKind) -> MetaballSettings {
 
 /// A rendered frame: the renderer and buffers stay alive for readbacks.
 struct Frame {
-    r: MetaballRenderer,
+    r: FluidRenderer,
     b: fluidform::render::metaball::MetaballBuffers,
     centers: fluidform::gpu::Buffer,
 }
@@ -51,7 +51,7 @@ impl Frame {
             .storage_buffer("centers", pts.len() as u64 * 16)
             .unwrap();
         ctx.upload(&mut centers, 0, pts).unwrap();
-        let r = MetaballRenderer::new(ctx, s).unwrap();
+        let r = FluidRenderer::new(ctx, s).unwrap();
         let mut b = r.buffers(ctx, pts.len() as u64, 1, true).unwrap();
         let (st, _) = r
             .render_sync(ctx, &mut b, &centers, pts.len() as u32, cam, 0)
@@ -103,7 +103,7 @@ fn gpu_marching_cubes_match_the_cpu_on_the_same_grid() {
     let p3: Vec<[f32; 3]> = pts.iter().map(|p| [p[0], p[1], p[2]]).collect();
     let mass = SPACING.powi(3) * 1000.0;
     let dims = g.dims.map(|d| d as usize);
-    let cpu = fluidform::surface::density_on(&p3, (H_SPH, mass, 1000.0), g.origin, g.cell, dims);
+    let cpu = fluidform::isosurface::density_on(&p3, (H_SPH, mass, 1000.0), g.origin, g.cell, dims);
     // The density: fixed point on the GPU, f32 sums on the CPU.
     let gpu = sb.density(&ctx).unwrap();
     let worst = gpu
@@ -114,11 +114,11 @@ fn gpu_marching_cubes_match_the_cpu_on_the_same_grid() {
     assert!(worst < 1e-4, "density differs by {worst}");
     // The same grid on the CPU: the same triangles (up to nodes within rounding of the
     // level), the same enclosed volume.
-    let grid = fluidform::surface::Grid {
+    let grid = fluidform::isosurface::Grid {
         values: gpu.clone(),
         ..cpu
     };
-    let mesh = fluidform::surface::march(&grid, fluidform::render::surface::ISO);
+    let mesh = fluidform::isosurface::march(&grid, fluidform::render::surface::ISO);
     assert_eq!(mesh.open_edges(), 0);
     let soup = sb.soup(&ctx).unwrap();
     assert_eq!(soup.len() % 3, 0);
@@ -249,7 +249,7 @@ fn an_overflowing_soup_grows_and_the_frame_is_redone() {
         .storage_buffer("centers", pts.len() as u64 * 16)
         .unwrap();
     ctx.upload(&mut centers, 0, &pts).unwrap();
-    let r = MetaballRenderer::new(&ctx, settings(SurfaceKind::Mesh)).unwrap();
+    let r = FluidRenderer::new(&ctx, settings(SurfaceKind::Mesh)).unwrap();
     let mut b = r.buffers(&ctx, pts.len() as u64, 1, false).unwrap();
     // Room for 10 triangles: the frame overflows, the soup grows to fit and it is redone.
     b.surface.as_mut().unwrap().capacity = 30;

@@ -1,5 +1,5 @@
 #version 450
-// Skinning (src/character/skin.rs): every vertex's position and normal from its joint
+// Skinning (src/sim/character/skin.rs): every vertex's position and normal from its joint
 // influences. SKIN_METHOD 0: linear blend of the joint matrices, normals by the blend's
 // cofactor matrix. 1: dual quaternions (Kavan et al. 2008) with the antipodality fix
 // against the heaviest influence; the polar stretch S blended linearly first (§4).

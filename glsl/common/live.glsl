@@ -1,4 +1,4 @@
-// The GPU-side live particle count. Mirrors LiveCount in src/particles.rs.
+// The GPU-side live particle count. Mirrors LiveCount in src/sim/sph/store.rs.
 #ifndef COMMON_LIVE_GLSL
 #define COMMON_LIVE_GLSL
 struct LiveCount {

@@ -1,6 +1,6 @@
 // Control particles (seed 000, 3.1): the SPH bindings (as CTL_B_* numbers) and the control
 // set, sorted by its own grid (cells of h_c / 2; sums and field on cells of h_c). Bindings: ControlIo in
-// src/control/force.rs; ControlParams mirrors ControlGpuParams there (offsets tested).
+// src/sim/control/force.rs; ControlParams mirrors ControlGpuParams there (offsets tested).
 #ifndef CONTROL_COMMON_GLSL
 #define CONTROL_COMMON_GLSL
 #define SPH_B_PARAMS CTL_B_PARAMS

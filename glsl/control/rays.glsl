@@ -3,7 +3,7 @@
 // lists (S-buffer: count, scan, fill), each list sorted by z, and control particles put
 // at the lattice steps z = lo.z + (k + 1/2) s where the running sum of signs (entries +1,
 // exits -1) is non-zero, so overlapping closed parts give their union. Bindings: RaysIo
-// in src/control/rays.rs; RaysPush mirrors RaysGpuPush there.
+// in src/sim/control/rays.rs; RaysPush mirrors RaysGpuPush there.
 #ifndef CONTROL_RAYS_GLSL
 #define CONTROL_RAYS_GLSL
 layout(push_constant) uniform Push {

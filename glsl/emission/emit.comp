@@ -7,7 +7,7 @@
 // surface point and this frame's, with velocity k (post - prev) / (t_post - t_prev) about
 // tau (eq. 7: k = transfer / frame time, so transfer 1 gives the surface's own velocity)
 // and an age drawn in (0, limit / 2); a due slot without budget dies (pos.w = -1, which
-// the neighbour keys sort last). Bindings: EmitIo in src/emission/emit.rs; EmitParams
+// the neighbour keys sort last). Bindings: EmitIo in src/sim/emission/emit.rs; EmitParams
 // mirrors EmitGpuParams there.
 #include "common/index.glsl"
 struct EmitParams {

@@ -1,6 +1,6 @@
 // RenderToUV (seed 002): the skinned mesh rasterised into its UV atlas, each covered
 // texel holding the world position of the surface point it maps to and its layout
-// triangle. Bindings: UvIo in src/emission/uv.rs; Push mirrors UvPush there.
+// triangle. Bindings: UvIo in src/sim/emission/uv.rs; Push mirrors UvPush there.
 #ifndef EMISSION_UV_GLSL
 #define EMISSION_UV_GLSL
 layout(push_constant) uniform Push {

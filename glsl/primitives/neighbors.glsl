@@ -10,7 +10,7 @@
 #define PRIMITIVES_NEIGHBORS_GLSL
 #extension GL_EXT_control_flow_attributes : require
 // NB_GRID, NB_HASH, NB_MORTON, NB_STRATEGY and NB_CELL_COUNTS come from
-// NeighborSearch::defines_for in src/primitives/neighbors.rs.
+// NeighborSearch::defines_for in src/gpu/primitives/neighbors.rs.
 #include "morton.glsl"
 
 ivec3 nb_cell_of(vec3 p) { return ivec3(floor((p - NB_ORIGIN) / NB_CELL)); }

@@ -2,7 +2,7 @@
 // while a run of elements is fully in range) and as uint[] (the array's tail).
 #ifndef PRIMITIVES_SCAN_IO_GLSL
 #define PRIMITIVES_SCAN_IO_GLSL
-// Defaults; src/primitives/scan.rs defines both (IPT elements per invocation of the top
+// Defaults; src/gpu/primitives/scan.rs defines both (IPT elements per invocation of the top
 // level, CHUNK per invocation of a level pass; multiples of 4).
 #ifndef IPT
 #define IPT 16u

@@ -1,9 +1,9 @@
 // GPU particle systems (seed 003): the system's parameters, the counters and helpers.
-// Mirrors src/psys/gpu.rs (SystemParams, Counters); one source of truth for the layout.
+// Mirrors src/sim/psys/gpu.rs (SystemParams, Counters); one source of truth for the layout.
 #ifndef PSYS_COMMON_GLSL
 #define PSYS_COMMON_GLSL
 // Limits, force, collider and emitter kinds, integrators, event flags and kinds, NO_SLOT:
-// generated from src/psys/codes.rs.
+// generated from src/sim/psys/codes.rs.
 #include "generated/psys_codes.glsl"
 
 struct Force {

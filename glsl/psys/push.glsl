@@ -1,5 +1,5 @@
 // The per-frame push constants of every particle-system compute pass (StepPush in
-// src/psys/gpu.rs).
+// src/sim/psys/gpu.rs).
 #ifndef PSYS_PUSH_GLSL
 #define PSYS_PUSH_GLSL
 layout(push_constant) uniform Push {

@@ -1,5 +1,5 @@
 #version 450
-// A skinned mesh (src/render/mesh.rs): vertices pulled from the skinning pass's output by
+// A skinned mesh (src/sim/render/mesh.rs): vertices pulled from the skinning pass's output by
 // the index buffer, three per triangle, with the corner's barycentric for the wireframe.
 // Drawn in more than one pass against the same depth: the same inputs give bit-equal positions.
 invariant gl_Position;

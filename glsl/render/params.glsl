@@ -1,6 +1,6 @@
 // The renderer's parameters and counters, shared by the metaball passes
 // (render/metaball/common.glsl) and the other surfaces (render/surface/common.glsl).
-// RenderParams and RenderStats mirror src/render/metaball/settings.rs and stats.rs (field
+// RenderParams and RenderStats mirror src/sim/render/metaball/settings.rs and stats.rs (field
 // offsets tested).
 #ifndef RENDER_PARAMS_GLSL
 #define RENDER_PARAMS_GLSL

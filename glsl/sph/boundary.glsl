@@ -1,4 +1,4 @@
-// The solid boundary in the densities and pressures of every solver (src/sph/boundary.rs
+// The solid boundary in the densities and pressures of every solver (src/sim/sph/boundary.rs
 // has the same in f64): the domain's walls and the colliders, each a solid half-space at
 // rest density, the continuum limit of boundary particles (Akinci et al. 2012) as a volume
 // map (Koschier & Bender 2017) in closed form. Planes and the box are exact; spheres and

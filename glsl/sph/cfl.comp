@@ -1,5 +1,5 @@
 #version 450
-// The step's dt from its own velocities (src/sph/cfl.rs), at the step's start: MODE 0,
+// The step's dt from its own velocities (src/sim/sph/cfl.rs), at the step's start: MODE 0,
 // each workgroup's largest |v|^2 over ITEMS particles each, one atomicMax of its bits per
 // workgroup (non-negative floats order like their bits: order-free); MODE 1, one
 // invocation: dt = min(dt_max, cfl h / max(v_max, cfl_speed)) into the parameters (the

@@ -1,6 +1,6 @@
 // SPH after Müller et al. 2003 / Kelager 2006: parameters, kernels and bindings shared by
-// the passes. Bindings: SphIo in src/sph/solver.rs (SPH_B_* defines); SphParams and
-// Collider mirror SphGpuParams and GpuCollider in src/sph/params.rs (field offsets tested).
+// the passes. Bindings: SphIo in src/sim/sph/solver.rs (SPH_B_* defines); SphParams and
+// Collider mirror SphGpuParams and GpuCollider in src/sim/sph/params.rs (field offsets tested).
 // Particle arrays are in sorted order.
 #ifndef SPH_COMMON_GLSL
 #define SPH_COMMON_GLSL

@@ -1,5 +1,5 @@
 #version 450
-// A uniform extra acceleration added after the forces pass (src/sph/hooks.rs).
+// A uniform extra acceleration added after the forces pass (src/sim/sph/hooks.rs).
 #include "common/index.glsl"
 layout(std430, binding = CF_B_ACC) buffer Acc { vec4 acc[]; };
 layout(push_constant) uniform Push { vec4 accel; uint n; } pc;

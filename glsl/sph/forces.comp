@@ -3,7 +3,7 @@
 // viscosity (viscosity Laplacian), surface tension (colour field, where |n| >= threshold),
 // gravity; writes the acceleration f / rho.
 #ifdef PASS
-// DFSPH's forces pass (src/sph/pressure.rs): neighbours from the step's lists.
+// DFSPH's forces pass (src/sim/sph/pressure.rs): neighbours from the step's lists.
 #include "pressure.glsl"
 #else
 #include "common.glsl"

@@ -1,5 +1,5 @@
 #version 450
-// The state's health after a frame (src/sph/health.rs): particles with a non-finite
+// The state's health after a frame (src/sim/sph/health.rs): particles with a non-finite
 // velocity or density, the largest speed^2 and density. Non-negative floats order like
 // their bits, so atomicMax on the bits takes the float maximum.
 #include "common/index.glsl"

@@ -1,4 +1,4 @@
-// The smoothing kernel of densities and pressure gradients, P.kernel (src/sph/kernel.rs
+// The smoothing kernel of densities and pressure gradients, P.kernel (src/sim/sph/kernel.rs
 // has the formulas, and the same in f64): KERNEL_MULLER, the thesis's poly6 densities with
 // spiky gradients; KERNEL_CUBIC, the cubic spline; KERNEL_WENDLAND, Wendland C2. Support
 // h; P.kernel_k: cubic's or wendland's normalisation. Host-checked: no other value comes.

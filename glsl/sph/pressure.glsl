@@ -1,4 +1,4 @@
-// The pressure solvers' shared part (src/sph/pressure.rs): PressureIo's bindings past
+// The pressure solvers' shared part (src/sim/sph/pressure.rs): PressureIo's bindings past
 // SphIo's, the iteration state, the kernel and its gradient, and the per-workgroup error
 // reduction the loop pass (solve_loop.comp) finishes. V = m / rho0 throughout.
 #ifndef SPH_PRESSURE_GLSL

@@ -1,5 +1,5 @@
 #version 450
-// The density error of a step (src/sph/errors.rs): per live particle (pos.w >= 0)
+// The density error of a step (src/sim/sph/errors.rs): per live particle (pos.w >= 0)
 // e = max(rho / rho0 - 1, 0), compression only (surface particles lack neighbours, as in
 // SPlisHSPlasH's solvers). Two levels: mode 0 reduces each block of WG * ITEMS particles to
 // a (sum, max, count) partial; mode 1 (one workgroup) reduces the partials into

@@ -8,7 +8,6 @@ use super::{BenchOptions, Row};
 use crate::config::Adaptive;
 use crate::error::{Error, Result};
 use crate::run::{run, RunOptions, RunStats};
-use clap::ValueEnum;
 
 fn secs(t: Option<f64>, last: f64) -> String {
     t.map(|t| format!("{t:.3}"))
@@ -20,7 +19,7 @@ pub fn control(opts: &BenchOptions) -> Result<Vec<Row>> {
     let scene = opts.character.clone().unwrap_or_else(|| "giraffe".into());
     let modes: Vec<Adaptive> = match sw.control.adaptive {
         Some(a) => vec![a],
-        None => Adaptive::value_variants().to_vec(),
+        None => Adaptive::all().to_vec(),
     };
     let velocities = match (&opts.velocities[..], sw.control.control_velocity) {
         ([], k) => vec![k.unwrap_or(0.0)],

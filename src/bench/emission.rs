@@ -90,10 +90,10 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &variant.replace('/', "-"),
                 actual,
-                "frame",
+                crate::gpu::FRAME,
                 detail,
                 |prof, cmd| {
-                    prof.begin(ctx, cmd, "frame");
+                    prof.begin(ctx, cmd, crate::gpu::FRAME.name());
                     targets.record_before(ctx, cmd, prof, &mut st, t, dt, 1)?;
                     solver.record_hooked_step(ctx, cmd, prof, &mut st, &mut targets.hooks())?;
                     prof.end(ctx, cmd);

@@ -7,6 +7,10 @@ use crate::error::Result;
 use crate::gpu::{ComputeDesc, ComputePipeline, Context, Guard};
 use serde_json::json;
 
+/// The floor's timestamp scopes: a buffer copy and the FMA-rate kernel.
+pub const COPY: crate::gpu::ScopeKey = crate::gpu::ScopeKey::new("copy");
+pub const FMA: crate::gpu::ScopeKey = crate::gpu::ScopeKey::new("fma");
+
 /// FLOPs of one density evaluation (Wyvill, from r^2 and the sum): d = x - c (3), r^2 (5),
 /// q^2 (1), the cubic in q^2 by Horner (6), the sum (1).
 pub const FLOPS_PER_EVAL: f64 = 16.0;
@@ -39,8 +43,8 @@ impl Floor {
         let out = Guard::new(ctx, ctx.storage_buffer("floor fma out", invocations * 16)?);
         let desc = ComputeDesc::plain("fma rate", "bench/fma.comp", &[], 256);
         let fma = Guard::new(ctx, ComputePipeline::<FmaIo>::new(ctx, &desc)?);
-        let copy = measure(ctx, opts, "copy", bytes, "copy", json!({}), |prof, cmd| {
-            prof.begin(ctx, cmd, "copy");
+        let copy = measure(ctx, opts, "copy", bytes, COPY, json!({}), |prof, cmd| {
+            prof.begin(ctx, cmd, COPY.name());
             ctx.copy(cmd, &src, 0, &dst, 0, bytes);
             prof.end(ctx, cmd);
             Ok(())
@@ -50,10 +54,10 @@ impl Floor {
             opts,
             "fma",
             invocations,
-            "fma",
+            FMA,
             json!({}),
             |prof, cmd| {
-                prof.begin(ctx, cmd, "fma");
+                prof.begin(ctx, cmd, FMA.name());
                 fma.dispatch(ctx, cmd, &FmaBufs { out: &out }, &ITERS, invocations);
                 prof.end(ctx, cmd);
                 Ok(())

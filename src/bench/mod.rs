@@ -1,6 +1,7 @@
 //! `fluidform bench <what>`: warm-up, timed repetitions, per-pass GPU ms in the output
 //! contract (timings.csv + summary.json per configuration) and a sweep table
 //! (sweep.csv + sweep.md) when several configurations run.
+pub mod args;
 pub mod control;
 pub mod emission;
 pub mod floor;
@@ -15,14 +16,48 @@ pub mod sph;
 
 use crate::config::{Group, Switches};
 use crate::error::{Error, Result};
-use crate::gpu::{Context, ContextOptions, FrameTiming, Profiler, RecordOnly};
+use crate::gpu::vk;
+use crate::gpu::{Context, ContextOptions, FrameTiming, Profiler, RecordOnly, ScopeKey, FRAME};
 use crate::report::{stat, Report, Stat};
-use ash::vk;
 use serde_json::Value;
 use std::path::PathBuf;
 
+fluidform_gpu::switch_enum!(
+    /// The benchmarks of `fluidform bench`, one per subcommand.
+    Bench {
+        Scan,
+        Sort,
+        Neighbors,
+        Sph,
+        Stability,
+        Solvers,
+        Render,
+        Skin,
+        Control,
+        Emission,
+        Particles
+    }
+);
+
+/// Who measures through the benchmarks' machinery: a benchmark, or an experiment (whose
+/// name then labels the outputs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measurer {
+    Bench(Bench),
+    Experiment(crate::experiment::Experiment),
+}
+
+impl std::fmt::Display for Measurer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Measurer::Bench(b) => b.fmt(f),
+            Measurer::Experiment(e) => e.fmt(f),
+        }
+    }
+}
+
 pub struct BenchOptions {
-    pub what: String,
+    pub what: Measurer,
     pub out: PathBuf,
     /// Timed repetitions per configuration.
     pub frames: u64,
@@ -62,20 +97,6 @@ pub struct BenchConfig {
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct NoStats {}
 
-pub const WHATS: &[&str] = &[
-    "scan",
-    "sort",
-    "neighbors",
-    "sph",
-    "stability",
-    "solvers",
-    "render",
-    "skin",
-    "control",
-    "emission",
-    "particles",
-];
-
 /// Default particle counts of a sweep: 8K ... 256K and 1M.
 pub const SWEEP: &[u32] = &[
     8 << 10,
@@ -100,6 +121,17 @@ pub struct Row {
     pub extra: Vec<(String, String)>,
 }
 
+impl Row {
+    /// The statistics of timestamp scope `key`; an error where it was not recorded.
+    pub fn pass(&self, key: ScopeKey) -> Result<&Stat> {
+        self.passes
+            .iter()
+            .find(|(k, _)| k == key.path())
+            .map(|(_, s)| s)
+            .ok_or_else(|| key.missing(self.passes.iter().map(|(k, _)| k.as_str())))
+    }
+}
+
 pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
     if opts.frames == 0 {
         return Err(Error::Param("--frames must be at least 1".into()));
@@ -110,73 +142,73 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         validation: sw.common.validation,
         present: None,
     })?;
-    let rows = match opts.what.as_str() {
-        "scan" => {
+    let Measurer::Bench(bench) = opts.what else {
+        return Err(Error::Bug(format!(
+            "bench::run runs benchmarks; {} measures through bench::measure",
+            opts.what
+        )));
+    };
+    let rows = match bench {
+        Bench::Scan => {
             sw.reject_unused("bench scan", &[])?;
             primitives::scan(&ctx, opts)?
         }
-        "sort" => {
+        Bench::Sort => {
             sw.reject_unused("bench sort", &[Group::Sort])?;
             primitives::sort(&ctx, opts)?
         }
-        "neighbors" => {
+        Bench::Neighbors => {
             sw.reject_unused("bench neighbors", &[Group::Sort, Group::Neighbors])?;
             primitives::neighbors(&ctx, opts)?
         }
-        "sph" => {
+        Bench::Sph => {
             sw.reject_unused("bench sph", &[Group::Sort, Group::Neighbors, Group::Fluid])?;
             sph::steps(&ctx, opts)?
         }
-        "stability" => {
+        Bench::Stability => {
             sw.reject_unused(
                 "bench stability",
                 &[Group::Sort, Group::Neighbors, Group::Fluid],
             )?;
             sph::stability(&ctx, opts)?
         }
-        "solvers" => {
+        Bench::Solvers => {
             sw.reject_unused(
                 "bench solvers",
                 &[Group::Sort, Group::Neighbors, Group::Fluid],
             )?;
             solvers::solvers(&ctx, opts)?
         }
-        "render" => {
+        Bench::Render => {
             sw.reject_unused("bench render", &[Group::Metaball, Group::Camera])?;
             render::render(&ctx, opts)?
         }
-        "skin" => {
+        Bench::Skin => {
             sw.reject_unused("bench skin", &[Group::Character])?;
             skin::skin(&ctx, opts)?
         }
-        "control" => {
+        Bench::Control => {
             sw.reject_unused(
                 "bench control",
                 &[Group::Control, Group::Character, Group::Fluid],
             )?;
             control::control(opts)?
         }
-        "emission" => {
+        Bench::Emission => {
             sw.reject_unused(
                 "bench emission",
                 &[Group::Sort, Group::Neighbors, Group::Fluid, Group::Emission],
             )?;
             emission::emission(&ctx, opts)?
         }
-        "particles" => {
+        Bench::Particles => {
             sw.reject_unused("bench particles", &[Group::Sort, Group::Particles])?;
             particles::particles(&ctx, opts)?
         }
-        other => {
-            return Err(Error::Param(format!(
-                "unknown benchmark '{other}' (one of: {})",
-                WHATS.join(", ")
-            )))
-        }
     };
-    let notes = primitives::notes(&opts.what, &rows);
+    let notes = primitives::notes(bench, &rows);
     write_sweep(&ctx, opts, &rows, &notes)?;
-    crate::session::check_validation(&ctx)?;
+    crate::run::common::check_validation(&ctx)?;
     Ok(rows)
 }
 
@@ -202,7 +234,7 @@ pub fn measure(
     opts: &BenchOptions,
     variant: &str,
     n: u64,
-    main_scope: &str,
+    main_scope: ScopeKey,
     config: Value,
     mut record: impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
 ) -> Result<Row> {
@@ -232,7 +264,7 @@ pub fn measure(
         device: &ctx.info,
         config: BenchConfig {
             command: "bench".into(),
-            what: opts.what.clone(),
+            what: opts.what.to_string(),
             variant: variant.to_string(),
             n,
             frames: reps,
@@ -252,12 +284,19 @@ pub fn measure(
     };
     report.write(&opts.out.join("runs").join(&label))?;
     let passes = crate::report::pass_stats(&timings);
-    let main = passes
-        .iter()
-        .find(|(name, _)| name == main_scope)
-        .map(|(_, s)| *s)
-        .or_else(|| stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>()))
-        .ok_or_else(|| Error::Param("no timed frames".into()))?;
+    if timings.is_empty() {
+        return Err(Error::Param("no timed frames".into()));
+    }
+    let main = if main_scope == FRAME {
+        stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>())
+            .ok_or_else(|| Error::Param("no timed frames".into()))?
+    } else {
+        passes
+            .iter()
+            .find(|(name, _)| name == main_scope.path())
+            .map(|(_, s)| *s)
+            .ok_or_else(|| main_scope.missing(passes.iter().map(|(k, _)| k.as_str())))?
+    };
     eprintln!(
         "{:<24} n = {:>9}  {main_scope} median {:9.3} ms (min {:.3}, max {:.3}, {reps} reps)",
         variant, n, main.median, main.min, main.max
@@ -281,7 +320,7 @@ fn run_frames(
     quiet: bool,
 ) -> Result<Vec<FrameTiming>> {
     let mut work = RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd));
-    crate::session::play(ctx, count, &mut work, label, quiet)
+    crate::run::common::play(ctx, count, &mut work, label, quiet)
 }
 
 /// A CSV field, quoted where it holds a comma, a quote or a line break.
@@ -390,7 +429,7 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String
     plot::sweep(
         &opts.out.join("sweep.png"),
         &title,
-        &opts.what,
+        &opts.what.to_string(),
         &ctx.info.name,
         rows,
     )

@@ -138,7 +138,7 @@ pub fn particles(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &variant.replace('/', "-"),
                 n as u64,
-                "frame",
+                crate::gpu::FRAME,
                 detail,
                 |prof, cmd| {
                     let f = frame_info(&cam, dt, k, w, h);

@@ -2,14 +2,19 @@
 use super::{counts, measure, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::{Buffer, Context, Guard};
+use crate::gpu::vk;
+use crate::gpu::{Buffer, Context, Guard, ScopeKey};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::primitives::sort::{Network, NetworkSort};
-use ash::vk;
 use rand::{Rng, SeedableRng};
 use serde_json::json;
+
+/// The primitives' timestamp scopes, opened here around each primitive.
+const SCAN: ScopeKey = ScopeKey::new("scan");
+const SORT: ScopeKey = ScopeKey::new("sort");
+const NEIGHBORS: ScopeKey = ScopeKey::new("neighbors");
 
 fn copy(ctx: &Context, cmd: vk::CommandBuffer, src: &Buffer, dst: &Buffer, bytes: u64) {
     ctx.copy(cmd, src, 0, dst, 0, bytes);
@@ -47,10 +52,10 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             opts,
             variant,
             n as u64,
-            "scan",
+            SCAN,
             json!({}),
             |prof, cmd| {
-                prof.begin(ctx, cmd, "scan");
+                prof.begin(ctx, cmd, SCAN.name());
                 pass.record(
                     ctx,
                     cmd,
@@ -61,7 +66,7 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     &scratch,
                 )?;
                 prof.end(ctx, cmd);
-                prof.begin(ctx, cmd, "copy");
+                prof.begin(ctx, cmd, super::floor::COPY.name());
                 copy(ctx, cmd, &input, &copied, bytes);
                 prof.end(ctx, cmd);
                 Ok(())
@@ -72,12 +77,7 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             ctx.destroy_buffer(b);
         }
         let mut row = row?;
-        let copy_ms = row
-            .passes
-            .iter()
-            .find(|(p, _)| p == "copy")
-            .map(|(_, s)| s.median)
-            .unwrap_or(f64::NAN);
+        let copy_ms = row.pass(super::floor::COPY)?.median;
         // Both move 2 * bytes (read + write); bandwidth = 2 * bytes / time.
         let gbs = |ms: f64| 2.0 * bytes as f64 / (ms * 1e6);
         row.extra = vec![
@@ -138,14 +138,14 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &algo.as_str(),
                 n as u64,
-                "sort",
+                SORT,
                 detail,
                 |prof, cmd| {
                     prof.begin(ctx, cmd, "restore");
                     copy(ctx, cmd, &pk, &wk, bytes);
                     copy(ctx, cmd, &pv, &wv, bytes);
                     prof.end(ctx, cmd);
-                    prof.begin(ctx, cmd, "sort");
+                    prof.begin(ctx, cmd, SORT.name());
                     match &network {
                         Some(s) => {
                             s.record(ctx, cmd, &wk, &wv, n as u64)?;
@@ -211,10 +211,10 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &variant.replace('/', "-"),
                 n as u64,
-                "neighbors",
+                NEIGHBORS,
                 detail,
                 |prof, cmd| {
-                    prof.begin(ctx, cmd, "neighbors");
+                    prof.begin(ctx, cmd, NEIGHBORS.name());
                     search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
                     search.record_query(ctx, cmd, prof, &b, &p, n, &grid, radius)?;
                     prof.end(ctx, cmd);
@@ -281,17 +281,18 @@ fn pair_mismatches(rows: &[Row]) -> (usize, Vec<String>) {
 }
 
 /// What a bench's rows say against its targets, one line each.
-pub fn notes(what: &str, rows: &[Row]) -> Vec<String> {
+pub fn notes(what: super::Bench, rows: &[Row]) -> Vec<String> {
+    use super::Bench;
     match what {
-        "solvers" => super::solvers::notes(rows),
-        "particles" => super::particles::notes(rows),
-        "emission" => emission_notes(rows),
-        "sort" => sort_notes(rows),
-        "neighbors" => neighbors_notes(rows),
-        "sph" => sph_notes(rows),
-        "render" => render_notes(rows),
-        "scan" => scan_notes(rows),
-        _ => Vec::new(),
+        Bench::Solvers => super::solvers::notes(rows),
+        Bench::Particles => super::particles::notes(rows),
+        Bench::Emission => emission_notes(rows),
+        Bench::Sort => sort_notes(rows),
+        Bench::Neighbors => neighbors_notes(rows),
+        Bench::Sph => sph_notes(rows),
+        Bench::Render => render_notes(rows),
+        Bench::Scan => scan_notes(rows),
+        Bench::Stability | Bench::Skin | Bench::Control => Vec::new(),
     }
 }
 

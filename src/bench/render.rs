@@ -8,7 +8,7 @@ use super::{measure, BenchOptions, Row};
 use crate::config::{BuildKind, ListKind, SurfaceKind};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
-use crate::render::metaball::{blob, blob_camera, MetaballRenderer, MetaballSettings};
+use crate::render::metaball::{blob, blob_camera, FluidRenderer};
 use crate::sph::FluidParams;
 use serde_json::json;
 
@@ -29,30 +29,37 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     let result = (|| -> Result<()> {
         for (list, sorted, build) in lists {
-            let mut settings = MetaballSettings::from_switches(sw)?;
+            let mut settings = crate::settings::metaball_settings(sw)?;
             (settings.list, settings.sorted, settings.build) = (list, sorted, build);
             settings.fluid = Some(blob_fluid(&pts, spacing));
             let name = match other {
                 Some(k) => k.as_str(),
                 None => settings.list_name(),
             };
-            let cam = crate::session::camera_with_switches(
+            let cam = crate::run::common::camera_with_switches(
                 blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
                 sw,
             );
-            let r = Guard::new(ctx, MetaballRenderer::new(ctx, settings.clone())?);
+            let r = Guard::new(ctx, FluidRenderer::new(ctx, settings.clone())?);
             let mut b = Guard::new(ctx, r.buffers(ctx, n as u64, 2, false)?);
             // Size the lists (and count the redos) before timing.
             let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0);
             let row = sized.and_then(|(st, redos)| {
                 let detail = json!({ "settings": settings, "particles": n, "spacing": spacing });
-                let mut row =
-                    measure(ctx, opts, &name, n as u64, "render", detail, |prof, cmd| {
-                        prof.begin(ctx, cmd, "render");
+                let mut row = measure(
+                    ctx,
+                    opts,
+                    &name,
+                    n as u64,
+                    crate::render::SCOPE,
+                    detail,
+                    |prof, cmd| {
+                        prof.begin(ctx, cmd, crate::render::SCOPE.name());
                         r.record(ctx, cmd, prof, &b, &centers, n as u32, &cam, 0)?;
                         prof.end(ctx, cmd);
                         Ok(())
-                    })?;
+                    },
+                )?;
                 let after = r.frame_stats(&b, 0);
                 let cut = after.budget_pixels.max(st.budget_pixels);
                 // The march's per-ray counters of the last timed frame, per pixel.
@@ -106,7 +113,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
 /// The (list, sorted, build) rows: what --list, --list-sort and --build pick, or every
 /// list mode (both S-buffer orders by both builds, and tiles) when --list is unset.
 fn rows_of(sw: &crate::config::Switches) -> Result<Vec<(ListKind, bool, BuildKind)>> {
-    let s = MetaballSettings::from_switches(sw)?;
+    let s = crate::settings::metaball_settings(sw)?;
     if sw
         .metaball
         .surface

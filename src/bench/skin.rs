@@ -9,6 +9,9 @@ use crate::gpu::{Context, Guard};
 use glam::{Mat4, Vec3};
 use serde_json::json;
 
+/// The skinning pass's timestamp scope.
+const SKIN: crate::gpu::ScopeKey = crate::gpu::ScopeKey::new("skin");
+
 /// `copies` of `ch` side by side (one mesh, the same skeleton and weights).
 pub fn tiled(ch: &Character, copies: usize) -> Character {
     let mut out = ch.clone();
@@ -67,8 +70,8 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let n = c.mesh.vertices() as u64;
             let detail = json!({ "mesh": c.source, "vertices": n, "joints": c.skeleton.joints.len(),
                                  "influences": 4 * c.mesh.influence_sets, "method": method.as_str() });
-            let mut row = measure(ctx, opts, &variant, n, "skin", detail, |prof, cmd| {
-                prof.begin(ctx, cmd, "skin");
+            let mut row = measure(ctx, opts, &variant, n, SKIN, detail, |prof, cmd| {
+                prof.begin(ctx, cmd, SKIN.name());
                 sk.record(ctx, cmd, &joints)?;
                 prof.end(ctx, cmd);
                 Ok(())

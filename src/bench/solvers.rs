@@ -7,15 +7,15 @@
 use super::{BenchOptions, Row};
 use crate::config::Solver;
 use crate::error::{Error, Result};
+use crate::gpu::vk;
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
 use crate::report::stat;
 use crate::scene::Scene;
 use crate::sph::errors::DensityErrorStats;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Eos, FluidParams};
-use crate::sph::run::Stepper;
+use crate::sph::stepper::Stepper;
 use crate::sph::{SphSolver, SphState};
-use ash::vk;
 
 pub const SOLVERS: [Solver; 4] = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
 
@@ -163,7 +163,7 @@ pub fn play(
 ) -> Result<Outcome> {
     let parts = scene.particles(opts.switches.common.seed);
     let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
-    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::session::SLOTS)?);
+    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::run::common::SLOTS)?);
     let mut work = Play {
         solver,
         st: &mut st,
@@ -171,7 +171,7 @@ pub fn play(
     };
     let total = opts.warmup + opts.frames;
     let quiet = opts.switches.common.quiet;
-    let played = crate::session::play(ctx, total, &mut work, label, quiet);
+    let played = crate::run::common::play(ctx, total, &mut work, label, quiet);
     let mut out = Outcome {
         particles: st.n as usize,
         ..Outcome::default()
@@ -185,16 +185,11 @@ pub fn play(
         Err(e) => return Err(e),
     };
     for t in timings.iter().filter(|t| t.frame >= opts.warmup) {
-        let scope = |name: &str| -> f64 {
-            t.passes
-                .iter()
-                .filter(|(k, _)| k == name)
-                .map(|(_, v)| v)
-                .sum()
-        };
-        let ms = scope("sph");
-        out.solve_ms[0] += scope("sph/pressure");
-        out.solve_ms[1] += scope("sph/divergence");
+        // WCSPH records no pressure or divergence iterations: those are 0 ms there.
+        let iterations = |key: crate::gpu::ScopeKey| key.ms_in(t).unwrap_or(0.0);
+        let ms = crate::sph::SCOPE.ms_in(t)?;
+        out.solve_ms[0] += iterations(crate::sph::PRESSURE_SCOPE);
+        out.solve_ms[1] += iterations(crate::sph::DIVERGENCE_SCOPE);
         let steps: Vec<_> = stepper.steps.iter().filter(|s| s.0 == t.frame).collect();
         for s in &steps {
             out.errors.add(&s.3);

@@ -8,7 +8,7 @@ use crate::primitives::neighbors::default_sort;
 use crate::scene::Scene;
 use crate::sph::errors::DensityErrorStats;
 use crate::sph::params::FluidParams;
-use crate::sph::run::{check, physics_stats, PhysicsStats, Stepper};
+use crate::sph::stepper::{check, physics_stats, PhysicsStats, Stepper};
 use crate::sph::SphSolver;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -52,7 +52,7 @@ pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 opts,
                 &variant.replace('/', "-"),
                 actual,
-                "sph",
+                crate::sph::SCOPE,
                 detail,
                 |prof, cmd| solver.record_step(ctx, cmd, prof, &mut st),
             );
@@ -117,12 +117,12 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let parts = scene.particles(opts.switches.common.seed);
     let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
     let st_n = st.n as usize;
-    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::session::SLOTS)?);
+    let mut stepper = Guard::new(ctx, Stepper::new(ctx, &st, crate::run::common::SLOTS)?);
     let frame_time = stepper.frame_time;
     // Frames to cover the seconds, a hair under whole counting as whole (the f32 step
     // makes 2 s / 20 ms 100.0000025).
     let total = (opts.seconds / frame_time - 1e-4).ceil().max(1.0) as u64;
-    let mut frames = FrameLoop::new(ctx, crate::session::SLOTS)?;
+    let mut frames = FrameLoop::new(ctx, crate::run::common::SLOTS)?;
     let mut checkpoints: Vec<Checkpoint> = Vec::new();
     let started = std::time::Instant::now();
     let mut work = super::solvers::Play {
@@ -276,7 +276,7 @@ fn write_stability(
 fn stability_row(
     summary: &StabilitySummary,
     timings: &[crate::gpu::FrameTiming],
-    last: &crate::sph::run::PhysicsStats,
+    last: &crate::sph::stepper::PhysicsStats,
     solver_kind: crate::config::Solver,
     ratio: f64,
 ) -> Result<Row> {

@@ -1,8 +1,8 @@
 //! `experiment adaptive`: the giraffe fill test with adaptive control pressure off, on
 //! and smooth (thesis figures 12/13).
 use super::findings::{self, Finding, Verdict};
-use super::{write, Env, Steps};
-use crate::bench::Row;
+use super::{write, Env, Experiment, Steps};
+use crate::bench::{Bench, Measurer, Row};
 use crate::config::Adaptive;
 use crate::error::{Error, Result};
 use std::path::PathBuf;
@@ -21,7 +21,7 @@ pub fn adaptive(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
         true => &[Adaptive::Off, Adaptive::On],
         false => &[Adaptive::Off, Adaptive::On, Adaptive::Smooth],
     };
-    let mut opts = env.bench_options("control", "adaptive");
+    let mut opts = env.bench_options(Measurer::Bench(Bench::Control), Experiment::Adaptive);
     opts.character = Some("giraffe".into());
     opts.frames = if env.quick { 40 } else { 700 };
     let mut steps = Steps::new("adaptive", modes.len() as u64, env.switches.common.quiet);
@@ -55,7 +55,7 @@ pub fn adaptive(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let (md, csv) = adaptive_tables(&rows);
     let p_csv = env.out.join("adaptive.csv");
     write(&p_csv, &csv)?;
-    let p_md = super::finish_md(env, "adaptive", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Adaptive, md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
 }
 

@@ -351,8 +351,8 @@ pub fn write_devices(root: &Path) -> Result<PathBuf> {
 mod tests {
     #[test]
     fn every_experiment_has_a_spec() {
-        for n in super::super::NAMES {
-            assert!(super::SPECS.iter().any(|s| s.file == *n), "{n}");
+        for n in super::super::Experiment::all() {
+            assert!(super::SPECS.iter().any(|s| s.file == n.as_str()), "{n}");
         }
     }
 }

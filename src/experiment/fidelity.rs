@@ -3,7 +3,7 @@
 //! fidelity preset: the fidelity metrics side by side (means over the second half of each
 //! run), the last saved frame of each (same scene time), and fill and IoU over time.
 use super::findings::Finding;
-use super::{write, Env, Steps};
+use super::{write, Env, Experiment, Steps};
 use crate::config::{ControlPreset, RenderKind};
 use crate::control::metrics::ControlRow;
 use crate::error::{Error, Result};
@@ -108,7 +108,7 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
                 scene,
                 preset,
                 frames,
-                &env.runs("fidelity").join(&name),
+                &env.runs(Experiment::Fidelity).join(&name),
             );
             steps.tick();
             // A run that goes unstable is a result: its row says so.
@@ -125,7 +125,7 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
                 }
                 Err(e) => return Err(e),
             };
-            let cells = row_cells(label, preset, &o);
+            let cells = row_cells(label, preset, &o)?;
             md.push_str(&format!("| {} |\n", cells.join(" | ")));
             // (The csv splits mean and min.)
             let mut c = cells.to_vec();
@@ -158,7 +158,7 @@ pub fn fidelity(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let plots = plots(env, &mut md, (&fill_series, &iou_series), &pictures)?;
     let p_csv = env.out.join("fidelity.csv");
     write(&p_csv, &csv)?;
-    let p_md = super::finish_md(env, "fidelity", md, &[])?;
+    let p_md = super::finish_md(env, Experiment::Fidelity, md, &[])?;
     files.push(p_csv);
     files.push(p_md);
     files.extend(plots);
@@ -192,16 +192,16 @@ fn plots(
 }
 
 /// A run's row: metrics (mean, min in brackets), time to 90% and the control's share.
-fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> [String; 11] {
+fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> Result<[String; 11]> {
     let t = &o.summary["stats"]["control"]["targets"][0];
     let w = &t["fidelity"];
     let m = |k: &str| (cell(&w[k]["mean"], 3), cell(&w[k]["min"], 3));
-    let p = &o.summary["pass_ms"];
+    let median = |k| crate::report::pass_median(&o.summary, k);
     let share = match (
-        p["sph/control"]["median"].as_f64(),
-        p["sph"]["median"].as_f64(),
+        median(crate::control::force::SCOPE)?,
+        median(crate::sph::SCOPE)?,
     ) {
-        (Some(c), Some(s)) if s > 0.0 => format!("{:.2}", c / s),
+        (c, s) if s > 0.0 => format!("{:.2}", c / s),
         _ => "-".into(),
     };
     let t90 = cell(&t["time_to_90"], 2);
@@ -219,7 +219,7 @@ fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> [String; 11] {
         t90,
         share,
     ];
-    cells
+    Ok(cells)
 }
 
 /// `a` and `b` side by side in one PNG (a on the left), each at its own size.

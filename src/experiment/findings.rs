@@ -1,7 +1,7 @@
 //! The papers' qualitative findings, each confirmed or refuted by an experiment's numbers.
 //! Every experiment saves its verdicts as `<name>.findings.json`; `findings.md` is rebuilt
 //! from all of them, one section per claim.
-use super::{io, write, Env, NAMES};
+use super::{io, write, Env, Experiment};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -66,9 +66,9 @@ pub struct Saved {
 }
 
 /// Save `<name>.findings.json` with the run's device, date and mode.
-pub fn save(env: &Env, name: &str, found: &[Finding]) -> Result<()> {
+pub fn save(env: &Env, name: Experiment, found: &[Finding]) -> Result<()> {
     let s = Saved {
-        experiment: name.into(),
+        experiment: name.to_string(),
         quick: env.quick,
         device: env.meta.device.clone(),
         date: env.meta.date.clone(),
@@ -78,10 +78,10 @@ pub fn save(env: &Env, name: &str, found: &[Finding]) -> Result<()> {
     write(&env.out.join(format!("{name}.findings.json")), &text)
 }
 
-/// Every experiment's saved findings in `dir`, in `NAMES` order.
+/// Every experiment's saved findings in `dir`, in `Experiment` order.
 pub fn load(dir: &Path) -> Result<Vec<Saved>> {
     let mut saved = Vec::new();
-    for name in NAMES {
+    for name in Experiment::all() {
         let p = dir.join(format!("{name}.findings.json"));
         if !p.exists() {
             continue;

@@ -6,8 +6,9 @@
 //! Lipschitz march's steps, and the speed targets of the best mode.
 use super::findings::{Finding, Verdict};
 use super::measure::{base, time_frame, Frame};
-use super::{write, Env, Steps};
+use super::{write, Env, Experiment, Steps};
 use crate::bench::floor::Floor;
+use crate::bench::Measurer;
 use crate::config::{BuildKind, ListKind, MarchKind, Material, RenderKind};
 use crate::error::{Error, Result};
 use crate::render::metaball::MetaballSettings;
@@ -118,7 +119,7 @@ fn thesis_frame(
     let centers = env.scene(ctx)?.centers.clone();
     let cam = env.scene(ctx)?.camera;
     let n = centers.len();
-    let opts = env.bench_options("lists", "lists");
+    let opts = env.bench_options(Measurer::Experiment(Experiment::Lists), Experiment::Lists);
     let floor = Floor::measure(ctx, &opts)?;
     let mut buf = ctx.storage_buffer("thesis centers", (n * 16) as u64)?;
     let mut out = Vec::new();
@@ -207,7 +208,7 @@ fn character(env: &Env, steps: &mut Steps) -> Result<Vec<(Mode, f64)>> {
         sw.metaball.tile = (mode.2 == C).then_some(mode.3);
         sw.metaball.march = Some(mode.4);
         let dir = env
-            .runs("lists")
+            .runs(Experiment::Lists)
             .join(format!("character-{}", mode.name().replace(' ', "-")));
         let opts = crate::run::RunOptions {
             scene: "character".into(),
@@ -221,9 +222,7 @@ fn character(env: &Env, steps: &mut Steps) -> Result<Vec<(Mode, f64)>> {
             std::fs::read_to_string(dir.join("summary.json")).map_err(|e| super::io(&dir, e))?;
         let v: Value =
             serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))?;
-        let ms = v["pass_ms"]["render"]["median"]
-            .as_f64()
-            .unwrap_or(f64::NAN);
+        let ms = crate::report::pass_median(&v, crate::render::SCOPE)?;
         out.push((*mode, ms));
         steps.tick();
     }
@@ -321,7 +320,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
     let found = findings(&cells, &demo);
     let p_csv = env.out.join("lists.csv");
     write(&p_csv, &csv)?;
-    let p_md = super::finish_md(env, "lists", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Lists, md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
 }
 

@@ -3,7 +3,7 @@
 use super::findings::{self, Finding, Verdict};
 use super::tables::{value, Col, TableDef, SBUFFER};
 use super::{write, Env, Steps};
-use crate::bench::measure as bench_measure;
+use crate::bench::{measure as bench_measure, Measurer};
 use crate::config::ListKind;
 use crate::error::Result;
 use crate::gpu::Context;
@@ -46,7 +46,7 @@ fn slug(s: &str) -> String {
 
 /// The thesis defaults (Wyvill, T 0.9, R 0.04, I 2, Phong, depth 1) at the table's size.
 pub fn base(width: u32, height: u32) -> Result<MetaballSettings> {
-    let mut s = MetaballSettings::from_switches(&crate::config::Switches::default())?;
+    let mut s = crate::settings::metaball_settings(&crate::config::Switches::default())?;
     s.width = width;
     s.height = height;
     Ok(s)
@@ -65,10 +65,10 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     let seed = env.switches.common.seed;
     let base_centers = env.scene(ctx)?.centers.clone();
     let cam = env.scene(ctx)?.camera;
-    let opts = env.bench_options(def.name, def.name);
+    let opts = env.bench_options(Measurer::Experiment(def.name), def.name);
     let (width, height) = (env.width, env.height);
     let mut steps = Steps::new(
-        def.name,
+        &def.name.as_str(),
         (def.rows.len() * def.cols.len()) as u64,
         env.switches.common.quiet,
     );
@@ -114,7 +114,7 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
                 if *col == SBUFFER {
                     image = b.pixels(0).to_vec();
                 }
-                let detail = json!({ "table": def.name, "row": label, "list": col.name,
+                let detail = json!({ "table": def.name.as_str(), "row": label, "list": col.name,
                     "settings": s, "particles": n, "redos": redos });
                 let variant = format!("{}-{}", slug(&label), col.name);
                 let frame = Frame {
@@ -153,7 +153,7 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
 
 /// A renderer's frame of `n` metaballs at `centers` seen by `cam`.
 pub struct Frame<'a> {
-    pub r: &'a crate::render::metaball::MetaballRenderer,
+    pub r: &'a crate::render::metaball::FluidRenderer,
     pub b: &'a crate::render::metaball::MetaballBuffers,
     pub centers: &'a crate::gpu::Buffer,
     pub n: u32,
@@ -173,10 +173,10 @@ pub fn time_frame(
         opts,
         variant,
         f.n as u64,
-        "render",
+        crate::render::SCOPE,
         detail,
         |prof, cmd| {
-            prof.begin(ctx, cmd, "render");
+            prof.begin(ctx, cmd, crate::render::SCOPE.name());
             f.r.record(ctx, cmd, prof, f.b, f.centers, f.n, f.cam, 0)?;
             prof.end(ctx, cmd);
             Ok(())

@@ -14,23 +14,40 @@ pub mod sweeps;
 pub mod tables;
 pub mod thesis;
 
+use crate::bench::Measurer;
 use crate::config::Switches;
 use crate::error::{Error, Result};
 use crate::gpu::{Context, ContextOptions, Guard};
-use crate::render::metaball::{MetaballBuffers, MetaballRenderer, MetaballSettings};
+use crate::render::metaball::{FluidRenderer, MetaballBuffers, MetaballSettings};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-pub const NAMES: &[&str] = &[
-    "table2", "table3", "table4", "table5", "table6", "table7", "table8", "fig9", "adaptive",
-    "scaling", "fidelity", "surfaces", "lists", "surge",
-];
+fluidform_gpu::switch_enum!(
+    /// The papers' tables and figures `fluidform experiment` reproduces, and our own studies.
+    Experiment {
+        Table2,
+        Table3,
+        Table4,
+        Table5,
+        Table6,
+        Table7,
+        Table8,
+        Fig9,
+        Adaptive,
+        Scaling,
+        Fidelity,
+        Surfaces,
+        Lists,
+        Surge
+    }
+);
 
 pub struct ExperimentOptions {
-    pub name: String,
+    /// The experiments to run, in order.
+    pub experiments: Vec<Experiment>,
     /// None: results/<device-slug>.
     pub out: Option<PathBuf>,
     pub quick: bool,
@@ -56,7 +73,7 @@ pub struct Env {
     scene: Option<thesis::ThesisScene>,
     /// Renderers made once per shader configuration (llvmpipe takes about a second to
     /// compile one), with buffers for up to the count beside them.
-    renderers: HashMap<String, (MetaballRenderer, MetaballBuffers, u64)>,
+    renderers: HashMap<String, (FluidRenderer, MetaballBuffers, u64)>,
 }
 
 impl Env {
@@ -83,7 +100,7 @@ impl Env {
         ctx: &Context,
         s: &MetaballSettings,
         n: u64,
-    ) -> Result<(&MetaballRenderer, &mut MetaballBuffers)> {
+    ) -> Result<(&FluidRenderer, &mut MetaballBuffers)> {
         // The build and tile size choose passes and buffers beside the defines.
         let key = format!("{:?} {:?} {}", s.shader_defines(), s.build, s.tile);
         let fits = self.renderers.get(&key).is_some_and(|e| e.2 >= n);
@@ -92,7 +109,7 @@ impl Env {
                 b.destroy(ctx);
                 r.destroy(ctx);
             }
-            let r = Guard::new(ctx, MetaballRenderer::new(ctx, s.clone())?);
+            let r = Guard::new(ctx, FluidRenderer::new(ctx, s.clone())?);
             let b = r.buffers(ctx, n, 2, false)?;
             self.renderers.insert(key.clone(), (r.take(), b, n));
         }
@@ -116,15 +133,16 @@ impl Env {
     }
 
     /// Where per-configuration outputs (timings.csv, summary.json) of `name` go.
-    pub fn runs(&self, name: &str) -> PathBuf {
-        self.out.join("runs").join(name)
+    pub fn runs(&self, name: Experiment) -> PathBuf {
+        self.out.join("runs").join(name.as_str())
     }
 
-    pub fn bench_options(&self, what: &str, name: &str) -> crate::bench::BenchOptions {
+    /// Options to measure `what` through the benchmarks, its outputs under runs/<name>.
+    pub fn bench_options(&self, what: Measurer, name: Experiment) -> crate::bench::BenchOptions {
         let mut switches = self.switches.clone();
         switches.common.quiet = true;
         crate::bench::BenchOptions {
-            what: what.into(),
+            what,
             out: self.runs(name),
             frames: self.frames,
             warmup: self.warmup,
@@ -262,7 +280,7 @@ impl Steps {
 /// `<out>/<name>.md`.
 pub fn finish_md(
     env: &Env,
-    name: &str,
+    name: Experiment,
     mut md: String,
     found: &[findings::Finding],
 ) -> Result<PathBuf> {
@@ -295,16 +313,9 @@ pub fn write(path: &std::path::Path, text: &str) -> Result<()> {
 
 /// Run the named experiment (or all); the files written.
 pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
-    let names: Vec<&str> = match opts.name.as_str() {
-        "all" => NAMES.to_vec(),
-        n if NAMES.contains(&n) => vec![n],
-        other => {
-            return Err(Error::Param(format!(
-                "unknown experiment '{other}' (one of: {}, all)",
-                NAMES.join(", ")
-            )))
-        }
-    };
+    if opts.experiments.is_empty() {
+        return Err(Error::Param("experiment: no experiment named".into()));
+    }
     let sw = &opts.switches;
     let ctx = Context::new(&ContextOptions {
         device: sw.common.device.clone(),
@@ -331,27 +342,34 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
         scene: None,
         renderers: HashMap::new(),
     };
-    let result = run_all(&ctx, &mut env, &names);
+    let result = run_all(&ctx, &mut env, &opts.experiments);
     env.destroy(&ctx);
     let files = result?;
-    crate::session::check_validation(&ctx)?;
+    crate::run::common::check_validation(&ctx)?;
     Ok(files)
 }
 
-fn run_all(ctx: &Context, env: &mut Env, names: &[&str]) -> Result<Vec<PathBuf>> {
+fn run_all(ctx: &Context, env: &mut Env, names: &[Experiment]) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for &name in names {
         let t = Instant::now();
         let (written, found) = match name {
-            "fig9" => sweeps::fig9(ctx, env)?,
-            "adaptive" => adaptive::adaptive(env)?,
-            "scaling" => sweeps::scaling(ctx, env)?,
-            "fidelity" => fidelity::fidelity(env)?,
-            "surfaces" => surfaces::surfaces(env)?,
-            "lists" => lists::lists(ctx, env)?,
-            "surge" => surge::surge(ctx, env)?,
-            table => {
-                let def = tables::def(table).expect("a table name");
+            Experiment::Fig9 => sweeps::fig9(ctx, env)?,
+            Experiment::Adaptive => adaptive::adaptive(env)?,
+            Experiment::Scaling => sweeps::scaling(ctx, env)?,
+            Experiment::Fidelity => fidelity::fidelity(env)?,
+            Experiment::Surfaces => surfaces::surfaces(env)?,
+            Experiment::Lists => lists::lists(ctx, env)?,
+            Experiment::Surge => surge::surge(ctx, env)?,
+            Experiment::Table2
+            | Experiment::Table3
+            | Experiment::Table4
+            | Experiment::Table5
+            | Experiment::Table6
+            | Experiment::Table7
+            | Experiment::Table8 => {
+                let def = tables::def(name)
+                    .ok_or_else(|| Error::Bug(format!("{name} has no table definition")))?;
                 measure::table(ctx, env, def)?
             }
         };

@@ -4,9 +4,11 @@
 //! side; and the marching cubes at the particle spacing against one SPH step at 64K
 //! particles.
 use super::findings::{Finding, Verdict};
-use super::{write, Env, Steps};
+use super::{write, Env, Experiment, Steps};
 use crate::config::{RenderKind, SurfaceKind};
 use crate::error::{Error, Result};
+use crate::render::surface::cubes::{CELLS_SCOPE, DENSITY_SCOPE, RASTER_SCOPE};
+use crate::report::pass_median;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -65,10 +67,6 @@ fn play(env: &Env, scene: &str, look: Look, frames: u64, out: &Path) -> Result<V
     serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))
 }
 
-fn median(s: &Value, scope: &str) -> Option<f64> {
-    s["pass_ms"][scope]["median"].as_f64()
-}
-
 /// The renderer's bytes: its buffers in `memory_bytes`.
 fn render_bytes(s: &Value) -> u64 {
     let m = s["memory_bytes"].as_object();
@@ -115,10 +113,10 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
         for kind in SURFACES {
             let name = format!("{scene}-{}", kind.as_str());
             steps.start(&name);
-            let out = env.runs("surfaces").join(&name);
+            let out = env.runs(Experiment::Surfaces).join(&name);
             let s = play(env, scene, (kind, None, None), frames, &out)?;
             steps.tick();
-            let ms = median(&s, "render").unwrap_or(f64::NAN);
+            let ms = pass_median(&s, crate::render::SCOPE)?;
             let b = *base.get_or_insert(ms);
             let tris = s["stats"]["render"]["last_frame"]["triangles"]
                 .as_u64()
@@ -163,17 +161,16 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     // The marching cubes at the spacing against one SPH step, 64K particles (4K quick).
     let n = if env.quick { 4096 } else { 65536 };
     steps.start("cubes at 64K");
-    let out = env.runs("surfaces").join("cubes-64k");
+    let out = env.runs(Experiment::Surfaces).join("cubes-64k");
     let frames = if env.quick { 3 } else { 10 };
     let look = (SurfaceKind::Mesh, Some(1.0), Some(n));
     let s = play(env, "dam-break", look, frames, &out)?;
     steps.tick();
     steps.finish();
-    let cubes = median(&s, "render/density").unwrap_or(f64::NAN)
-        + median(&s, "render/cells").unwrap_or(f64::NAN);
+    let cubes = pass_median(&s, DENSITY_SCOPE)? + pass_median(&s, CELLS_SCOPE)?;
     let per_frame =
         s["stats"]["steps"].as_f64().unwrap_or(f64::NAN) / s["frames"].as_f64().unwrap_or(f64::NAN);
-    let step = median(&s, "sph").unwrap_or(f64::NAN) / per_frame;
+    let step = pass_median(&s, crate::sph::SCOPE)? / per_frame;
     let labels: Vec<&str> = SCENES.iter().map(|s| s.0).collect();
     md.push_str(&format!(
         "\nThe last frame of each: metaballs, screen-space, mesh (left to right); {} (top to \
@@ -185,9 +182,9 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
          particles: density {:.2} ms + cells {:.2} ms = **{cubes:.2} ms** per frame against \
          **{step:.2} ms** per SPH step (the `sph` scope's median over {per_frame:.0} steps a \
          frame); drawing the soup (raster) {:.2} ms.\n",
-        median(&s, "render/density").unwrap_or(f64::NAN),
-        median(&s, "render/cells").unwrap_or(f64::NAN),
-        median(&s, "render/raster").unwrap_or(f64::NAN),
+        pass_median(&s, DENSITY_SCOPE)?,
+        pass_median(&s, CELLS_SCOPE)?,
+        pass_median(&s, RASTER_SCOPE)?,
     ));
     csv.push_str(&format!(
         "dam break {n},cubes-vs-step,{frames},{cubes:.4},{:.3},,\n",
@@ -210,7 +207,7 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     ];
     let p_csv = env.out.join("surfaces.csv");
     write(&p_csv, &csv)?;
-    let p_md = super::finish_md(env, "surfaces", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Surfaces, md, &found)?;
     files.push(p_csv);
     files.push(p_md);
     Ok((files, found))

@@ -2,7 +2,7 @@
 //! solver, its surge front over time beside their measurements (tests/physics.rs holds
 //! the solvers to it).
 use super::findings::{Finding, Verdict};
-use super::{write, Env, Steps};
+use super::{write, Env, Experiment, Steps};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Labels};
@@ -202,7 +202,7 @@ pub fn surge(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>
     let paper: Vec<(f64, f64)> = MARTIN_MOYCE.to_vec();
     crate::bench::plot::front(&png, &env.meta.device, &series, &paper)?;
     md.push_str("\n![the surge front against Martin & Moyce](surge.png)\n");
-    let p_md = super::finish_md(env, "surge", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Surge, md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
 }
 

@@ -2,8 +2,8 @@
 //! bitonic), the thesis's adaptive-pressure fill test (figures 12/13), and our own
 //! scaling sweep of the SPH step and the renderer.
 use super::findings::{self, Finding, Verdict};
-use super::{write, Env, Steps};
-use crate::bench::Row;
+use super::{write, Env, Experiment, Steps};
+use crate::bench::{Bench, Measurer, Row};
 use crate::config::{ListKind, Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -114,7 +114,7 @@ pub fn fig9(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)
         true => vec![8 << 10, 16 << 10],
         false => crate::bench::emission::COUNTS.to_vec(),
     };
-    let mut opts = env.bench_options("emission", "fig9");
+    let mut opts = env.bench_options(Measurer::Bench(Bench::Emission), Experiment::Fig9);
     let mut steps = Steps::new("fig9", counts.len() as u64, env.switches.common.quiet);
     let mut rows = Vec::new();
     for &n in &counts {
@@ -179,7 +179,7 @@ pub fn fig9(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)
         }
     }
     md.push_str("\n![frames per second against N](fig9.png)\n");
-    let p_md = super::finish_md(env, "fig9", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Fig9, md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
 }
 
@@ -213,13 +213,13 @@ pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Findin
         stops: Vec::new(),
         cap_ms,
     };
-    let mut opts = env.bench_options("sph", "scaling");
+    let mut opts = env.bench_options(Measurer::Bench(Bench::Sph), Experiment::Scaling);
     for (strategy, sort) in strategies {
         scaling_sph(ctx, &mut opts, (strategy, sort), &sph_counts, &mut sw)?;
     }
     // Render: the thesis scene's walker and camera filled with more and more particles.
     let cam = env.scene(ctx)?.camera;
-    let ropts = env.bench_options("render", "scaling");
+    let ropts = env.bench_options(Measurer::Bench(Bench::Render), Experiment::Scaling);
     for list in lists {
         scaling_render(ctx, env, &ropts, list, &render_factors, &cam, &mut sw)?;
     }
@@ -270,7 +270,7 @@ pub fn scaling(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Findin
         }
     }
     md.push_str("\n![cost per particle against N](scaling.png)\n");
-    let p_md = super::finish_md(env, "scaling", md, &found)?;
+    let p_md = super::finish_md(env, Experiment::Scaling, md, &found)?;
     Ok((vec![p_csv, p_md, png], found))
 }
 
@@ -424,10 +424,10 @@ fn render_row(
             opts,
             list.as_str().as_str(),
             n as u64,
-            "render",
+            crate::render::SCOPE,
             detail,
             |prof, cmd| {
-                prof.begin(ctx, cmd, "render");
+                prof.begin(ctx, cmd, crate::render::SCOPE.name());
                 r.record(ctx, cmd, prof, b, &buf, n as u32, cam, 0)?;
                 prof.end(ctx, cmd);
                 Ok(())

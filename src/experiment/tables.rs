@@ -1,5 +1,6 @@
 //! Thesis tables 2-8 (seed 000, section 5): the same rows and columns, the thesis's frame
 //! rates (K1 = GTX 1660 Ti laptop, K2 = GTX 1080 Ti desktop) and list memory beside ours.
+use super::Experiment;
 use crate::config::{DensityFn, ListKind, Material};
 use crate::render::metaball::MetaballSettings;
 
@@ -98,7 +99,7 @@ pub struct RowDef {
 }
 
 pub struct TableDef {
-    pub name: &'static str,
+    pub name: Experiment,
     pub title: &'static str,
     /// The thesis's configuration for this table, and how ours differs.
     pub notes: Vec<&'static str>,
@@ -119,20 +120,16 @@ fn k2(v: [&'static str; 3]) -> Vec<Thesis> {
     v.iter().map(|&x| t("", x)).collect()
 }
 
-pub const NAMES: &[&str] = &[
-    "table2", "table3", "table4", "table5", "table6", "table7", "table8",
-];
-
-/// The definition of a thesis table by name (`NAMES`).
-pub fn def(name: &str) -> Option<TableDef> {
-    Some(match name {
-        "table2" => table2(),
-        "table3" => table3(),
-        "table4" => table4(),
-        "table5" => table5(),
-        "table6" => table6(),
-        "table7" => table7(),
-        "table8" => table8(),
+/// The definition of a thesis table; None for an experiment that is no table.
+pub fn def(e: Experiment) -> Option<TableDef> {
+    Some(match e {
+        Experiment::Table2 => table2(),
+        Experiment::Table3 => table3(),
+        Experiment::Table4 => table4(),
+        Experiment::Table5 => table5(),
+        Experiment::Table6 => table6(),
+        Experiment::Table7 => table7(),
+        Experiment::Table8 => table8(),
         _ => return None,
     })
 }
@@ -150,7 +147,7 @@ fn table2() -> TableDef {
         memory: ("8.7", "5.8"),
     };
     TableDef {
-            name: "table2",
+            name: Experiment::Table2,
             title: "Table 2: materials x metaball lists",
             notes: vec![
                 "Transparent is `--material glass`, partially transparent `--material tinted`, both at recursion depth 2: the thesis does not give table 2's depth, and its 65 fps (K2, S-buffer) lies between its depth-2 and depth-3 rows of tables 6 and 7.",
@@ -181,7 +178,7 @@ fn table3() -> TableDef {
         memory: ("9", "6"),
     };
     TableDef {
-        name: "table3",
+        name: Experiment::Table3,
         title: "Table 3: density functions x metaball lists (Phong)",
         notes: vec![
             "The thesis's \"original\" is Blinn's Gaussian truncated at R (`--density blinn`).",
@@ -224,7 +221,7 @@ fn table4() -> TableDef {
         .map(|ti| (0..3).map(|ri| ri * 3 + ti).collect())
         .collect();
     TableDef {
-            name: "table4",
+            name: Experiment::Table4,
             title: "Table 4: threshold T x radius R (Wyvill, Phong)",
             notes: vec![
                 "The thesis prints one range per radius over the three thresholds (K2, S-buffer), A-buffer memory per radius, and none at 11-12 fps throughout; it gives no A-buffer frame rates.",
@@ -256,7 +253,7 @@ fn table5() -> TableDef {
     })
     .collect();
     TableDef {
-        name: "table5",
+        name: Experiment::Table5,
         title: "Table 5: binary refinement steps I (Phong)",
         notes: vec![],
         cols: three,
@@ -297,7 +294,7 @@ fn table6() -> TableDef {
         }
     }
     TableDef {
-            name: "table6",
+            name: Experiment::Table6,
             title: "Table 6: transparent (glass), recursion depth 1 and 3 x refinement I",
             notes: vec!["sbuffer-sorted is ours (S-buffer ranges sorted by view depth, each sample summing the metaballs within R of its depth); the thesis has no such column."],
             cols: four,
@@ -335,7 +332,7 @@ fn table7() -> TableDef {
     })
     .collect();
     TableDef {
-        name: "table7",
+        name: Experiment::Table7,
         title: "Table 7: partially transparent (tinted), recursion depth 1-3, I = 0",
         notes: vec!["sbuffer-sorted is ours, as in table 6."],
         cols: four,
@@ -364,7 +361,7 @@ fn table8() -> TableDef {
     })
     .collect();
     TableDef {
-            name: "table8",
+            name: Experiment::Table8,
             title: "Table 8: particle count (Phong)",
             notes: vec!["The same walker and camera filled with half, the same and twice the particles (the thesis's 1024, 2048, 4096): the spacing shrinks, the metaball radius stays."],
             cols: three,

@@ -7,7 +7,7 @@ use crate::config::{ListKind, Skinning};
 use crate::control::placement;
 use crate::error::{Error, Result};
 use crate::gpu::{Context, Guard};
-use crate::render::metaball::{MetaballRenderer, MetaballSettings};
+use crate::render::metaball::{FluidRenderer, MetaballSettings};
 use crate::render::Camera;
 use crate::scene::character::CharacterDesc;
 use glam::Vec3;
@@ -143,12 +143,12 @@ impl ThesisScene {
             list: ListKind::Sbuffer,
             width,
             height,
-            ..MetaballSettings::from_switches(&crate::config::Switches::default())?
+            ..crate::settings::metaball_settings(&crate::config::Switches::default())?
         };
         let aspect = width as f32 / height as f32;
         let mut distance = 3.0 * body.height;
         let mut fragments = 0;
-        let r = Guard::new(ctx, MetaballRenderer::new(ctx, settings)?);
+        let r = Guard::new(ctx, FluidRenderer::new(ctx, settings)?);
         let mut b = Guard::new(ctx, r.buffers(ctx, n as u64, 2, false)?);
         let mut buf = ctx.storage_buffer("thesis centers", (n * 16) as u64)?;
         let result = (|| -> Result<()> {

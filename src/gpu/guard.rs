@@ -48,8 +48,8 @@ impl<T: Destroy, const N: usize> Destroy for [T; N] {
 #[macro_export]
 macro_rules! impl_destroy {
     ($($t:ty),* $(,)?) => {$(
-        impl $crate::gpu::Destroy for $t {
-            fn destroy(&mut self, ctx: &$crate::gpu::Context) {
+        impl $crate::Destroy for $t {
+            fn destroy(&mut self, ctx: &$crate::Context) {
                 <$t>::destroy(self, ctx)
             }
         }

@@ -12,13 +12,13 @@ use std::collections::BTreeMap;
 
 /// A byte range of a buffer bound as one binding (passes that split large arrays).
 #[derive(Clone, Copy)]
-pub struct View<'a> {
+pub struct BufferRange<'a> {
     pub buffer: &'a Buffer,
     pub offset: u64,
     pub range: u64,
 }
 
-impl View<'_> {
+impl BufferRange<'_> {
     pub fn info(&self) -> vk::DescriptorBufferInfo {
         vk::DescriptorBufferInfo {
             buffer: self.buffer.raw,
@@ -78,16 +78,16 @@ macro_rules! gpu_interface {
         $(#[$m])*
         $vis struct $name;
         #[doc = concat!("Buffers of one `", stringify!($name), "` dispatch, by binding name.")]
-        $vis struct $bufs<'a> { $(pub $field: &'a $crate::gpu::Buffer),* }
-        impl $crate::gpu::Interface for $name {
+        $vis struct $bufs<'a> { $(pub $field: &'a $crate::Buffer),* }
+        impl $crate::Interface for $name {
             const NAME: &'static str = stringify!($name);
             const PREFIX: &'static str = $prefix;
-            const BINDINGS: &'static [$crate::gpu::BindingDecl] = &[
-                $($crate::gpu::BindingDecl { name: stringify!($field), binding: $n }),*
+            const BINDINGS: &'static [$crate::BindingDecl] = &[
+                $($crate::BindingDecl { name: stringify!($field), binding: $n }),*
             ];
             type Push = $push;
             type Bufs<'a> = $bufs<'a>;
-            fn buffers(b: &$bufs<'_>) -> Vec<(u32, ash::vk::DescriptorBufferInfo)> {
+            fn buffers(b: &$bufs<'_>) -> Vec<(u32, $crate::vk::DescriptorBufferInfo)> {
                 vec![$(($n, b.$field.info())),*]
             }
         }

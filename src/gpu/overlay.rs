@@ -2,7 +2,7 @@
 //! swapchain image, inside the presenter's rendering scope, after the scene's picture. It
 //! records Vulkan commands, so it lives in the GPU core with the presenter.
 use crate::error::{Error, Result};
-use crate::gpu::Context;
+use crate::Context;
 use ash::vk;
 use egui_ash_renderer::{DynamicRendering, Options, Renderer};
 

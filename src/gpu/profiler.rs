@@ -70,8 +70,74 @@ impl Scopes for Profiler {
     }
 }
 
+/// A timestamp scope's key, shared by the code that records the scope and the code that
+/// reads its timings: the names of the scopes open around it and its own, joined by `/`
+/// (`render/density`). The recording code opens it by `name()` inside its parents; a reader
+/// that finds no such scope gets an error naming the ones recorded, never a NaN.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ScopeKey {
+    path: &'static str,
+    name: &'static str,
+}
+
+impl ScopeKey {
+    pub const fn new(path: &'static str) -> Self {
+        let b = path.as_bytes();
+        let mut i = b.len();
+        while i > 0 && b[i - 1] != b'/' {
+            i -= 1;
+        }
+        let name = match std::str::from_utf8(b.split_at(i).1) {
+            Ok(n) => n,
+            Err(_) => path,
+        };
+        Self { path, name }
+    }
+
+    /// The whole path: the key in frame timings, summaries and tables.
+    pub const fn path(self) -> &'static str {
+        self.path
+    }
+
+    /// The scope's own name, opened inside its parent scopes.
+    pub const fn name(self) -> &'static str {
+        self.name
+    }
+
+    /// The error for a reader that did not find this scope among `recorded`.
+    pub fn missing<'a>(self, recorded: impl Iterator<Item = &'a str>) -> Error {
+        let names: Vec<&str> = recorded.collect();
+        Error::Bug(format!(
+            "timestamp scope '{}' was not recorded (recorded: {})",
+            self.path,
+            if names.is_empty() {
+                "none".to_string()
+            } else {
+                names.join(", ")
+            }
+        ))
+    }
+
+    /// This scope's milliseconds in one frame's timing (summed over its repeats).
+    pub fn ms_in(self, t: &FrameTiming) -> Result<f64> {
+        let mut found = t.passes.iter().filter(|(k, _)| k == self.path).peekable();
+        if found.peek().is_none() {
+            return Err(self.missing(t.passes.iter().map(|(k, _)| k.as_str())));
+        }
+        Ok(found.map(|(_, ms)| ms).sum())
+    }
+}
+
+impl std::fmt::Display for ScopeKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.path)
+    }
+}
+
 /// Name of the scope that spans a whole frame.
 pub const FRAME_SCOPE: &str = "frame";
+/// The whole frame: its time is each `FrameTiming`'s `frame_ms`, not one of its passes.
+pub const FRAME: ScopeKey = ScopeKey::new(FRAME_SCOPE);
 
 impl Profiler {
     /// `slots` frames in flight.

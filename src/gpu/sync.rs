@@ -143,7 +143,7 @@ impl Context {
             let bt = std::backtrace::Backtrace::force_capture().to_string();
             let at: Vec<&str> = bt
                 .lines()
-                .filter(|l| l.contains("fluidform::") && !l.contains("gpu::"))
+                .filter(|l| l.contains("fluidform") && !l.contains("fluidform_gpu::"))
                 .take(3)
                 .collect();
             eprintln!("track: place={place} {need:?} at {}", at.join(" < "));

@@ -43,7 +43,7 @@ impl FrameWork for CharacterWork {
                 "a character scene with its mesh hidden".into(),
             ));
         };
-        let layers = crate::viewer::Layers {
+        let layers = crate::run::view::Layers {
             mesh: m.as_ref(),
             overlay: None,
         };

@@ -29,7 +29,7 @@ pub struct LiveStats {
     pub particles: u32,
     pub sim_time: f64,
     pub steps: u64,
-    pub render: crate::viewer::RenderSummary,
+    pub render: crate::run::view::RenderSummary,
     pub memory_bytes: u64,
     pub control: Vec<crate::control::metrics::ControlRow>,
 }

@@ -1,27 +1,29 @@
 //! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
-//! Every scene kind is a `FrameWork` played by `session::play`.
+//! Every scene kind is a `FrameWork` played by `common::play`.
 use crate::animation::Animation;
 use crate::config::Switches;
 use crate::config::{Neighbors, RenderKind, ShowMesh, Skinning, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::target::save_rgba;
+use crate::gpu::vk;
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
 use crate::render::Camera;
 use crate::report::{Report, Summary};
+pub use crate::run::common::{camera_with_switches, check_validation, SLOTS};
+use crate::run::common::{open, play};
+use crate::run::view::{FluidView, Picture, PointsViewer};
 use crate::scene::character::{CharacterStats, SceneCharacter};
-pub use crate::session::{camera_with_switches, check_validation, SLOTS};
-use crate::session::{open, play};
 use crate::sph::FluidParams;
-use crate::viewer::{Picture, PointsViewer, View};
-use ash::vk;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod character;
+pub mod common;
 pub mod live;
 mod orbits;
 pub mod particles;
 mod sph;
+pub mod view;
 use character::run_character;
 use orbits::run_orbits;
 use sph::run_sph;
@@ -69,7 +71,7 @@ pub struct OrbitsStats {
 #[serde(deny_unknown_fields)]
 pub struct CharacterRunStats {
     pub character: CharacterStats,
-    pub render: crate::viewer::RenderSummary,
+    pub render: crate::run::view::RenderSummary,
 }
 
 /// `stats` of a run, by scene kind.
@@ -77,10 +79,10 @@ pub struct CharacterRunStats {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct SphRunStats {
     #[serde(flatten)]
-    pub physics: crate::sph::run::PhysicsStats,
+    pub physics: crate::sph::stepper::PhysicsStats,
     pub steps: u64,
     pub simulated_seconds: f64,
-    pub render: crate::viewer::RenderSummary,
+    pub render: crate::run::view::RenderSummary,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub character: Option<crate::scene::character::CharacterStats>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

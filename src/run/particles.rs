@@ -1,6 +1,7 @@
 //! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
 use crate::config::Group;
 use crate::error::Result;
+use crate::gpu::vk;
 use crate::gpu::{ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
 use crate::kinds::{Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
 use crate::psys::character::{CharacterBufs, CharacterLink};
@@ -10,12 +11,11 @@ use crate::psys::spec::SystemSpec;
 use crate::psys::system::{FrameInfo, ParticleSystem};
 use crate::render::mesh::MeshView;
 use crate::render::Camera;
+use crate::run::common::{camera_with_switches, open, play, SLOTS};
+use crate::run::view::Picture;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
 use crate::scene::character::SceneCharacter;
 use crate::scene::particles::ParticleScene;
-use crate::session::{camera_with_switches, open, play, SLOTS};
-use crate::viewer::Picture;
-use ash::vk;
 use serde::{Deserialize, Serialize};
 
 /// One system's totals in summary.json.
@@ -190,7 +190,7 @@ pub struct SystemsFrame<'a> {
     frame: u64,
 }
 
-impl crate::viewer::Overlay for SystemsFrame<'_> {
+impl crate::run::view::Overlay for SystemsFrame<'_> {
     fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, opaque: bool) {
         self.scene.prepare_draws(ctx, cmd, self.frame, opaque);
     }

@@ -6,8 +6,8 @@ use super::*;
 pub(super) struct SphWork {
     solver: crate::sph::SphSolver,
     st: crate::sph::SphState,
-    stepper: crate::sph::run::Stepper,
-    view: Box<dyn crate::viewer::View>,
+    stepper: crate::sph::stepper::Stepper,
+    view: Box<dyn crate::run::view::FluidView>,
     pub(super) frames: Frames,
     export: Option<crate::export::ParticleExport>,
     targets: crate::scene::targets::SceneTargets,
@@ -41,9 +41,11 @@ impl FrameWork for SphWork {
         let st = &self.st;
         let mesh = self.targets.draw();
         let overlay = self.systems.as_ref().map(|s| s.at(frame));
-        let layers = crate::viewer::Layers {
+        let layers = crate::run::view::Layers {
             mesh: mesh.as_ref(),
-            overlay: overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay),
+            overlay: overlay
+                .as_ref()
+                .map(|o| o as &dyn crate::run::view::Overlay),
         };
         self.view.record(
             ctx,
@@ -71,7 +73,9 @@ impl FrameWork for SphWork {
         }
         let save = self.frames.save(frame);
         let overlay = self.systems.as_ref().map(|s| s.at(frame));
-        let overlay = overlay.as_ref().map(|o| o as &dyn crate::viewer::Overlay);
+        let overlay = overlay
+            .as_ref()
+            .map(|o| o as &dyn crate::run::view::Overlay);
         let pic = self.view.retire(ctx, slot, self.st.n, save, overlay)?;
         self.frames.store(frame, pic)?;
         checked
@@ -120,11 +124,11 @@ impl SphWork {
         Ok(())
     }
 
-    pub(super) fn stepper(&self) -> &crate::sph::run::Stepper {
+    pub(super) fn stepper(&self) -> &crate::sph::stepper::Stepper {
         &self.stepper
     }
 
-    pub(super) fn stepper_mut(&mut self) -> &mut crate::sph::run::Stepper {
+    pub(super) fn stepper_mut(&mut self) -> &mut crate::sph::stepper::Stepper {
         &mut self.stepper
     }
 
@@ -144,7 +148,11 @@ impl SphWork {
     }
 
     /// Use `view` from the next frame on (no frame may be in flight).
-    pub(super) fn replace_view(&mut self, ctx: &Context, view: Box<dyn crate::viewer::View>) {
+    pub(super) fn replace_view(
+        &mut self,
+        ctx: &Context,
+        view: Box<dyn crate::run::view::FluidView>,
+    ) {
         self.view.destroy(ctx);
         self.view = view;
         self.frames.latest = None;
@@ -156,7 +164,7 @@ impl SphWork {
         (self.st.n, s.sim_time, s.steps_taken)
     }
 
-    pub(super) fn render_stats(&self) -> crate::viewer::RenderSummary {
+    pub(super) fn render_stats(&self) -> crate::run::view::RenderSummary {
         self.view.stats()
     }
 
@@ -299,8 +307,8 @@ pub(super) fn make_view(
     cam: &Camera,
     n: u32,
     show: ShowMesh,
-) -> Result<Box<dyn View>> {
-    use crate::viewer::MetaballViewer;
+) -> Result<Box<dyn FluidView>> {
+    use crate::run::view::MetaballViewer;
     Ok(match render {
         RenderKind::Metaballs => {
             let tank = (scene.look.tank)
@@ -368,7 +376,7 @@ impl SphWork {
         render: RenderKind,
         neighbors: Neighbors,
     ) -> Result<Self> {
-        use crate::sph::run::Stepper;
+        use crate::sph::stepper::Stepper;
         use crate::sph::SphSolver;
         let mut solver = Guard::new(ctx, SphSolver::new(ctx, neighbors, sw.sorting.sort)?);
         let parts = scene.particles(sw.common.seed);
@@ -428,7 +436,7 @@ impl SphWork {
         frame_count: u64,
         timings: Result<Vec<crate::gpu::FrameTiming>>,
     ) -> Result<RunResult> {
-        use crate::sph::run::{check, physics_stats};
+        use crate::sph::stepper::{check, physics_stats};
         let memory = ctx.memory_bytes();
         let ok = timings.is_ok();
         let dump = ok.then(|| self.st.read(ctx));

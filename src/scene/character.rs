@@ -3,9 +3,9 @@
 use crate::character::{self, anim, anim::Up, skin::Skinner, Animator, Character};
 use crate::config::{ShowMesh, Skinning};
 use crate::error::{Error, Result};
+use crate::gpu::vk;
 use crate::gpu::{Context, Guard};
 use crate::render::mesh::MeshDraw;
-use ash::vk;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 

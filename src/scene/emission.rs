@@ -9,8 +9,8 @@ use crate::config::{EmitterKind, Switches};
 use crate::emission::emit::EmitSettings;
 use crate::emission::emitter::Emitter;
 use crate::error::{Error, Result};
+use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, MemoryLocation};
-use ash::vk;
 use serde::{Deserialize, Serialize};
 
 fn yes() -> bool {

@@ -1,7 +1,7 @@
 //! Test scene: particles orbiting an attractor inside a box, moved by one compute pass.
 use crate::error::Result;
+use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
-use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use rand::{Rng, SeedableRng};
 

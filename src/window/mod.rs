@@ -166,7 +166,7 @@ pub fn view(opts: ViewOptions) -> Result<()> {
     })();
     presenter.destroy(&ctx);
     let walls = played?;
-    crate::session::check_validation(&ctx)?;
+    crate::run::common::check_validation(&ctx)?;
     // Resizes, rebuilds and resets make and free buffers: none may be left over.
     let (mem, objects) = (ctx.memory_bytes(), ctx.live_objects());
     if !mem.is_empty() || !objects.is_empty() {

@@ -2,7 +2,7 @@
 //! OBJ reader (tobj) and a PLY header check: closed, facing out, and holding the particles'
 //! volume within 10%.
 use super::common::{fluidform, summary, text};
-use fluidform::surface::Mesh;
+use fluidform::isosurface::Mesh;
 
 #[test]
 fn exported_surfaces_are_closed_and_hold_the_fluids_volume() {

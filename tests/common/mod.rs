@@ -120,7 +120,7 @@ pub fn random_u32(n: usize, seed: u64) -> Vec<u32> {
 
 /// Distance from `p` to triangle (a, b, c) (the library's, Ericson 5.1.5).
 #[allow(unused_imports)]
-pub use fluidform::control::surface::tri_distance;
+pub use fluidform::control::mesh_distance::tri_distance;
 
 /// The dam break's scene with `fluid` in a box from the origin to `domain`, filled with
 /// `blocks` (with none, a 10 cm cube: a scene needs some fluid; tests that bring their

@@ -1,4 +1,4 @@
-//! The kernels of `--kernel` (src/sph/kernel.rs) against numerical integration: each
+//! The kernels of `--kernel` (src/sim/sph/kernel.rs) against numerical integration: each
 //! normalised, its gradient W's derivative, its wall terms the integrals over a solid
 //! half-space, and a rest lattice's density at the kernel's default support.
 use fluidform::config::Solver;

@@ -1,6 +1,6 @@
 // Metaball rendering (seed 000, section 4): parameters, bindings, density functions and
-// the per-pixel metaball lists. Bindings: MetaballIo in src/render/metaball/renderer.rs
-// (MB_B_* defines); RenderParams and RenderStats mirror src/render/metaball/settings.rs
+// the per-pixel metaball lists. Bindings: MetaballIo in src/sim/render/metaball/renderer.rs
+// (MB_B_* defines); RenderParams and RenderStats mirror src/sim/render/metaball/settings.rs
 // and stats.rs (field offsets tested). Defines from Rust: LIST (LIST_NONE | LIST_ABUFFER |
 // LIST_SBUFFER | LIST_TILES), SORTED (1: S-buffer ranges sorted by depth), DENSITY (DENSITY_BLINN |
 // _WYVILL | _NISHIMURA | _MURAKAMI), MATERIAL (MATERIAL_PHONG | _GLASS | _TINTED | _METAL).
@@ -26,7 +26,7 @@ layout(std430, binding = MB_B_DEPTHS) buffer Depths { float depths[]; };  // vie
 layout(std430, binding = MB_B_OPAQUE) readonly buffer Opaque { uint opaque[]; };
 // With the opaque layer: the NDC depth of the first surface each primary ray meets (march.comp).
 layout(std430, binding = MB_B_SCENE_DEPTH) writeonly buffer SceneDepth { float scene_depth[]; };
-// Per-tile lists (src/render/metaball/tiles.rs): each metaball's pixel rectangle (x0 | y0
+// Per-tile lists (src/sim/render/metaball/tiles.rs): each metaball's pixel rectangle (x0 | y0
 // << 16, x1 | y1 << 16), its depth key and index sorted front to back, each depth rank's
 // first pair (W scanned), the (tile, metaball) pairs by key tile << rank_bits | rank, then
 // sorted, each sorted pair's metaball (xyz, view depth), each tile's pair range [x, y).
@@ -49,7 +49,7 @@ float view_depth(vec3 x) {
 float radius() { return P.eye.w; }
 float threshold() { return P.base.w; }
 
-// D(r) from r^2, normalised to D(0) = 1, zero from R on (src/render/metaball/density.rs).
+// D(r) from r^2, normalised to D(0) = 1, zero from R on (src/sim/render/metaball/density.rs).
 const float BLINN_A = 4.0;
 float density2(float r2) {
     float R = radius();

@@ -1,5 +1,5 @@
 #version 450
-// Per-tile lists, step 1 (src/render/metaball/tiles.rs): each metaball's pixel rectangle
+// Per-tile lists, step 1 (src/sim/render/metaball/tiles.rs): each metaball's pixel rectangle
 // (the billboard's, sphere_rect), its view depth and a depth key whose unsigned order is
 // the depths' order; the depth sort then orders (ball_keys, ball_ids) front to back.
 #include "common/index.glsl"

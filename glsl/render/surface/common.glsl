@@ -1,6 +1,6 @@
-// The surfaces beside the metaballs (src/render/surface): screen-space fluid and marching
+// The surfaces beside the metaballs (src/sim/render/surface): screen-space fluid and marching
 // cubes write one G-buffer that shade.comp lights with the metaballs' materials. Bindings:
-// SurfaceIo in src/render/surface/mod.rs (SF_B_* defines); Push mirrors SurfacePush there.
+// SurfaceIo in src/sim/render/surface/mod.rs (SF_B_* defines); Push mirrors SurfacePush there.
 #ifndef SURFACE_COMMON_GLSL
 #define SURFACE_COMMON_GLSL
 #include "render/params.glsl"
@@ -24,7 +24,7 @@ layout(std430, binding = SF_B_SMOOTHED) buffer Smoothed { vec2 smoothed[]; };
 // Marching cubes: the density over the rest density at the grid's nodes, x fastest, in
 // 1/GRID_SCALE (atomic adds).
 layout(std430, binding = SF_B_GRID) buffer Grid { uint grid[]; };
-// The case table from src/surface/table.rs: 257 offsets into the triangles, 12 edges
+// The case table from src/sim/isosurface/table.rs: 257 offsets into the triangles, 12 edges
 // (corner a | corner b << 4), then triangles (edge e0 | e1 << 4 | e2 << 8).
 layout(std430, binding = SF_B_CASES) readonly buffer Cases { uint cases[]; };
 // Triangle soup: per vertex (position, 1), (unit normal out of the fluid, 0).
@@ -38,9 +38,9 @@ layout(push_constant) uniform Push {
     vec4 fluid;   // x: smoothing length h, y: particle volume m / rho0, z: poly6 constant, w: splat radius
     vec4 look;    // x: iso level, y: smoothing axis (0: x, 1: y), z: filter half-width cap (pixels)
 } pc;
-// GRID_SCALE and THICK_SCALE: the fixed points, from src/render/surface/mod.rs.
+// GRID_SCALE and THICK_SCALE: the fixed points, from src/sim/render/surface/mod.rs.
 #if !defined(GRID_SCALE) || !defined(THICK_SCALE)
-#error "GRID_SCALE and THICK_SCALE come from src/render/surface/mod.rs"
+#error "GRID_SCALE and THICK_SCALE come from src/sim/render/surface/mod.rs"
 #endif
 const uint NO_DEPTH = 0xFFFFFFFFu;
 

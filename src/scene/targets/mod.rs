@@ -12,6 +12,7 @@ use crate::control::timeline::{FiredEvent, Timeline};
 use crate::emission::emitter::{EmitSource, Emitter};
 use crate::emission::layout::UvLayout;
 use crate::error::Result;
+use crate::gpu::vk;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
 use crate::scene::schema::MAIN_TARGET;
@@ -19,7 +20,6 @@ use crate::scene::Scene;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::{SphSolver, SphState};
-use ash::vk;
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
@@ -125,7 +125,7 @@ impl SceneTargets {
                         solver,
                         &character.ch,
                         &character.anim,
-                        &d.with_switches(sw)?,
+                        &crate::settings::control_with_switches(d, sw)?,
                         &scene.fluid,
                         (scene.domain.min, scene.domain.max),
                         (sw.common.seed, method),

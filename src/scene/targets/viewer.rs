@@ -16,7 +16,7 @@ impl SceneTargets {
             let (Some((c, _)), Some(d)) = (&l.control, &l.desc) else {
                 continue;
             };
-            let nd = d.with_switches(sw)?;
+            let nd = crate::settings::control_with_switches(d, sw)?;
             let s = nd.settings(fluid);
             s.validate()?;
             let (o, od) = (&c.force.settings, &c.desc);

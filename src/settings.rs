@@ -1,0 +1,140 @@
+//! The switches turned into the lower crates' own settings, at the application's edge:
+//! the simulation crate takes `MetaballSettings` and `ControlDesc`, never `Switches`.
+use crate::config::Switches;
+use crate::control::target::ControlDesc;
+use crate::error::{Error, Result};
+use crate::kinds::{BuildKind, DensityFn, ListKind, MarchKind, Material, SurfaceKind};
+use crate::render::metaball::MetaballSettings;
+
+/// The metaball settings: the thesis's defaults (Wyvill, T = 0.9, R = 0.04, I = 2, Phong, S-buffer),
+/// overridden by the switches that are set.
+pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
+    let radius = sw.metaball.radius.unwrap_or(0.04);
+    let mut s = MetaballSettings {
+        list: sw.metaball.list.unwrap_or(ListKind::Sbuffer),
+        density: sw.metaball.density.unwrap_or(DensityFn::Wyvill),
+        material: sw.metaball.material.unwrap_or(Material::Phong),
+        threshold: sw.metaball.threshold.unwrap_or(0.9),
+        radius,
+        refine: sw.metaball.refine.unwrap_or(2),
+        depth: sw.metaball.depth.unwrap_or(1),
+        step: radius / 8.0,
+        max_steps: 2048,
+        march: sw.metaball.march.unwrap_or(MarchKind::Fixed),
+        build: sw.metaball.build.unwrap_or(BuildKind::Raster),
+        tile: sw.metaball.tile.unwrap_or(16),
+        offscreen_end: sw
+            .metaball
+            .offscreen
+            .map(|o| o == crate::kinds::Offscreen::End)
+            .unwrap_or(false),
+        // Sorting pays where rays read the lists many times: inside glass and tinted.
+        sorted: match sw.metaball.list_sort {
+            Some(o) => o == crate::kinds::OnOff::On,
+            None => matches!(
+                sw.metaball.material,
+                Some(Material::Glass) | Some(Material::Tinted)
+            ),
+        },
+        width: sw.frame.width(),
+        height: sw.frame.height(),
+        ior: 1.33,
+        absorb: [6.0, 2.0, 0.8],
+        base: [0.08, 0.06, 0.05],
+        tank: None,
+        sky: sw.metaball.sky.clone(),
+        opaque: false,
+        surface: sw.metaball.surface.unwrap_or(SurfaceKind::Metaballs),
+        mesh_cell: sw.metaball.mesh_cell.unwrap_or(0.5),
+        fluid: None,
+    };
+    if s.surface != SurfaceKind::Metaballs {
+        let m = &sw.metaball;
+        let listed = [
+            ("--list", m.list.is_some()),
+            ("--density", m.density.is_some()),
+            ("--threshold", m.threshold.is_some()),
+            ("--refine", m.refine.is_some()),
+            ("--offscreen", m.offscreen.is_some()),
+            ("--list-sort", m.list_sort.is_some()),
+            ("--march", m.march.is_some()),
+            ("--build", m.build.is_some()),
+            ("--tile", m.tile.is_some()),
+        ];
+        if let Some((name, _)) = listed.iter().find(|(_, set)| *set) {
+            return Err(Error::Param(format!(
+                "{name} belongs to the metaball surface, not --surface {}",
+                s.surface.as_str()
+            )));
+        }
+        // Nothing is listed or marched.
+        s.list = ListKind::None;
+        s.sorted = false;
+    } else if sw.metaball.mesh_cell.is_some() {
+        return Err(Error::Param("--mesh-cell belongs to --surface mesh".into()));
+    }
+    match (s.list, sw.metaball.build) {
+        (ListKind::Tiles, Some(BuildKind::Raster)) => {
+            return Err(Error::Param(
+                "--list tiles is built in compute (its pairs are sorted by tile and depth); \
+                 --build raster applies to the S-buffer"
+                    .into(),
+            ))
+        }
+        (ListKind::Tiles, _) => s.build = BuildKind::Compute,
+        _ => {}
+    }
+    if sw.metaball.tile.is_some() && s.build != BuildKind::Compute {
+        return Err(Error::Param(format!(
+            "--tile sets the tiles of --list tiles and --build compute, not --list {} \
+             built by raster",
+            s.list.as_str()
+        )));
+    }
+    if sw.metaball.list_sort.is_some() && s.list != ListKind::Sbuffer {
+        return Err(Error::Param(format!(
+            "--list-sort applies to the S-buffer's contiguous ranges, not --list {}",
+            s.list.as_str()
+        )));
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+/// `desc` with the control switches applied.
+pub fn control_with_switches(desc: &ControlDesc, sw: &Switches) -> Result<ControlDesc> {
+    let c = &sw.control;
+    let thresholds = pair("--adaptive-thresholds", &c.adaptive_thresholds)?;
+    let factors = pair("--adaptive-factors", &c.adaptive_factors)?;
+    Ok(ControlDesc {
+        placement: c.placement.unwrap_or(desc.placement),
+        spacing: c.control_spacing.or(desc.spacing),
+        bone_weights: c.bone_weights.unwrap_or(desc.bone_weights),
+        pressure: c.control_pressure.unwrap_or(desc.pressure),
+        radius: c.control_radius.or(desc.radius),
+        adaptive: c.adaptive.unwrap_or(desc.adaptive),
+        thresholds: thresholds.unwrap_or(desc.thresholds),
+        factors: factors.unwrap_or(desc.factors),
+        velocity: c.control_velocity.or(desc.velocity),
+        preset: c.control_preset.or(desc.preset),
+        attraction: c.control_attraction.or(desc.attraction),
+        reach: c.control_reach.or(desc.reach),
+        damping: c.control_damping.or(desc.damping),
+        motion: c.control_motion.or(desc.motion),
+        deficit: c.control_deficit.or(desc.deficit),
+        group: desc.group,
+        every: c.control_every.or(desc.every),
+    })
+}
+
+/// The two values of switch `name`, if given.
+fn pair(name: &str, v: &Option<Vec<f32>>) -> Result<Option<[f32; 2]>> {
+    match v.as_deref() {
+        None => Ok(None),
+        Some([a, b]) => Ok(Some([*a, *b])),
+        Some(v) => Err(Error::Param(format!(
+            "{name} takes two numbers separated by a comma, got {}",
+            v.len()
+        ))),
+    }
+}

@@ -1,0 +1,15 @@
+//! Control particles (seed 000, section 3): placement inside a character's mesh, binding to
+//! its skeleton, and the inside tests they need.
+pub mod binding;
+pub mod cache;
+pub mod fidelity;
+pub mod force;
+pub mod grid;
+pub mod inside;
+pub mod mesh_distance;
+pub mod metrics;
+pub mod placement;
+pub mod rays;
+pub mod settings;
+pub mod target;
+pub mod timeline;

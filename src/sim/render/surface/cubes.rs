@@ -1,0 +1,84 @@
+//! Marching cubes on the GPU over the SPH density (as splashsurf meshes particle fluids):
+//! the particles' poly6 density on a grid over the fluid's bounds, every cell's triangles
+//! appended to a soup whose count drives an indirect draw, and the soup rasterised into
+//! the G-buffer in two passes (nearest depth and thickness, then the nearest fragment's
+//! interpolated normal). Checked against `crate::isosurface::march` on the same grid.
+use super::{compute_pass, raster_pass, Rec, SurfaceIo};
+use crate::error::Result;
+use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::track::BufferUse;
+use crate::gpu::vk;
+use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, ScopeKey, Scopes};
+
+/// The mesh surface's timestamp scopes, inside the frame's rendering scope.
+pub const DENSITY_SCOPE: ScopeKey = ScopeKey::new("render/density");
+pub const CELLS_SCOPE: ScopeKey = ScopeKey::new("render/cells");
+pub const RASTER_SCOPE: ScopeKey = ScopeKey::new("render/raster");
+
+type Graphics = GraphicsPipeline<SurfaceIo>;
+
+pub struct Cubes {
+    density: ComputePipeline<SurfaceIo>,
+    cells: ComputePipeline<SurfaceIo>,
+    /// PASS 0: depth and thickness; PASS 1: normals.
+    raster: [Graphics; 2],
+}
+
+impl Cubes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let density = compute_pass(ctx, "density", "render/surface/density.comp")?;
+        let cells = compute_pass(ctx, "cells", "render/surface/cells.comp")?;
+        let shaders = ("render/surface/mesh.vert", "render/surface/mesh.frag");
+        let depth = raster_pass(ctx, "mesh depth", shaders, Some(0))?;
+        let normals = raster_pass(ctx, "mesh normals", shaders, Some(1))?;
+        Ok(Self {
+            density: density.take(),
+            cells: cells.take(),
+            raster: [depth.take(), normals.take()],
+        })
+    }
+
+    pub(super) fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        r: &Rec,
+    ) -> Result<()> {
+        let (bufs, push, b) = (&r.bufs, &r.push, r.b);
+        scopes.begin(ctx, cmd, DENSITY_SCOPE.name());
+        ctx.fill(cmd, &b.grid, 0);
+        // The draw's arguments, then the box of nodes reached (empty).
+        let m = u32::MAX;
+        ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0, m, m, m, 0, 0, 0]);
+        self.density.dispatch(ctx, cmd, bufs, push, r.n as u64);
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, CELLS_SCOPE.name());
+        self.cells.dispatch(ctx, cmd, bufs, push, b.shape.cells());
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, RASTER_SCOPE.name());
+        ctx.fill(cmd, &b.zbits, u32::MAX);
+        ctx.fill(cmd, &b.thick, 0);
+        ctx.fill(cmd, &b.gbuf, 0);
+        let (w, h) = b.size;
+        for pass in &self.raster {
+            pass.prepare(ctx, cmd, bufs);
+            ctx.prepare_draws(cmd, &[BufferUse::indirect(b.args.raw)]);
+            begin_empty_rendering(ctx, cmd, w, h);
+            pass.bind(ctx, cmd, bufs, push);
+            ctx.draw_indirect(cmd, &b.args, 0);
+            ctx.end_rendering(cmd);
+        }
+        scopes.end(ctx, cmd);
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.density.destroy(ctx);
+        self.cells.destroy(ctx);
+        for p in &mut self.raster {
+            p.destroy(ctx);
+        }
+    }
+}
+crate::impl_destroy!(Cubes);

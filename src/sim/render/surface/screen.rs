@@ -1,0 +1,66 @@
+//! Screen-space fluid (van der Laan, Green & Sainz 2009): particles splatted as spheres
+//! into the nearest depth and an additive thickness, a separable bilateral filter of the
+//! depth (x, then y), and normals from the smoothed depth into the G-buffer.
+use super::{compute_pass, raster_pass, Rec, SurfaceIo};
+use crate::error::Result;
+use crate::gpu::target::begin_empty_rendering;
+use crate::gpu::vk;
+use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, Scopes};
+
+pub struct ScreenSpace {
+    splat: GraphicsPipeline<SurfaceIo>,
+    smooth: ComputePipeline<SurfaceIo>,
+    normals: ComputePipeline<SurfaceIo>,
+}
+
+impl ScreenSpace {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let shaders = ("render/surface/splat.vert", "render/surface/splat.frag");
+        let splat = raster_pass(ctx, "splat", shaders, None)?;
+        let smooth = compute_pass(ctx, "smooth", "render/surface/smooth.comp")?;
+        let normals = compute_pass(ctx, "normals", "render/surface/normals.comp")?;
+        Ok(Self {
+            splat: splat.take(),
+            smooth: smooth.take(),
+            normals: normals.take(),
+        })
+    }
+
+    pub(super) fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        r: &Rec,
+    ) {
+        let (bufs, push, b, n) = (&r.bufs, &r.push, r.b, r.n);
+        let px = b.pixels;
+        scopes.begin(ctx, cmd, "splat");
+        ctx.fill(cmd, &b.zbits, u32::MAX);
+        ctx.fill(cmd, &b.thick, 0);
+        self.splat.prepare(ctx, cmd, bufs);
+        let (width, height) = b.size;
+        begin_empty_rendering(ctx, cmd, width, height);
+        self.splat.bind(ctx, cmd, bufs, push);
+        ctx.draw(cmd, 6, n);
+        ctx.end_rendering(cmd);
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "smooth");
+        for axis in [0.0, 1.0] {
+            let mut p = *push;
+            p.look[1] = axis;
+            self.smooth.dispatch(ctx, cmd, bufs, &p, px);
+        }
+        scopes.end(ctx, cmd);
+        scopes.begin(ctx, cmd, "normals");
+        self.normals.dispatch(ctx, cmd, bufs, push, px);
+        scopes.end(ctx, cmd);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.splat.destroy(ctx);
+        self.smooth.destroy(ctx);
+        self.normals.destroy(ctx);
+    }
+}
+crate::impl_destroy!(ScreenSpace);
