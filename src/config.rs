@@ -111,10 +111,10 @@ pub struct NeighborArgs {
 #[derive(Args, Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct FluidArgs {
     /// Override a fluid parameter of an SPH scene, e.g. --fluid viscosity=1.5
-    /// --fluid eos=tait (repeatable; the keys of a scene file's [fluid] table)
+    /// --fluid eos=tait (repeatable; the keys of a scene file's `[fluid]` table)
     #[arg(long = "fluid", value_name = "KEY=VALUE")]
     pub fluid: Vec<String>,
-    /// SPH pressure solver (default: the scene's [fluid] solver, else wcsph)
+    /// SPH pressure solver (default: the scene's `[fluid]` solver, else wcsph)
     #[arg(long, value_parser = choice::<Solver>())]
     pub solver: Option<Solver>,
     /// SPH smoothing kernel, one for densities and pressure gradients: muller (the

@@ -309,8 +309,18 @@ fn overview() -> String {
          Benchmarks (fluidform bench NAME --help): {}\n\
          Experiments (fluidform experiment NAME): {}, all, list\n\
          Built-in scenes: fluidform scene list. Documentation: README.md and docs/.",
-        names(fluidform::bench::Bench::all().iter().map(|b| b.as_str()).collect()),
-        names(fluidform::experiment::Experiment::all().iter().map(|e| e.as_str()).collect()),
+        names(
+            fluidform::bench::Bench::all()
+                .iter()
+                .map(|b| b.as_str())
+                .collect()
+        ),
+        names(
+            fluidform::experiment::Experiment::all()
+                .iter()
+                .map(|e| e.as_str())
+                .collect()
+        ),
     )
 }
 

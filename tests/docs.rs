@@ -75,13 +75,23 @@ fn the_readme_is_short_and_links_every_chapter() {
     }
 }
 
-/// The commands shown in indented code lines: (page, words after `fluidform`). Lines with
-/// placeholders (`[...]`, `a|b`, `<name>`, `N`-style metavariables) are synopses, not commands.
+/// Inline code spans: the text between pairs of backticks.
+fn spans(text: &str) -> Vec<&str> {
+    text.split('`').skip(1).step_by(2).collect()
+}
+
+/// The commands shown in indented code lines and inline code: (page, words after
+/// `fluidform`). Those with placeholders (`[...]`, `a|b`, `<name>`, `...`, `FILE`-style
+/// metavariables) are synopses, not commands.
 fn commands() -> Vec<(PathBuf, Vec<String>)> {
     let mut out = Vec::new();
     for page in pages() {
         let text = std::fs::read_to_string(&page).unwrap();
-        for line in text.lines().filter(|l| l.starts_with("    ")) {
+        let indented = text.lines().filter(|l| l.starts_with("    "));
+        let inline = spans(&text)
+            .into_iter()
+            .filter(|s| s.starts_with("fluidform"));
+        for line in indented.chain(inline) {
             let line = line.split("  #").next().unwrap().trim();
             let Some(at) = line
                 .find("fluidform ")
@@ -89,14 +99,20 @@ fn commands() -> Vec<(PathBuf, Vec<String>)> {
             else {
                 continue;
             };
-            let before = &line[..at];
-            // `xvfb-run -a fluidform ...` runs it; `FLUIDFORM_BIN=./fluidform scripts/...`
-            // names the binary for a script.
-            if before.contains('=') || before.contains('/') || !line[at..].starts_with("fluidform")
-            {
+            // Run as is, or under Xvfb; not a word inside prose or a path.
+            let before = line[..at].trim();
+            if !(before.is_empty() || before == "xvfb-run -a") {
                 continue;
             }
             let cmd = line[at + "fluidform".len()..].trim();
+            let commands = [
+                "devices", "run", "view", "bench", "plot", "scene", "inspect",
+            ];
+            let first = cmd.split_whitespace().next().unwrap_or("");
+            let named = commands.contains(&first) || ["experiment", "compare"].contains(&first);
+            if !(first.is_empty() || first.starts_with("--") || named) {
+                continue; // prose or a diagram naming the crate
+            }
             let synopsis = cmd.contains('[')
                 || cmd.contains('|')
                 || cmd.contains('<')
@@ -121,7 +137,7 @@ fn commands() -> Vec<(PathBuf, Vec<String>)> {
 #[test]
 fn every_command_shown_parses() {
     let cmds = commands();
-    assert!(cmds.len() >= 20, "only {} commands found", cmds.len());
+    assert!(cmds.len() >= 12, "only {} commands found", cmds.len());
     for (page, args) in &cmds {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_fluidform"))
             .args(args)
@@ -160,4 +176,81 @@ fn every_script_named_exists() {
         }
     }
     assert!(checked >= 5, "only {checked} script names checked");
+}
+
+/// Every long option of every command: the words `--name` in each command's --help.
+fn cli_options() -> std::collections::BTreeSet<String> {
+    let help = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_fluidform"))
+            .args(args)
+            .arg("--help")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "fluidform {} --help", args.join(" "));
+        String::from_utf8_lossy(&o.stdout).to_string()
+    };
+    let mut text = help(&[]);
+    for cmd in [
+        "devices",
+        "run",
+        "view",
+        "plot",
+        "inspect",
+        "experiment",
+        "compare",
+        "scene",
+    ] {
+        text.push_str(&help(&[cmd]));
+    }
+    for b in fluidform::bench::Bench::all() {
+        text.push_str(&help(&["bench", &b.as_str()]));
+    }
+    options_in(&text)
+}
+
+/// The `--name` words of `text`.
+fn options_in(text: &str) -> std::collections::BTreeSet<String> {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+        .filter(|w| w.starts_with("--") && w.len() > 2 && w.as_bytes()[2].is_ascii_lowercase())
+        .map(|w| w.trim_end_matches('-').to_string())
+        .collect()
+}
+
+#[test]
+fn every_switch_named_exists() {
+    let known = cli_options();
+    // Options of the scripts and of other tools the pages show (cargo, xvfb-run, apt).
+    let mut others = String::new();
+    for e in std::fs::read_dir(root().join("scripts")).unwrap() {
+        others.push_str(&std::fs::read_to_string(e.unwrap().path()).unwrap_or_default());
+    }
+    let others = options_in(&others);
+    let tools = [
+        "--release",
+        "--test-threads",
+        "--all-targets",
+        "--no-deps",
+        "--features",
+    ];
+    let mut checked = 0;
+    for page in pages() {
+        let text = std::fs::read_to_string(&page).unwrap();
+        let code: Vec<&str> = text
+            .lines()
+            .filter(|l| l.starts_with("    "))
+            .chain(spans(&text))
+            .collect();
+        for opt in options_in(&code.join("\n")) {
+            if others.contains(&opt) || tools.contains(&opt.as_str()) {
+                continue;
+            }
+            assert!(
+                known.contains(&opt),
+                "{}: `{opt}` is no switch of any fluidform command",
+                page.display()
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 60, "only {checked} switches checked");
 }

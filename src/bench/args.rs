@@ -71,7 +71,7 @@ pub enum BenchWhat {
         character: CharacterArgs,
         #[command(flatten)]
         fluid_args: FluidArgs,
-        /// Scene with a [control] target (built-in name or TOML file; default giraffe)
+        /// Scene with a `[control]` target (built-in name or TOML file; default giraffe)
         #[arg(long)]
         scene: Option<String>,
         /// Velocity-term gains K to sweep beside the adaptive modes (default: 0, or

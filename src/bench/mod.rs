@@ -227,7 +227,7 @@ pub fn counts_or(opts: &BenchOptions, default: &[u32]) -> Vec<u32> {
 }
 
 /// Run `warmup + frames` frames of `record`, keep the timed ones, write the per-config
-/// outputs under out/runs/<label>/ and return the row.
+/// outputs under `out/runs/<label>/` and return the row.
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
     ctx: &Context,

@@ -26,7 +26,7 @@ pub struct Cell {
 pub struct Measured {
     pub labels: Vec<String>,
     pub particles: Vec<usize>,
-    /// [row][col]
+    /// `[row][col]`
     pub cells: Vec<Vec<Cell>>,
     /// The thesis's S-buffer frame of each row (RGBA).
     pub images: Vec<Vec<u8>>,

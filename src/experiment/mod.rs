@@ -48,7 +48,7 @@ fluidform_gpu::switch_enum!(
 pub struct ExperimentOptions {
     /// The experiments to run, in order.
     pub experiments: Vec<Experiment>,
-    /// None: results/<device-slug>.
+    /// None: `results/<device-slug>`.
     pub out: Option<PathBuf>,
     pub quick: bool,
     /// Device, validation, quiet and seed; nothing else is read.
@@ -137,7 +137,7 @@ impl Env {
         self.out.join("runs").join(name.as_str())
     }
 
-    /// Options to measure `what` through the benchmarks, its outputs under runs/<name>.
+    /// Options to measure `what` through the benchmarks, its outputs under `runs/<name>`.
     pub fn bench_options(&self, what: Measurer, name: Experiment) -> crate::bench::BenchOptions {
         let mut switches = self.switches.clone();
         switches.common.quiet = true;

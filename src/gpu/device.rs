@@ -45,7 +45,7 @@ pub struct DeviceInfo {
 }
 
 impl DeviceInfo {
-    /// A filesystem-friendly name for results/<slug>/.
+    /// A filesystem-friendly name for `results/<slug>/`.
     pub fn slug(&self) -> String {
         let mut s = String::new();
         for c in self.name.to_lowercase().chars() {

@@ -240,7 +240,7 @@ impl Context {
         r.map(|_| out)
     }
 
-    /// Whole buffer as Vec<T>.
+    /// Whole buffer as `Vec<T>`.
     pub fn read_all<T: bytemuck::Pod>(&self, src: &Buffer) -> Result<Vec<T>> {
         self.readback(src, 0, src.size as usize / std::mem::size_of::<T>())
     }

@@ -46,7 +46,7 @@ pub struct CountingSort {
 
 /// Buffers for up to `capacity` elements and `cells` cells.
 pub struct CountingBuffers {
-    /// Per-cell counts; counts[cells] counts out-of-range keys.
+    /// Per-cell counts; `counts[cells]` counts out-of-range keys.
     pub counts: Buffer,
     /// Exclusive scan of counts: the first sorted slot of each cell.
     pub starts: Buffer,
@@ -168,7 +168,7 @@ impl CountingSort {
     }
 }
 
-/// dst[i] = src[perm[i]] for vec4 attributes.
+/// `dst[i] = src[perm[i]]` for vec4 attributes.
 pub struct GatherPass {
     pipeline: ComputePipeline<GatherIo>,
 }

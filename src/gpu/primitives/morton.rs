@@ -24,7 +24,7 @@ impl MortonPass {
         })
     }
 
-    /// keys[i] = Morton code of pos[i] in `bounds` (two vec4), vals[i] = i.
+    /// `keys[i]` = Morton code of `pos[i]` in `bounds` (two vec4), `vals[i] = i`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,

@@ -33,18 +33,18 @@ fn default_pressure() -> f32 {
 }
 
 /// The fidelity preset's velocity term K (1/s), deficit attraction (m/s^2) and damping
-/// (1/s), chosen from the runs in results/<device>/control-fidelity.md.
+/// (1/s), chosen from the runs in `results/<device>/control-fidelity.md`.
 pub const FIDELITY_VELOCITY: f32 = 10.0;
 pub const FIDELITY_ATTRACTION: f32 = 120.0;
 pub const FIDELITY_DAMPING: f32 = 4.0;
 /// The fidelity preset's reach of the attraction and damping, in control radii h_c: at 5
 /// (was 3) CesiumMan drew his whole pool up (fill 0.97, 90% after 0.42 s, against 0.77
-/// and never) and the walker kept his metrics (results/<device>/control-fidelity.md).
+/// and never) and the walker kept his metrics (`results/<device>/control-fidelity.md`).
 pub const FIDELITY_REACH: f32 = 5.0;
 /// The fidelity preset's time between refreshes of the control's sums (`--control-every`
 /// is this over the step, rounded): on the walker, 4 steps of 0.36 ms held every metric of
 /// a refresh each step, and with damping 4/s so did 5 (here, on CesiumMan too); 6 more than
-/// doubled the speed excess (results/<device>/control-fidelity.md).
+/// doubled the speed excess (`results/<device>/control-fidelity.md`).
 pub const FIDELITY_REFRESH_S: f32 = 1.8e-3;
 
 /// c_cp when neither the scene nor --control-pressure sets it (with h_c = 2h, the
@@ -165,7 +165,7 @@ impl ControlDesc {
 
     /// The deficit measure: as set, else rest density (the shape's fill, tried as the
     /// fidelity default, held less water at the skin and let it run faster: the walker's
-    /// fill 0.95 -> 0.93, speed excess 0.66 -> 3.7 m/s; results/<device>/control-fidelity.md).
+    /// fill 0.95 -> 0.93, speed excess 0.66 -> 3.7 m/s; `results/<device>/control-fidelity.md`).
     /// The shape's fill needs particles inside it: asked for with vertices or rays, it is
     /// refused.
     pub fn deficit(&self) -> Result<Deficit> {

@@ -1,6 +1,6 @@
 //! The emission atlas: where each part of a character's surface lies in the one UV
 //! texture RenderToUV fills (seed 002: "several textures merged into one atlas by a
-//! per-part UV scale and offset"). A part is a triangle range with UVs in [0,1]^2 of its
+//! per-part UV scale and offset"). A part is a triangle range with UVs in `[0,1]^2` of its
 //! own: a file's UV sets (its primitives), or, for the built-in characters (no UVs),
 //! generated ones: one equal-area cylindrical map per bone capsule (u = angle around the
 //! axis times the radius, v = position along it: the hat-box theorem makes it area
@@ -29,7 +29,7 @@ pub struct LayoutPart {
 pub struct UvLayout {
     /// Per corner: the mesh vertex.
     pub src: Vec<u32>,
-    /// Per corner: UV in its part's [0,1]^2.
+    /// Per corner: UV in its part's `[0,1]^2`.
     pub uvs: Vec<Vec2>,
     /// Per layout triangle: the mesh triangle.
     pub tri_of: Vec<u32>,
@@ -47,7 +47,7 @@ impl UvLayout {
     }
 
     /// The mesh's own UVs: one part per UV set (`mesh.uv_parts`, else the whole mesh).
-    /// A set whose UVs leave [0,1]^2 is mapped from its UV bounds.
+    /// A set whose UVs leave `[0,1]^2` is mapped from its UV bounds.
     pub fn from_mesh(mesh: &Mesh, size: [u32; 2]) -> Result<Self> {
         if mesh.uvs.len() != mesh.positions.len() || mesh.uvs.is_empty() {
             return Err(Error::Param(

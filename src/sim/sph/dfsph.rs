@@ -50,7 +50,7 @@ pub struct DfsphParams {
     /// list instead of searching 27 grid cells; a particle with more neighbours is searched
     /// as before (exact; counted in `stats.density_error.list_overflows`).
     pub neighbor_list: u32,
-    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// The solver's own step, used when `[fluid]` sets no `cfl`: CFL-limited (cfl h /
     /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it; cfl 0:
     /// fixed steps of `dt`).
     pub cfl: f32,

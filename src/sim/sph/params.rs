@@ -231,9 +231,9 @@ impl FluidParams {
     }
 
     /// Apply `KEY=VALUE` overrides (TOML values; a bare word is a string), checked like
-    /// a scene file's [fluid] table: unknown keys and invalid values are errors.
+    /// a scene file's `[fluid]` table: unknown keys and invalid values are errors.
     /// The parameters with `KEY=VALUE` `overrides` (`--fluid`) and `solver` applied, and
-    /// the solver's own step (its table's `cfl` and `dt_max`) where [fluid] sets no `cfl`.
+    /// the solver's own step (its table's `cfl` and `dt_max`) where `[fluid]` sets no `cfl`.
     pub fn with_overrides(&self, overrides: &[String], solver: Option<Solver>) -> Result<Self> {
         let mut out = self.with_values(overrides)?;
         out.solver = solver.unwrap_or(out.solver);
@@ -255,7 +255,7 @@ impl FluidParams {
         Ok(out)
     }
 
-    /// The step the solver takes by its own table, `cfl` and `dt_max` each where [fluid]
+    /// The step the solver takes by its own table, `cfl` and `dt_max` each where `[fluid]`
     /// (or --fluid) sets none: wcsph keeps the fixed `dt`, its stable step at its speed of
     /// sound.
     pub fn with_own_step(mut self) -> Self {

@@ -34,7 +34,7 @@ pub struct PbfParams {
     pub xsph: f32,
     /// Vorticity confinement epsilon, m/s (acceleration = epsilon N x omega).
     pub vorticity: f32,
-    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// The solver's own step, used when `[fluid]` sets no `cfl`: CFL-limited (cfl h /
     /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it; cfl 0:
     /// fixed steps of `dt`).
     pub cfl: f32,

@@ -20,7 +20,7 @@ pub struct PcisphParams {
     /// Iterations each solve takes at least and at most.
     pub min_iterations: u32,
     pub max_iterations: u32,
-    /// The solver's own step, used when [fluid] sets no `cfl`: CFL-limited (cfl h /
+    /// The solver's own step, used when `[fluid]` sets no `cfl`: CFL-limited (cfl h /
     /// v_max) up to `dt_max` seconds (--fluid cfl=..., dt_max=... override it; cfl 0:
     /// fixed steps of `dt`).
     pub cfl: f32,

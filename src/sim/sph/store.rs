@@ -198,7 +198,7 @@ impl ParticleStore {
         ctx.readback(self.get(id), 0, n)
     }
 
-    /// Record moving every reordered attribute into sorted order: dst[i] = src[perm[i]].
+    /// Record moving every reordered attribute into sorted order: `dst[i] = src[perm[i]]`.
     pub fn record_reorder(
         &mut self,
         ctx: &Context,
