@@ -1,4 +1,5 @@
-//! Command-line switches shared by `run` and `bench` (names fixed by DESIGN.md).
+//! Command-line switches shared by `run`, `view` and `bench` (names fixed by DESIGN.md).
+//! Only the application sees them: `settings` turns them into the lower crates' settings.
 //! Values are closed enums so an unknown value is rejected by the parser; a switch the
 //! chosen scene or benchmark does not use is rejected by `reject_unused` with a clear
 //! message naming what uses it.

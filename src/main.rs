@@ -110,7 +110,7 @@ enum Command {
     /// <out>/<name>.csv, .md, .png and findings.md. `all` runs every one in order, `list`
     /// prints their names
     Experiment {
-        #[arg(value_parser = experiment_names())]
+        #[arg(value_parser = ExperimentName)]
         name: String,
         /// Output directory (default results/<device-slug>)
         #[arg(long)]
@@ -324,15 +324,48 @@ fn overview() -> String {
     )
 }
 
-/// `experiment`'s names: every experiment, `all` and `list`, each shown in --help.
-fn experiment_names() -> clap::builder::PossibleValuesParser {
-    let mut names: Vec<clap::builder::PossibleValue> = fluidform::experiment::Experiment::all()
-        .iter()
-        .map(|e| clap::builder::PossibleValue::new(e.as_str()))
-        .collect();
-    names.push(clap::builder::PossibleValue::new("all").help("every experiment, in this order"));
-    names.push(clap::builder::PossibleValue::new("list").help("print the names"));
-    clap::builder::PossibleValuesParser::new(names)
+/// `experiment`'s names: every experiment, `all` and `list`, each shown in --help; any
+/// other is refused naming them.
+#[derive(Clone)]
+struct ExperimentName;
+
+impl ExperimentName {
+    fn names() -> Vec<clap::builder::PossibleValue> {
+        use clap::builder::PossibleValue;
+        let mut v: Vec<PossibleValue> = fluidform::experiment::Experiment::all()
+            .iter()
+            .map(|e| PossibleValue::new(e.as_str()))
+            .collect();
+        v.push(PossibleValue::new("all").help("every experiment, in this order"));
+        v.push(PossibleValue::new("list").help("print the names"));
+        v
+    }
+}
+
+impl clap::builder::TypedValueParser for ExperimentName {
+    type Value = String;
+
+    fn parse_ref(
+        &self,
+        _cmd: &clap::Command,
+        _arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<String, clap::Error> {
+        let v = value.to_string_lossy().to_string();
+        let names = Self::names();
+        if names.iter().any(|n| n.matches(&v, false)) {
+            return Ok(v);
+        }
+        let all: Vec<&str> = names.iter().map(|n| n.get_name()).collect();
+        Err(clap::Error::raw(
+            clap::error::ErrorKind::InvalidValue,
+            format!("unknown experiment '{v}' (one of: {})\n", all.join(", ")),
+        ))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue>>> {
+        Some(Box::new(Self::names().into_iter()))
+    }
 }
 
 trait ParseDefault {

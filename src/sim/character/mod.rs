@@ -1,5 +1,6 @@
-//! Characters: glTF 2.0 and OBJ loading, mesh checks, clip sampling, and skinning (a GPU
-//! pass with linear blend or dual quaternions, and its CPU reference).
+//! Characters: glTF 2.0 and OBJ loading, mesh checks, clip sampling and orientation,
+//! skinning (a GPU pass with linear blend or dual quaternions, and its CPU reference), the
+//! thickness of their parts, and what `inspect` reports and draws.
 pub mod anim;
 pub mod capsules;
 pub mod check;

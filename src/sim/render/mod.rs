@@ -1,5 +1,7 @@
-//! Rendering passes: the camera, the particle (billboard sphere) view, the metaball
-//! renderer and the character mesh.
+//! Rendering passes: the camera, the particle (billboard sphere) view, the fluid renderer
+//! (ray-marched metaballs with per-pixel or per-tile lists, screen-space fluid and GPU
+//! marching cubes, all shaded by one pass), the character mesh, and an independent f64 ray
+//! tracer (`trace`) the shading is checked against.
 pub mod camera;
 pub mod mesh;
 pub mod metaball;
