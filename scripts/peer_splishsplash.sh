@@ -24,7 +24,9 @@ while [ $# -gt 0 ]; do
     *) pass+=("$1"); shift ;;
   esac
 done
-source scripts/bench_common.sh "${pass[@]}"
+# `source` with no arguments would hand bench_common.sh this script's own, filtered ones too.
+set -- ${pass[@]+"${pass[@]}"}
+source scripts/bench_common.sh "$@"
 venv=out/peer-venv
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"

@@ -12,7 +12,7 @@ macro_rules! scene {
     ($name:literal) => {
         BuiltIn {
             name: $name,
-            text: include_str!(concat!("../../scenes/", $name, ".toml")),
+            text: include_str!(concat!("../../../scenes/", $name, ".toml")),
         }
     };
 }
