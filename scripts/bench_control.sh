@@ -13,7 +13,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [[ " $* " == *" --frames "* ]] || set -- "$@" --frames 900
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 # The other parts' frame caps replace the giraffes'.
 rest=()
 skip=0

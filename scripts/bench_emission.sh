@@ -7,7 +7,8 @@
 # FLUIDFORM_SWEEP="65536 131072 262144 524288 1048576" adds the sweep to 1M.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 md=$dir/emission.md
 fig=("$bin" bench emission --out out/bench/emission "${dev[@]}" "${args[@]}")
 "${fig[@]}" > /dev/null

@@ -6,7 +6,8 @@
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 md=$dir/particles.md
 sprites=("$bin" bench particles --out out/bench/particles "${dev[@]}" "${args[@]}")
 points=("$bin" bench particles --draw points --out out/bench/particles-points "${dev[@]}" "${args[@]}")

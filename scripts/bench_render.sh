@@ -8,7 +8,8 @@
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 n=2048 w=512 h=512
 rest=()
 set -- "${args[@]}"

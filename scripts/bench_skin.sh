@@ -6,7 +6,8 @@
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 character=builtin:walker
 [ -f ../shared/assets/CesiumMan.glb ] && character=../shared/assets/CesiumMan.glb
 cmd=("$bin" bench skin --out out/bench/skin --character "$character" "${dev[@]}" "${args[@]}")

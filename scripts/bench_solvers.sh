@@ -27,9 +27,8 @@ done
 # bench_common.sh's defaults (20 after 3) are repetitions; here frames are scene time.
 [[ " ${pass[*]-} " == *" --frames "* ]] || pass+=(--frames 10)
 [[ " ${pass[*]-} " == *" --warmup "* ]] || pass+=(--warmup 5)
-# `source` with no arguments would hand bench_common.sh this script's own, filtered ones too.
-set -- ${pass[@]+"${pass[@]}"}
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "${pass[@]}"
 md=$dir/solvers.md
 rows=("$bin" bench solvers --out out/bench/solvers "${dev[@]}" "${args[@]}")
 if [ -z "${SKIP_ROWS:-}" ]; then

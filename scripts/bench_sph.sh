@@ -13,9 +13,8 @@ for a in "$@"; do
     *) pass+=("$a") ;;
   esac
 done
-# `source` with no arguments would hand bench_common.sh this script's own, filtered ones too.
-set -- ${pass[@]+"${pass[@]}"}
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "${pass[@]}"
 md=$dir/sph.md
 sweep=("$bin" bench sph --out out/bench/sph "${dev[@]}" "${args[@]}")
 stab=("$bin" bench stability --out out/bench/stability "${dev[@]}")

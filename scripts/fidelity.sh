@@ -8,7 +8,8 @@
 # metrics do not depend on the picture). Usage: scripts/fidelity.sh [--device N|NAME]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "$@"
 md=$dir/control-fidelity.md
 csv=$dir/control-fidelity.csv
 walker=tests/scenes/walker_pool.toml

@@ -24,9 +24,8 @@ while [ $# -gt 0 ]; do
     *) pass+=("$1"); shift ;;
   esac
 done
-# `source` with no arguments would hand bench_common.sh this script's own, filtered ones too.
-set -- ${pass[@]+"${pass[@]}"}
-source scripts/bench_common.sh "$@"
+source scripts/bench_common.sh
+bench_setup "${pass[@]}"
 venv=out/peer-venv
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
