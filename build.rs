@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 fn main() {
     embed_commit();
+    embed_rustc();
     embed_font();
     println!("cargo:rerun-if-changed=build.rs");
 }
@@ -32,6 +33,19 @@ fn embed_commit() {
             println!("cargo:rerun-if-changed={p}");
         }
     }
+}
+
+/// FLUIDFORM_RUSTC: the compiler's version, part of every page's provenance.
+fn embed_rustc() {
+    let rustc = env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let v = std::process::Command::new(rustc)
+        .arg("--version")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "unknown".into());
+    println!("cargo:rustc-env=FLUIDFORM_RUSTC={v}");
 }
 
 /// Embed DejaVu Sans (fonts-dejavu-core, from scripts/setup.sh) for the benchmark plots: a

@@ -6,6 +6,7 @@
 //! here under their module names. See README.md and docs/.
 pub mod bench;
 pub mod experiment;
+pub mod provenance;
 pub mod shaders;
 
 pub use fluidform_app::{run, window};

@@ -63,9 +63,16 @@ enum Command {
         /// Untimed warm-up repetitions
         #[arg(long, global = true, default_value_t = 5)]
         warmup: u64,
-        /// Seconds one configuration may take; slower ones get fewer repetitions (>= 3)
+        /// Seconds one configuration may take; slower ones get fewer repetitions (one
+        /// frame a round at the least)
         #[arg(long, global = true, default_value_t = 300.0)]
         budget_s: f64,
+        /// Interleaved rounds the timed frames are spread over (at least 5)
+        #[arg(long, global = true, default_value_t = 5, value_parser = clap::value_parser!(u64).range(5..=1000))]
+        rounds: u64,
+        /// Seconds the sentinel's warm-up may take before timing starts anyway
+        #[arg(long, global = true, default_value_t = 2.0)]
+        warmup_s: f64,
     },
     /// Plot a sweep.csv (e.g. a committed results/<device>/sph.csv) as a PNG
     Plot {
@@ -199,8 +206,17 @@ fn real_main() -> Result<()> {
             frames,
             warmup,
             budget_s,
+            rounds,
+            warmup_s,
         } => {
-            let (out, rows) = fluidform::bench::args::run(what, out, (frames, warmup, budget_s))?;
+            let timing = fluidform::bench::args::Timing {
+                frames,
+                warmup,
+                budget_s,
+                rounds,
+                warmup_s,
+            };
+            let (out, rows) = fluidform::bench::args::run(what, out, timing)?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);
             eprintln!("{rows} configurations; wrote {}", out.display());
             Ok(())

@@ -261,12 +261,23 @@ impl BenchWhat {
     }
 }
 
+/// How a benchmark times its configurations (the protocol's knobs).
+pub struct Timing {
+    pub frames: u64,
+    pub warmup: u64,
+    pub budget_s: f64,
+    pub rounds: u64,
+    pub warmup_s: f64,
+}
+
 /// `bench`: run one benchmark; where its table went and how many configurations it has.
-pub fn run(
-    what: BenchWhat,
-    out: PathBuf,
-    (frames, warmup, budget_s): (u64, u64, f64),
-) -> Result<(PathBuf, usize)> {
+pub fn run(what: BenchWhat, out: PathBuf, t: Timing) -> Result<(PathBuf, usize)> {
+    if !(t.warmup_s.is_finite() && t.warmup_s >= 0.0) {
+        return Err(crate::Error::Param(format!(
+            "--warmup-s must be a number of seconds >= 0 (got {})",
+            t.warmup_s
+        )));
+    }
     let seconds = match &what {
         BenchWhat::Stability { seconds, .. } => *seconds,
         _ => crate::bench::sph::STABILITY_SECONDS,
@@ -275,9 +286,11 @@ pub fn run(
     let rows = crate::bench::run(&crate::bench::BenchOptions {
         what: super::Measurer::Bench(what),
         out: out.clone(),
-        frames,
-        warmup,
-        budget_s,
+        frames: t.frames,
+        warmup: t.warmup,
+        budget_s: t.budget_s,
+        rounds: t.rounds,
+        warmup_s: t.warmup_s,
         switches,
         character,
         vertices,

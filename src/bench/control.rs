@@ -122,6 +122,8 @@ fn one_run(
         secs(c.time_to_90, last.time),
     );
     let row = Row {
+        interval: None,
+        flagged: false,
         variant: variant.to_string(),
         n: c.control_particles as u64,
         main,

@@ -3,7 +3,8 @@
 //! `game`'s room with a 2 x 1.5 m pool of N particles that are all emitter slots, alive at the start
 //! with ages spread over the life limit (`recycle`), and a birth rate that keeps them all
 //! alive: every frame skins the walker, renders it into its UV atlas, emits, and steps.
-use super::{measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
@@ -61,7 +62,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         None if !opts.counts.is_empty() => opts.counts.clone(),
         None => COUNTS.to_vec(),
     };
-    let mut rows = Vec::new();
+    let mut cases = Vec::new();
     for (strategy, sort) in strategies {
         for &n in &counts {
             let mut scene = scene(n);
@@ -75,7 +76,7 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             );
             let actual = st.n as u64;
             let dt = st.dt;
-            let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
+            let variant = format!("{}-{}", strategy.as_str(), sort.as_str());
             let detail = json!({
                 "scene": "game room, a floor pool of N emitter slots (recycle)",
                 "particles": actual,
@@ -85,14 +86,13 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 "fluid": scene.fluid,
             });
             let mut t = 0.0f64;
-            let row = measure(
-                ctx,
-                opts,
-                &variant.replace('/', "-"),
+            // The case owns its solver, state and targets: each advances in its own frames.
+            cases.push(Case::new(
+                variant,
                 actual,
                 crate::gpu::FRAME,
                 detail,
-                |prof, cmd| {
+                move |prof, cmd| {
                     prof.begin(ctx, cmd, crate::gpu::FRAME.name());
                     targets.record_before(ctx, cmd, prof, &mut st, t, dt, 1)?;
                     solver.record_hooked_step(ctx, cmd, prof, &mut st, &mut targets.hooks())?;
@@ -100,15 +100,13 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     t += dt as f64;
                     Ok(())
                 },
-            );
-            drop(targets);
-            drop(st);
-            drop(solver);
-            let mut row = row?;
-            row.variant = variant;
-            row.extra = vec![("fps".into(), format!("{:.1}", 1000.0 / row.main.median))];
-            rows.push(row);
+            ));
         }
+    }
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for row in &mut rows {
+        row.variant = row.variant.replacen('-', "/", 1);
+        row.extra = vec![("fps".into(), format!("{:.1}", 1000.0 / row.main.median))];
     }
     Ok(rows)
 }

@@ -2,7 +2,8 @@
 //! least memory traffic over the buffer-copy bandwidth, or its density evaluations over
 //! the FMA rate, whichever is larger. `bench render` prints each row's floor and how far
 //! above it the row is.
-use super::{measure, BenchOptions};
+use super::protocol::{self, Case};
+use super::BenchOptions;
 use crate::error::Result;
 use crate::gpu::{ComputeDesc, ComputePipeline, Context, Guard};
 use serde_json::json;
@@ -43,26 +44,27 @@ impl Floor {
         let out = Guard::new(ctx, ctx.storage_buffer("floor fma out", invocations * 16)?);
         let desc = ComputeDesc::plain("fma rate", "bench/fma.comp", &[], 256);
         let fma = Guard::new(ctx, ComputePipeline::<FmaIo>::new(ctx, &desc)?);
-        let copy = measure(ctx, opts, "copy", bytes, COPY, json!({}), |prof, cmd| {
-            prof.begin(ctx, cmd, COPY.name());
-            ctx.copy(cmd, &src, 0, &dst, 0, bytes);
-            prof.end(ctx, cmd);
-            Ok(())
-        })?;
-        let rate = measure(
-            ctx,
-            opts,
-            "fma",
-            invocations,
-            FMA,
-            json!({}),
-            |prof, cmd| {
-                prof.begin(ctx, cmd, FMA.name());
-                fma.dispatch(ctx, cmd, &FmaBufs { out: &out }, &ITERS, invocations);
+        // Its own folder: the table it serves writes rounds.csv of its own.
+        let mut opts = opts.clone();
+        opts.out = opts.out.join("floor");
+        let (src, dst, out) = (&*src, &*dst, &*out);
+        let fma = &*fma;
+        let cases = vec![
+            Case::new("copy", bytes, COPY, json!({}), move |prof, cmd| {
+                prof.begin(ctx, cmd, COPY.name());
+                ctx.copy(cmd, src, 0, dst, 0, bytes);
                 prof.end(ctx, cmd);
                 Ok(())
-            },
-        )?;
+            }),
+            Case::new("fma", invocations, FMA, json!({}), move |prof, cmd| {
+                prof.begin(ctx, cmd, FMA.name());
+                fma.dispatch(ctx, cmd, &FmaBufs { out }, &ITERS, invocations);
+                prof.end(ctx, cmd);
+                Ok(())
+            }),
+        ];
+        let rows = protocol::run(ctx, &opts, cases)?;
+        let (copy, rate) = (&rows[0], &rows[1]);
         let flops = invocations as f64 * ITERS as f64 * 64.0;
         let floor = Self {
             bytes_per_s: 2.0 * bytes as f64 / (copy.main.median / 1e3),

@@ -5,10 +5,12 @@ pub mod args;
 pub mod control;
 pub mod emission;
 pub mod floor;
+pub mod interval;
 pub mod particles;
 pub mod picture;
 pub mod plot;
 pub mod primitives;
+pub mod protocol;
 pub mod render;
 pub mod skin;
 pub mod solvers;
@@ -16,9 +18,8 @@ pub mod sph;
 
 use crate::config::{Group, Switches};
 use crate::error::{Error, Result};
-use crate::gpu::vk;
-use crate::gpu::{Context, ContextOptions, FrameTiming, Profiler, RecordOnly, ScopeKey, FRAME};
-use crate::report::{stat, Report, Stat};
+use crate::gpu::{Context, ContextOptions, ScopeKey};
+use crate::report::Stat;
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -56,12 +57,17 @@ impl std::fmt::Display for Measurer {
     }
 }
 
+#[derive(Clone)]
 pub struct BenchOptions {
     pub what: Measurer,
     pub out: PathBuf,
-    /// Timed repetitions per configuration.
+    /// Timed repetitions per configuration, spread over the protocol's rounds.
     pub frames: u64,
     pub warmup: u64,
+    /// Interleaved rounds (at least `protocol::MIN_ROUNDS`).
+    pub rounds: u64,
+    /// Seconds the sentinel's warm-up may take before timing starts anyway.
+    pub warmup_s: f64,
     /// Seconds of GPU time a configuration may take; slower ones get fewer repetitions
     /// (at least 3), and the table reports how many each had.
     pub budget_s: f64,
@@ -119,6 +125,11 @@ pub struct Row {
     /// Timed repetitions behind the statistics.
     pub reps: u64,
     pub extra: Vec<(String, String)>,
+    /// The headline's median of per-round medians, IQR and 95% interval.
+    /// None for rows outside the protocol (simulation runs timed over simulated seconds).
+    pub interval: Option<interval::Interval>,
+    /// A round stayed off after its rerun (protocol.rs): the row is not to be trusted.
+    pub flagged: bool,
 }
 
 impl Row {
@@ -226,105 +237,8 @@ pub fn counts_or(opts: &BenchOptions, default: &[u32]) -> Vec<u32> {
     }
 }
 
-/// Run `warmup + frames` frames of `record`, keep the timed ones, write the per-config
-/// outputs under `out/runs/<label>/` and return the row.
-#[allow(clippy::too_many_arguments)]
-pub fn measure(
-    ctx: &Context,
-    opts: &BenchOptions,
-    variant: &str,
-    n: u64,
-    main_scope: ScopeKey,
-    config: Value,
-    mut record: impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
-) -> Result<Row> {
-    // One warm-up frame tells how long a repetition takes.
-    let label = format!("{variant} n={n}");
-    let quiet = opts.switches.common.quiet;
-    let first = run_frames(ctx, 1, &mut record, &label, true)?;
-    let per_frame_s = first.iter().map(|t| t.frame_ms).sum::<f64>() / 1000.0;
-    let reps = if per_frame_s * opts.frames as f64 <= opts.budget_s {
-        opts.frames
-    } else {
-        // At least three repetitions where the run asks for that many.
-        ((opts.budget_s / per_frame_s.max(1e-9)) as u64).clamp(opts.frames.min(3), opts.frames)
-    };
-    let warmup = if per_frame_s * (opts.warmup as f64) < opts.budget_s / 10.0 {
-        opts.warmup.saturating_sub(1)
-    } else {
-        0
-    };
-    let mut timings = run_frames(ctx, warmup + reps, &mut record, &label, quiet)?;
-    timings.retain(|t| t.frame >= warmup);
-    for t in &mut timings {
-        t.frame -= warmup;
-    }
-    let label = format!("{variant}-{n}");
-    let report = Report {
-        device: &ctx.info,
-        config: BenchConfig {
-            command: "bench".into(),
-            what: opts.what.to_string(),
-            variant: variant.to_string(),
-            n,
-            frames: reps,
-            warmup: warmup + 1,
-            switches: opts.switches.clone(),
-            detail: config,
-        },
-        timings: &timings,
-        memory: ctx.memory_bytes(),
-        stats: NoStats {},
-        validation: opts
-            .switches
-            .common
-            .validation
-            .then(|| ctx.validation_counts()),
-        barriers: ctx.tracked_barriers(),
-    };
-    report.write(&opts.out.join("runs").join(&label))?;
-    let passes = crate::report::pass_stats(&timings);
-    if timings.is_empty() {
-        return Err(Error::Param("no timed frames".into()));
-    }
-    let main = if main_scope == FRAME {
-        stat(&timings.iter().map(|t| t.frame_ms).collect::<Vec<_>>())
-            .ok_or_else(|| Error::Param("no timed frames".into()))?
-    } else {
-        passes
-            .iter()
-            .find(|(name, _)| name == main_scope.path())
-            .map(|(_, s)| *s)
-            .ok_or_else(|| main_scope.missing(passes.iter().map(|(k, _)| k.as_str())))?
-    };
-    eprintln!(
-        "{:<24} n = {:>9}  {main_scope} median {:9.3} ms (min {:.3}, max {:.3}, {reps} reps)",
-        variant, n, main.median, main.min, main.max
-    );
-    Ok(Row {
-        variant: variant.to_string(),
-        n,
-        main,
-        passes,
-        reps,
-        extra: Vec::new(),
-    })
-}
-
-/// `count` frames of `record`, with a progress bar (or plain lines) named `label`.
-fn run_frames(
-    ctx: &Context,
-    count: u64,
-    record: &mut impl FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()>,
-    label: &str,
-    quiet: bool,
-) -> Result<Vec<FrameTiming>> {
-    let mut work = RecordOnly(|prof: &mut Profiler, cmd| record(prof, cmd));
-    crate::run::common::play(ctx, count, &mut work, label, quiet)
-}
-
 /// A CSV field, quoted where it holds a comma, a quote or a line break.
-fn csv_field(v: &str) -> String {
+pub(crate) fn csv_field(v: &str) -> String {
     if v.contains([',', '"', '\n']) {
         format!("\"{}\"", v.replace('"', "\"\""))
     } else {
@@ -348,10 +262,12 @@ fn sweep_tables(rows: &[Row]) -> (String, String) {
             }
         }
     }
-    let mut csv = String::from("variant,n,reps,median_ms,min_ms,max_ms,ns_per_element");
+    let mut csv = String::from(
+        "variant,n,reps,median_ms,min_ms,max_ms,ns_per_element,ci_lo_ms,ci_hi_ms,q1_ms,q3_ms,flagged",
+    );
     let mut md =
         format!(
-        "| variant | N | reps | median ms | min | max | ns/element |{}{}\n|---|---|---|---|---|---|---|{}{}\n",
+        "| variant | N | reps | median ms [95% interval] | IQR | ns/element |{}{}\n|---|---|---|---|---|---|{}{}\n",
         pass_names.iter().map(|p| format!(" {p} ms |")).collect::<String>(),
         extra_names.iter().map(|p| format!(" {p} |")).collect::<String>(),
         "---|".repeat(pass_names.len()),
@@ -366,13 +282,37 @@ fn sweep_tables(rows: &[Row]) -> (String, String) {
     csv.push('\n');
     for r in rows {
         let per = r.main.median * 1e6 / r.n.max(1) as f64;
+        let iv = r.interval.unwrap_or_default();
         csv.push_str(&format!(
-            "{},{},{},{:.6},{:.6},{:.6},{:.4}",
-            r.variant, r.n, r.reps, r.main.median, r.main.min, r.main.max, per
+            "{},{},{},{:.6},{:.6},{:.6},{:.4},{:.6},{:.6},{:.6},{:.6},{}",
+            r.variant,
+            r.n,
+            r.reps,
+            r.main.median,
+            r.main.min,
+            r.main.max,
+            per,
+            iv.lo,
+            iv.hi,
+            iv.q1,
+            iv.q3,
+            r.flagged
         ));
+        let (ci, iqr) = match r.interval {
+            Some(iv) => (
+                format!(" [{:.3}, {:.3}]", iv.lo, iv.hi),
+                format!("{:.3}-{:.3}", iv.q1, iv.q3),
+            ),
+            None => (String::new(), "-".into()),
+        };
         md.push_str(&format!(
-            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} |",
-            r.variant, r.n, r.reps, r.main.median, r.main.min, r.main.max, per
+            "| {}{} | {} | {} | {:.3}{ci} | {iqr} | {:.2} |",
+            r.variant,
+            if r.flagged { " (flagged)" } else { "" },
+            r.n,
+            r.reps,
+            r.main.median,
+            per
         ));
         for p in &pass_names {
             let v = r.passes.iter().find(|(n, _)| n == p).map(|(_, s)| s.median);
@@ -400,6 +340,30 @@ fn sweep_tables(rows: &[Row]) -> (String, String) {
     (csv, md)
 }
 
+/// The protocol and provenance in one paragraph, for every table page.
+pub fn protocol_text(opts: &BenchOptions) -> String {
+    let p = crate::provenance::Provenance::now(opts.frames, opts.warmup);
+    format!(
+        "Protocol: every configuration built first; a sentinel warm-up (up to {} s); then \
+         {} shuffled rounds (seed {}) sharing up to {} timed frames per configuration (at \
+         least one a round; fewer where they would exceed {} s), after {} warm-up frames \
+         each. A row is the \
+         median of its per-round medians with a 95% bootstrap interval; a row is flagged \
+         when a round's sentinel or steady pass stayed more than {:.0}% off after one rerun \
+         (rounds.csv). Commit {}, {}, measured {}.",
+        opts.warmup_s,
+        opts.rounds.max(protocol::MIN_ROUNDS),
+        opts.switches.common.seed,
+        opts.frames,
+        opts.budget_s,
+        opts.warmup.max(1),
+        protocol::DRIFT * 100.0,
+        p.commit,
+        p.rustc,
+        p.date
+    )
+}
+
 fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String]) -> Result<()> {
     let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
         path: p.display().to_string(),
@@ -408,15 +372,12 @@ fn write_sweep(ctx: &Context, opts: &BenchOptions, rows: &[Row], notes: &[String
     std::fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
     let (csv, mut md) = sweep_tables(rows);
     md.push_str(&format!(
-        "\nDevice: {} ({}, {}, Vulkan {}). Up to {} timed repetitions after {} warm-up, fewer \
-         (reps column) where they would exceed {} s; medians of GPU timestamp scopes.\n\n",
+        "\nDevice: {} ({}, {}, Vulkan {}). {}\n\n",
         ctx.info.name,
         ctx.info.kind,
         ctx.info.driver,
         ctx.info.api,
-        opts.frames,
-        opts.warmup,
-        opts.budget_s
+        protocol_text(opts),
     ));
     for n in notes {
         md.push_str(&format!("- {n}\n"));

@@ -1,7 +1,8 @@
 //! `bench particles` (seed 003): a full pool of N sprites thrown up from a sphere under
 //! gravity, bouncing on one plane (the closed form has no plane: gravity alone), one
 //! step, sort and draw per frame at 512 x 512 (or --width, --height).
-use super::{counts, measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{counts, BenchOptions, Row};
 use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{ColorTarget, Context, Guard};
@@ -111,64 +112,69 @@ pub fn particles(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     );
     let passes = Guard::new(ctx, Passes::new(ctx)?);
     let target = Guard::new(ctx, ColorTarget::new(ctx, w, h, 0)?);
-    let mut rows = Vec::new();
     let list: Vec<u32> = match opts.counts.is_empty() && opts.switches.common.particles.is_none() {
         true => COUNTS.to_vec(),
         false => counts(opts),
     };
     let draw = opts.switches.particle.draw.unwrap_or(SpriteMode::Sprites);
+    let dt = 1.0 / 60.0;
+    // Every system first, its pool filled at t = 0; each case then steps its own.
+    let mut keys = Vec::new();
+    let mut systems = Guard::new(ctx, Vec::new());
     for (integrator, sort) in variants(opts)? {
         for &n in &list {
             let spec = system(n, integrator, sort, draw);
-            let mut s = Guard::new(
-                ctx,
-                ParticleSystem::new(ctx, &passes, &spec, 0, opts.switches.common.seed)?,
-            );
-            // The pool filled at t = 0.
-            let dt = 1.0 / 60.0;
+            let mut s = ParticleSystem::new(ctx, &passes, &spec, 0, opts.switches.common.seed)?;
             let f0 = frame_info(&cam, dt, 0, w, h);
-            ctx.one_shot(|cmd| {
+            let born = ctx.one_shot(|cmd| {
                 s.record_births(ctx, cmd, &mut crate::gpu::Labels, &passes, &f0, n)
-            })?;
-            let variant = format!("{}/{}", integrator.as_str(), sort.as_str());
+            });
+            systems.push(s);
+            born?;
+            keys.push((integrator, sort, n, spec));
+        }
+    }
+    let (passes, target, cam) = (&*passes, &*target, &cam);
+    let cases = systems
+        .iter_mut()
+        .zip(&keys)
+        .map(|(s, (integrator, sort, n, spec))| {
+            let variant = format!("{}-{}", integrator.as_str(), sort.as_str());
             let detail = json!({ "system": spec, "width": w, "height": h });
             let mut k = 1u64;
-            let row = measure(
-                ctx,
-                opts,
-                &variant.replace('/', "-"),
-                n as u64,
+            Case::new(
+                variant,
+                *n as u64,
                 crate::gpu::FRAME,
                 detail,
-                |prof, cmd| {
-                    let f = frame_info(&cam, dt, k, w, h);
+                move |prof, cmd| {
+                    let f = frame_info(cam, dt, k, w, h);
                     k += 1;
-                    record_simulation(ctx, cmd, prof, &passes, std::slice::from_mut(&mut *s), &f)?;
+                    record_simulation(ctx, cmd, prof, passes, std::slice::from_mut(s), &f)?;
                     prof.begin(ctx, cmd, Passes::DRAW);
-                    s.prepare_draw(ctx, cmd, &passes, &f);
+                    s.prepare_draw(ctx, cmd, passes, &f);
                     target.begin_rendering(ctx, cmd, [0.0, 0.0, 0.0, 1.0]);
-                    s.record_draw(ctx, cmd, &passes, &f);
+                    s.record_draw(ctx, cmd, passes, &f);
                     target.end_rendering(ctx, cmd);
                     prof.end(ctx, cmd);
                     Ok(())
                 },
-            );
-            let counters = s.read_counters(ctx);
-            drop(s);
-            let mut row = row?;
-            let c = counters?;
-            // The unsorted closed form draws every slot (the vertex shader culls the dead).
-            let drawn = match (integrator, sort) {
-                (Integrator::Closed, SortAlgo::None) => n,
-                _ => c.draw_args[0] / c.verts,
-            };
-            row.variant = variant;
-            row.extra = vec![
-                ("fps".into(), format!("{:.1}", 1000.0 / row.main.median)),
-                ("drawn".into(), drawn.to_string()),
-            ];
-            rows.push(row);
-        }
+            )
+        })
+        .collect();
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for ((row, s), (integrator, sort, n, _)) in rows.iter_mut().zip(systems.iter()).zip(&keys) {
+        let c = s.read_counters(ctx)?;
+        // The unsorted closed form draws every slot (the vertex shader culls the dead).
+        let drawn = match (integrator, sort) {
+            (Integrator::Closed, SortAlgo::None) => *n,
+            _ => c.draw_args[0] / c.verts,
+        };
+        row.variant = format!("{}/{}", integrator.as_str(), sort.as_str());
+        row.extra = vec![
+            ("fps".into(), format!("{:.1}", 1000.0 / row.main.median)),
+            ("drawn".into(), drawn.to_string()),
+        ];
     }
     Ok(rows)
 }

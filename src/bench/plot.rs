@@ -48,7 +48,13 @@ pub fn today() -> String {
     let days = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs() / 86_400)
-        .unwrap_or(0) as i64;
+        .unwrap_or(0);
+    date_of(days)
+}
+
+/// The date (YYYY-MM-DD) `days` after 1970-01-01.
+pub fn date_of(days: u64) -> String {
+    let days = days as i64;
     // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
@@ -113,6 +119,8 @@ pub fn read_sweep(path: &Path) -> Result<Vec<Row>> {
             },
             passes: Vec::new(),
             extra: Vec::new(),
+            interval: None,
+            flagged: false,
         });
     }
     if rows.is_empty() {

@@ -1,5 +1,6 @@
 //! Benchmarks of the GPU primitives: scan (against a buffer copy), sorts, neighbours.
-use super::{counts, measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{counts, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
@@ -32,51 +33,44 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     if opts.switches.common.particles.is_none() {
         ns.push(16 << 20);
     }
-    let mut pass = ScanPass::new(ctx, ScanVariant::Auto)?;
+    let pass = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
     let variant = if pass.uses_subgroups {
         "scan-subgroup"
     } else {
         "scan-shared"
     };
-    let mut rows = Vec::new();
-    for n in ns {
+    // Every size's buffers first: the protocol interleaves them.
+    let mut sets = Vec::new();
+    for &n in &ns {
         let mut rng = rand_pcg::Pcg32::seed_from_u64(opts.switches.common.seed);
         let data: Vec<u32> = (0..n).map(|_| rng.random_range(0..16)).collect();
-        let mut input = upload(ctx, "bench scan input", &data)?;
-        let mut output = ctx.storage_buffer("bench scan output", n as u64 * 4)?;
-        let mut copied = ctx.storage_buffer("bench copy output", n as u64 * 4)?;
-        let mut scratch = pass.scratch(ctx, n as u64)?;
-        let bytes = n as u64 * 4;
-        let row = measure(
-            ctx,
-            opts,
-            variant,
-            n as u64,
-            SCAN,
-            json!({}),
-            |prof, cmd| {
+        sets.push((
+            n,
+            Guard::new(ctx, upload(ctx, "bench scan input", &data)?),
+            Guard::new(ctx, ctx.storage_buffer("bench scan output", n as u64 * 4)?),
+            Guard::new(ctx, ctx.storage_buffer("bench copy output", n as u64 * 4)?),
+            Guard::new(ctx, pass.scratch(ctx, n as u64)?),
+        ));
+    }
+    let pass = &*pass;
+    let cases = sets
+        .iter()
+        .map(|(n, input, output, copied, scratch)| {
+            let (n, bytes) = (*n as u64, *n as u64 * 4);
+            Case::new(variant, n, SCAN, json!({}), move |prof, cmd| {
                 prof.begin(ctx, cmd, SCAN.name());
-                pass.record(
-                    ctx,
-                    cmd,
-                    &input,
-                    &output,
-                    n as u64,
-                    ScanKind::Exclusive,
-                    &scratch,
-                )?;
+                pass.record(ctx, cmd, input, output, n, ScanKind::Exclusive, scratch)?;
                 prof.end(ctx, cmd);
                 prof.begin(ctx, cmd, super::floor::COPY.name());
-                copy(ctx, cmd, &input, &copied, bytes);
+                copy(ctx, cmd, input, copied, bytes);
                 prof.end(ctx, cmd);
                 Ok(())
-            },
-        );
-        scratch.destroy(ctx);
-        for b in [&mut input, &mut output, &mut copied] {
-            ctx.destroy_buffer(b);
-        }
-        let mut row = row?;
+            })
+        })
+        .collect();
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for row in &mut rows {
+        let bytes = row.n * 4;
         let copy_ms = row.pass(super::floor::COPY)?.median;
         // Both move 2 * bytes (read + write); bandwidth = 2 * bytes / time.
         let gbs = |ms: f64| 2.0 * bytes as f64 / (ms * 1e6);
@@ -88,9 +82,7 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 format!("{:.0}%", 100.0 * copy_ms / row.main.median),
             ),
         ];
-        rows.push(row);
     }
-    pass.destroy(ctx);
     Ok(rows)
 }
 
@@ -103,6 +95,16 @@ fn cell_keys(n: u32, seed: u64) -> (Vec<u32>, u32) {
     (keys, cells)
 }
 
+/// One sort configuration's buffers: pristine keys and values, the working copies, the
+/// counting sort's outputs.
+struct SortSet<'c> {
+    algo: SortAlgo,
+    n: u32,
+    cells: u32,
+    bufs: Guard<'c, Vec<Buffer>>,
+    cb: Guard<'c, CountingBuffers>,
+}
+
 pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let algos = match opts.switches.sorting.sort {
         Some(SortAlgo::None) => return Err(Error::Param(
@@ -112,70 +114,82 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         Some(s) => vec![s],
         None => vec![SortAlgo::OddEven, SortAlgo::Bitonic, SortAlgo::Counting],
     };
-    let mut rows = Vec::new();
-    for algo in algos {
-        let mut scan = ScanPass::new(ctx, ScanVariant::Auto)?;
-        let mut counting = CountingSort::new(ctx)?;
-        let mut network = match algo {
-            SortAlgo::OddEven => Some(NetworkSort::new(ctx, Network::OddEven)?),
-            SortAlgo::Bitonic => Some(NetworkSort::new(ctx, Network::Bitonic)?),
-            SortAlgo::Counting | SortAlgo::None => None,
-        };
+    let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
+    let counting = Guard::new(ctx, CountingSort::new(ctx)?);
+    let odd_even = Guard::new(ctx, NetworkSort::new(ctx, Network::OddEven)?);
+    let bitonic = Guard::new(ctx, NetworkSort::new(ctx, Network::Bitonic)?);
+    let mut sets = Vec::new();
+    for &algo in &algos {
         for n in counts(opts) {
             let (keys, cells) = cell_keys(n, opts.switches.common.seed);
             let vals: Vec<u32> = (0..n).collect();
             let bytes = n as u64 * 4;
-            let mut pk = upload(ctx, "bench pristine keys", &keys)?;
-            let mut pv = upload(ctx, "bench pristine values", &vals)?;
-            let mut wk = ctx.storage_buffer("bench keys", bytes)?;
-            let mut wv = ctx.storage_buffer("bench values", bytes)?;
-            let mut sk = ctx.storage_buffer("bench sorted keys", bytes)?;
-            let mut sv = ctx.storage_buffer("bench sorted values", bytes)?;
-            let mut cb = CountingBuffers::new(ctx, &scan, n as u64, cells)?;
-            let detail = json!({ "cells": cells, "keys": "uniform random cell ids" });
-            let row = measure(
-                ctx,
-                opts,
-                &algo.as_str(),
-                n as u64,
-                SORT,
-                detail,
-                |prof, cmd| {
-                    prof.begin(ctx, cmd, "restore");
-                    copy(ctx, cmd, &pk, &wk, bytes);
-                    copy(ctx, cmd, &pv, &wv, bytes);
-                    prof.end(ctx, cmd);
-                    prof.begin(ctx, cmd, SORT.name());
-                    match &network {
-                        Some(s) => {
-                            s.record(ctx, cmd, &wk, &wv, n as u64)?;
-                        }
-                        None => {
-                            counting.record(ctx, cmd, &scan, &cb, &wk, &wv, &sk, &sv, n as u64)?
-                        }
-                    }
-                    prof.end(ctx, cmd);
-                    Ok(())
-                },
-            );
-            cb.destroy(ctx);
-            for b in [&mut pk, &mut pv, &mut wk, &mut wv, &mut sk, &mut sv] {
-                ctx.destroy_buffer(b);
+            let mut bufs = Guard::new(ctx, Vec::new());
+            bufs.push(upload(ctx, "bench pristine keys", &keys)?);
+            bufs.push(upload(ctx, "bench pristine values", &vals)?);
+            for name in ["keys", "values", "sorted keys", "sorted values"] {
+                bufs.push(ctx.storage_buffer(&format!("bench {name}"), bytes)?);
             }
-            rows.push(row?);
+            let cb = Guard::new(ctx, CountingBuffers::new(ctx, &scan, n as u64, cells)?);
+            sets.push(SortSet {
+                algo,
+                n,
+                cells,
+                bufs,
+                cb,
+            });
         }
-        if let Some(s) = &mut network {
-            s.destroy(ctx);
-        }
-        counting.destroy(ctx);
-        scan.destroy(ctx);
     }
-    Ok(rows)
+    let (scan, counting) = (&*scan, &*counting);
+    let (odd_even, bitonic) = (&*odd_even, &*bitonic);
+    let cases = sets
+        .iter()
+        .map(|s| {
+            let network = match s.algo {
+                SortAlgo::OddEven => Some(odd_even),
+                SortAlgo::Bitonic => Some(bitonic),
+                SortAlgo::Counting | SortAlgo::None => None,
+            };
+            let (n, bytes) = (s.n as u64, s.n as u64 * 4);
+            let b = &s.bufs;
+            let cb = &*s.cb;
+            let detail = json!({ "cells": s.cells, "keys": "uniform random cell ids" });
+            Case::new(s.algo.as_str(), n, SORT, detail, move |prof, cmd| {
+                prof.begin(ctx, cmd, "restore");
+                copy(ctx, cmd, &b[0], &b[2], bytes);
+                copy(ctx, cmd, &b[1], &b[3], bytes);
+                prof.end(ctx, cmd);
+                prof.begin(ctx, cmd, SORT.name());
+                match network {
+                    Some(s) => {
+                        s.record(ctx, cmd, &b[2], &b[3], n)?;
+                    }
+                    None => counting.record(ctx, cmd, scan, cb, &b[2], &b[3], &b[4], &b[5], n)?,
+                }
+                prof.end(ctx, cmd);
+                Ok(())
+            })
+        })
+        .collect();
+    protocol::run(ctx, opts, cases)
 }
 
 /// Radius giving about `k` neighbours for n uniform points in the unit cube.
 pub fn radius_for(n: u32, k: f64) -> f32 {
     (k / (n as f64 * 4.0 / 3.0 * std::f64::consts::PI)).cbrt() as f32
+}
+
+/// One neighbour-search configuration: its search, points and buffers.
+struct SearchSet<'c> {
+    strategy: Neighbors,
+    sort: SortAlgo,
+    n: u32,
+    radius: f32,
+    grid: GridSpec,
+    max_nb: u32,
+    search: &'c NeighborSearch,
+    p: Guard<'c, Buffer>,
+    b: Guard<'c, crate::primitives::neighbors::NeighborBuffers>,
 }
 
 pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
@@ -189,9 +203,13 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             (Neighbors::Morton, SortAlgo::OddEven),
         ],
     };
-    let mut rows = Vec::new();
-    for (strategy, sort) in combos {
-        let mut search = NeighborSearch::new(ctx, strategy, Some(sort))?;
+    let mut searches = Guard::new(ctx, Vec::new());
+    for &(strategy, sort) in &combos {
+        searches.push(NeighborSearch::new(ctx, strategy, Some(sort))?);
+    }
+    let mut sets = Vec::new();
+    for (k, &(strategy, sort)) in combos.iter().enumerate() {
+        let search = &searches[k];
         for n in counts(opts) {
             let radius = radius_for(n, 30.0);
             let grid = GridSpec::covering([0.0; 3], [1.0; 3], radius)?;
@@ -204,49 +222,55 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             // Up to 64 listed neighbours, fewer where the lists would exceed one binding.
             let max_nb = (ctx.max_storage_range() / (n as u64 * 4)).min(64) as u32;
             let b = Guard::new(ctx, search.buffers(ctx, n as u64, &grid, max_nb)?);
-            let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
-            let detail = json!({ "radius": radius, "grid": grid.dims, "max_neighbors": max_nb });
-            let row = measure(
-                ctx,
-                opts,
-                &variant.replace('/', "-"),
-                n as u64,
-                NEIGHBORS,
-                detail,
-                |prof, cmd| {
-                    prof.begin(ctx, cmd, NEIGHBORS.name());
-                    search.record_build(ctx, cmd, prof, &b, &p, n, &grid)?;
-                    search.record_query(ctx, cmd, prof, &b, &p, n, &grid, radius)?;
-                    prof.end(ctx, cmd);
-                    Ok(())
-                },
-            );
-            let stats = row.as_ref().ok().map(|_| -> Result<(u64, f64)> {
-                let c: Vec<u32> = ctx.readback(&b.counts, 0, n as usize)?;
-                let v: Vec<u32> = ctx.readback(&b.visited, 0, n as usize)?;
-                let total = |x: &[u32]| x.iter().map(|&a| a as u64).sum::<u64>();
-                Ok((total(&c), total(&v) as f64 / n as f64))
+            sets.push(SearchSet {
+                strategy,
+                sort,
+                n,
+                radius,
+                grid,
+                max_nb,
+                search,
+                p,
+                b,
             });
-            drop(b);
-            drop(p);
-            let mut row = row?;
-            row.variant = variant;
-            if let Some(s) = stats {
-                let (pairs, visited) = s?;
-                row.extra = vec![
-                    (
-                        "mean neighbours".into(),
-                        format!("{:.1}", pairs as f64 / n as f64),
-                    ),
-                    ("mean candidates".into(), format!("{visited:.1}")),
-                    // Exact: every strategy must find the same pairs in the same points.
-                    (NEIGHBOUR_PAIRS.into(), pairs.to_string()),
-                ];
-            }
-            rows.push(row);
         }
-        search.destroy(ctx);
     }
+    let cases = sets
+        .iter()
+        .map(|s| {
+            let variant = format!("{}-{}", s.strategy.as_str(), s.sort.as_str());
+            let detail =
+                json!({ "radius": s.radius, "grid": s.grid.dims, "max_neighbors": s.max_nb });
+            Case::new(variant, s.n as u64, NEIGHBORS, detail, move |prof, cmd| {
+                prof.begin(ctx, cmd, NEIGHBORS.name());
+                s.search
+                    .record_build(ctx, cmd, prof, &s.b, &s.p, s.n, &s.grid)?;
+                s.search
+                    .record_query(ctx, cmd, prof, &s.b, &s.p, s.n, &s.grid, s.radius)?;
+                prof.end(ctx, cmd);
+                Ok(())
+            })
+        })
+        .collect();
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for (row, s) in rows.iter_mut().zip(&sets) {
+        let n = s.n as usize;
+        row.variant = format!("{}/{}", s.strategy.as_str(), s.sort.as_str());
+        let c: Vec<u32> = ctx.readback(&s.b.counts, 0, n)?;
+        let v: Vec<u32> = ctx.readback(&s.b.visited, 0, n)?;
+        let total = |x: &[u32]| x.iter().map(|&a| a as u64).sum::<u64>();
+        let (pairs, visited) = (total(&c), total(&v) as f64 / n as f64);
+        row.extra = vec![
+            (
+                "mean neighbours".into(),
+                format!("{:.1}", pairs as f64 / n as f64),
+            ),
+            ("mean candidates".into(), format!("{visited:.1}")),
+            // Exact: every strategy must find the same pairs in the same points.
+            (NEIGHBOUR_PAIRS.into(), pairs.to_string()),
+        ];
+    }
+    drop(sets);
     Ok(rows)
 }
 

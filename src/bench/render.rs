@@ -4,7 +4,8 @@
 //! and by compute, tiles), --build, --tile, --march, --material, --density, --threshold, --radius, --refine, --depth; or
 //! --surface screen-space|mesh (one row, no lists) on the same blob.
 use super::floor::Floor;
-use super::{measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{BenchOptions, Row};
 use crate::config::{BuildKind, ListKind, SurfaceKind};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
@@ -17,7 +18,10 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let n = sw.common.particles.unwrap_or(2048) as usize;
     let spacing = FluidParams::default().spacing();
     let pts = blob(n, spacing);
-    let mut centers = ctx.storage_buffer("metaball centers", (n * 16) as u64)?;
+    let mut centers = Guard::new(
+        ctx,
+        ctx.storage_buffer("metaball centers", (n * 16) as u64)?,
+    );
     ctx.upload(&mut centers, 0, &pts)?;
     let lists = rows_of(sw)?;
     // The floor's rates, measured in this run (metaball rows only).
@@ -26,88 +30,87 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         Some(_) => None,
     };
     let other = sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs);
-    let mut rows = Vec::new();
-    let result = (|| -> Result<()> {
-        for (list, sorted, build) in lists {
-            let mut settings = crate::settings::metaball_settings(sw)?;
-            (settings.list, settings.sorted, settings.build) = (list, sorted, build);
-            settings.fluid = Some(blob_fluid(&pts, spacing));
-            let name = match other {
-                Some(k) => k.as_str(),
-                None => settings.list_name(),
-            };
-            let cam = crate::run::common::camera_with_switches(
-                blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
-                sw,
-            );
-            let r = Guard::new(ctx, FluidRenderer::new(ctx, settings.clone())?);
-            let mut b = Guard::new(ctx, r.buffers(ctx, n as u64, 2, false)?);
-            // Size the lists (and count the redos) before timing.
-            let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0);
-            let row = sized.and_then(|(st, redos)| {
-                let detail = json!({ "settings": settings, "particles": n, "spacing": spacing });
-                let mut row = measure(
-                    ctx,
-                    opts,
-                    &name,
-                    n as u64,
-                    crate::render::SCOPE,
-                    detail,
-                    |prof, cmd| {
-                        prof.begin(ctx, cmd, crate::render::SCOPE.name());
-                        r.record(ctx, cmd, prof, &b, &centers, n as u32, &cam, 0)?;
-                        prof.end(ctx, cmd);
-                        Ok(())
-                    },
-                )?;
-                let after = r.frame_stats(&b, 0);
-                let cut = after.budget_pixels.max(st.budget_pixels);
-                // The march's per-ray counters of the last timed frame, per pixel.
-                let per_px = after.march.per_pixel(settings.pixels());
-                row.extra = vec![
-                    ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
-                    (
-                        "list MB".into(),
-                        format!("{:.2}", st.list_bytes as f64 / 1e6),
-                    ),
-                    ("fragments".into(), st.fragments.to_string()),
-                    ("longest list".into(), st.longest.to_string()),
-                    ("steps/px".into(), format!("{:.1}", per_px.0)),
-                    ("evals/px".into(), format!("{:.0}", per_px.1)),
-                    ("candidates/px".into(), format!("{:.1}", per_px.2)),
-                    ("redos".into(), redos.to_string()),
-                    (
-                        "overflow in timed frames".into(),
-                        after.overflow.to_string(),
-                    ),
-                    ("pixels past loop budget".into(), cut.to_string()),
-                ];
-                if let Some(f) = &floor {
-                    // The least traffic: the centres read, the picture written, the lists
-                    // written once and read once.
-                    let px = settings.pixels() as f64;
-                    let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
-                    let ms = f.ms(bytes, after.march.evaluations as f64);
-                    row.extra.push(("floor ms".into(), format!("{ms:.4}")));
-                    let above = row.main.median / ms.max(1e-12);
-                    row.extra.push(("x floor".into(), format!("{above:.1}")));
-                }
-                if cut > 0 {
-                    eprintln!(
-                        "warning: {name}: {cut} pixels' rays were cut short by llvmpipe's loop \
-                         budget; this row understates the cost and its image is wrong"
-                    );
-                }
-                Ok(row)
-            });
-            drop(b);
-            drop(r);
-            rows.push(row?);
+    // Every row's renderer and buffers first, its lists sized (and redos counted).
+    let mut sets = Vec::new();
+    for (list, sorted, build) in lists {
+        let mut settings = crate::settings::metaball_settings(sw)?;
+        (settings.list, settings.sorted, settings.build) = (list, sorted, build);
+        settings.fluid = Some(blob_fluid(&pts, spacing));
+        let name = match other {
+            Some(k) => k.as_str(),
+            None => settings.list_name(),
+        };
+        let cam = crate::run::common::camera_with_switches(
+            blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
+            sw,
+        );
+        let r = Guard::new(ctx, FluidRenderer::new(ctx, settings.clone())?);
+        let mut b = Guard::new(ctx, r.buffers(ctx, n as u64, 2, false)?);
+        let sized = r.render_sync(ctx, &mut b, &centers, n as u32, &cam, 0)?;
+        sets.push((settings, name, cam, r, b, sized));
+    }
+    let centers = &*centers;
+    let cases = sets
+        .iter()
+        .map(|(settings, name, cam, r, b, _)| {
+            let detail = json!({ "settings": settings, "particles": n, "spacing": spacing });
+            let (r, b) = (&**r, &**b);
+            Case::new(
+                name.clone(),
+                n as u64,
+                crate::render::SCOPE,
+                detail,
+                move |prof, cmd| {
+                    prof.begin(ctx, cmd, crate::render::SCOPE.name());
+                    r.record(ctx, cmd, prof, b, centers, n as u32, cam, 0)?;
+                    prof.end(ctx, cmd);
+                    Ok(())
+                },
+            )
+        })
+        .collect();
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for (row, (settings, name, _, r, b, (st, redos))) in rows.iter_mut().zip(&sets) {
+        let after = r.frame_stats(b, 0);
+        let cut = after.budget_pixels.max(st.budget_pixels);
+        // The march's per-ray counters of the last timed frame, per pixel.
+        let per_px = after.march.per_pixel(settings.pixels());
+        row.extra = vec![
+            ("fps".into(), format!("{:.2}", 1000.0 / row.main.median)),
+            (
+                "list MB".into(),
+                format!("{:.2}", st.list_bytes as f64 / 1e6),
+            ),
+            ("fragments".into(), st.fragments.to_string()),
+            ("longest list".into(), st.longest.to_string()),
+            ("steps/px".into(), format!("{:.1}", per_px.0)),
+            ("evals/px".into(), format!("{:.0}", per_px.1)),
+            ("candidates/px".into(), format!("{:.1}", per_px.2)),
+            ("redos".into(), redos.to_string()),
+            (
+                "overflow in timed frames".into(),
+                after.overflow.to_string(),
+            ),
+            ("pixels past loop budget".into(), cut.to_string()),
+        ];
+        if let Some(f) = &floor {
+            // The least traffic: the centres read, the picture written, the lists
+            // written once and read once.
+            let px = settings.pixels() as f64;
+            let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
+            let ms = f.ms(bytes, after.march.evaluations as f64);
+            row.extra.push(("floor ms".into(), format!("{ms:.4}")));
+            let above = row.main.median / ms.max(1e-12);
+            row.extra.push(("x floor".into(), format!("{above:.1}")));
         }
-        Ok(())
-    })();
-    ctx.destroy_buffer(&mut centers);
-    result.map(|_| rows)
+        if cut > 0 {
+            eprintln!(
+                "warning: {name}: {cut} pixels' rays were cut short by llvmpipe's loop \
+                 budget; this row understates the cost and its image is wrong"
+            );
+        }
+    }
+    Ok(rows)
 }
 
 /// The (list, sorted, build) rows: what --list, --list-sort and --build pick, or every

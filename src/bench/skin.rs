@@ -1,7 +1,8 @@
 //! `bench skin`: the skinning pass per method on a character (the built-in walker, or
 //! --character FILE) and on a generated mesh of about --vertices (default 1M) vertices:
 //! copies of the walker side by side, skinned by its 13 joints mid-walk.
-use super::{measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{BenchOptions, Row};
 use crate::character::{self, skin::Skinner, Animator, Character};
 use crate::config::Skinning;
 use crate::error::Result;
@@ -56,7 +57,8 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let walker = character::load("builtin:walker")?;
     let target = opts.vertices.unwrap_or(1 << 20) as usize;
     let big = tiled(&walker, target.div_ceil(walker.mesh.vertices()).max(1));
-    let mut rows = Vec::new();
+    let mut cases = Vec::new();
+    let mut moved = Vec::new();
     for (name, c) in [(file.as_str(), &ch), ("generated", &big)] {
         let anim = Animator {
             clip: (!c.clips.is_empty()).then_some(0),
@@ -70,23 +72,25 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let n = c.mesh.vertices() as u64;
             let detail = json!({ "mesh": c.source, "vertices": n, "joints": c.skeleton.joints.len(),
                                  "influences": 4 * c.mesh.influence_sets, "method": method.as_str() });
-            let mut row = measure(ctx, opts, &variant, n, SKIN, detail, |prof, cmd| {
+            // Bytes the pass moves: rest position, normal, influences in; position, normal out.
+            moved.push(n as f64 * (16.0 + 16.0 + 24.0 * c.mesh.influence_sets as f64 + 32.0));
+            cases.push(Case::new(variant, n, SKIN, detail, move |prof, cmd| {
                 prof.begin(ctx, cmd, SKIN.name());
                 sk.record(ctx, cmd, &joints)?;
                 prof.end(ctx, cmd);
                 Ok(())
-            })?;
-            // Bytes the pass moves: rest position, normal, influences in; position, normal out.
-            let bytes = n as f64 * (16.0 + 16.0 + 24.0 * c.mesh.influence_sets as f64 + 32.0);
-            row.extra = vec![
-                ("MB moved".into(), format!("{:.1}", bytes / 1e6)),
-                (
-                    "GB/s".into(),
-                    format!("{:.2}", bytes / 1e6 / row.main.median),
-                ),
-            ];
-            rows.push(row);
+            }));
         }
+    }
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for (row, bytes) in rows.iter_mut().zip(moved) {
+        row.extra = vec![
+            ("MB moved".into(), format!("{:.1}", bytes / 1e6)),
+            (
+                "GB/s".into(),
+                format!("{:.2}", bytes / 1e6 / row.main.median),
+            ),
+        ];
     }
     Ok(rows)
 }

@@ -221,6 +221,8 @@ fn row(variant: String, f: &FluidParams, o: &Outcome) -> Result<Row> {
         (None, _) => "ok".into(),
     };
     Ok(Row {
+        interval: None,
+        flagged: false,
         variant,
         n: o.particles as u64,
         main,

@@ -1,6 +1,7 @@
 //! SPH benchmarks: steps per second and per-pass ms over N and neighbour strategies, and
 //! the dam-break stability run (32K particles, 10 simulated seconds, any solver).
-use super::{counts, measure, BenchOptions, Row};
+use super::protocol::{self, Case};
+use super::{counts, BenchOptions, Row};
 use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, FrameLoop, Guard};
@@ -29,39 +30,54 @@ pub fn strategies(
 pub fn steps(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut base = Scene::built_in("dam-break").expect("built-in");
     base.fluid = opts.switches.fluid_args.apply(&base.fluid)?;
-    let mut rows = Vec::new();
-    for (strategy, sort) in strategies(
+    let combos = strategies(
         opts,
         &[
             (Neighbors::Grid, SortAlgo::Counting),
             (Neighbors::Hash, SortAlgo::Bitonic),
             (Neighbors::Morton, SortAlgo::OddEven),
         ],
-    ) {
-        // Guards release the solver and state on every path, an early `?` included.
-        let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
+    );
+    // Guards release the solvers and states on every path, an early `?` included.
+    let mut solvers = Guard::new(ctx, Vec::new());
+    for &(strategy, sort) in &combos {
+        solvers.push(SphSolver::new(ctx, strategy, Some(sort))?);
+    }
+    // Every state first (a state is made through its solver's `&mut`).
+    let mut states = Guard::new(ctx, Vec::new());
+    let mut keys = Vec::new();
+    for (k, &(strategy, sort)) in combos.iter().enumerate() {
         for n in counts(opts) {
             let scene = base.with_particles(n);
             let parts = scene.particles(opts.switches.common.seed);
-            let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
+            states.push(solvers[k].state(ctx, &scene, &parts)?);
+            keys.push((k, strategy, sort, scene.fluid));
+        }
+    }
+    let solvers = &*solvers;
+    let cases = states
+        .iter_mut()
+        .zip(&keys)
+        .map(|(st, (k, strategy, sort, fluid))| {
+            let solver = &solvers[*k];
             let actual = st.n as u64;
-            let variant = format!("{}/{}", strategy.as_str(), sort.as_str());
-            let detail = json!({ "scene": "dam-break", "particles": actual, "dt": st.dt, "fluid": scene.fluid });
-            let row = measure(
-                ctx,
-                opts,
-                &variant.replace('/', "-"),
+            let variant = format!("{}-{}", strategy.as_str(), sort.as_str());
+            let detail =
+                json!({ "scene": "dam-break", "particles": actual, "dt": st.dt, "fluid": fluid });
+            // The case owns its state: each advances only in its own frames.
+            Case::new(
+                variant,
                 actual,
                 crate::sph::SCOPE,
                 detail,
-                |prof, cmd| solver.record_step(ctx, cmd, prof, &mut st),
-            );
-            drop(st);
-            let mut row = row?;
-            row.variant = variant;
-            row.extra = vec![("steps/s".into(), format!("{:.1}", 1000.0 / row.main.median))];
-            rows.push(row);
-        }
+                move |prof, cmd| solver.record_step(ctx, cmd, prof, st),
+            )
+        })
+        .collect();
+    let mut rows = protocol::run(ctx, opts, cases)?;
+    for row in &mut rows {
+        row.variant = row.variant.replacen('-', "/", 1);
+        row.extra = vec![("steps/s".into(), format!("{:.1}", 1000.0 / row.main.median))];
     }
     Ok(rows)
 }
@@ -284,6 +300,8 @@ fn stability_row(
     let density_ok = summary.mean_density_within_5_percent;
     let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
     let row = Row {
+        interval: None,
+        flagged: false,
         variant: format!(
             "stability {} {}/{}",
             solver_kind.as_str(),

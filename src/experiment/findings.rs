@@ -2,6 +2,7 @@
 //! Every experiment saves its verdicts as `<name>.findings.json`; `findings.md` is rebuilt
 //! from all of them, one section per claim.
 use super::{io, write, Env, Experiment};
+use crate::bench::interval::{Interval, Standing};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -17,6 +18,8 @@ pub const GRID_LINEAR: &str = "the counting grid scales linearly in N";
 pub enum Verdict {
     Confirmed,
     Refuted,
+    /// The effect lies inside the noise: the intervals overlap, or a row was flagged.
+    Inconclusive,
     NotMeasured,
 }
 
@@ -32,8 +35,37 @@ impl Verdict {
         match self {
             Verdict::Confirmed => "confirmed",
             Verdict::Refuted => "refuted",
+            Verdict::Inconclusive => "inconclusive",
             Verdict::NotMeasured => "not measured",
         }
+    }
+
+    /// A claim that `a` takes less time than `b`: confirmed where a's interval lies wholly
+    /// below b's, refuted where wholly above, inconclusive where they overlap.
+    pub fn less(a: &Interval, b: &Interval) -> Self {
+        match a.against(b) {
+            Standing::Below => Verdict::Confirmed,
+            Standing::Above => Verdict::Refuted,
+            Standing::Overlap => Verdict::Inconclusive,
+        }
+    }
+
+    /// A claim that `slow / fast` is at least `k` (a speed-up): confirmed where even the
+    /// least ratio the intervals allow reaches k, refuted where even the greatest does not.
+    pub fn ratio_at_least(slow: &Interval, fast: &Interval, k: f64) -> Self {
+        if slow.lo / fast.hi.max(1e-12) >= k {
+            Verdict::Confirmed
+        } else if slow.hi / fast.lo.max(1e-12) < k {
+            Verdict::Refuted
+        } else {
+            Verdict::Inconclusive
+        }
+    }
+
+    /// A claim over several comparisons ("in every row"): refuted where any is, else
+    /// inconclusive where any is, else confirmed; not measured without comparisons.
+    pub fn all(verdicts: impl IntoIterator<Item = Verdict>) -> Self {
+        overall(&verdicts.into_iter().collect::<Vec<_>>())
     }
 }
 
@@ -105,6 +137,8 @@ pub fn overall<'a>(verdicts: impl IntoIterator<Item = &'a Verdict>) -> Verdict {
         Verdict::NotMeasured
     } else if measured.contains(&Verdict::Refuted) {
         Verdict::Refuted
+    } else if measured.contains(&Verdict::Inconclusive) {
+        Verdict::Inconclusive
     } else {
         Verdict::Confirmed
     }
@@ -130,7 +164,10 @@ pub fn rebuild(env: &Env) -> Result<PathBuf> {
     let mut md = format!(
         "# The papers' findings on {}\n\nWritten by `fluidform experiment`: each claim of the \
          papers, confirmed or refuted by the experiments that measure it (their tables are \
-         beside this file). A claim is refuted where any experiment refutes it. Every device's \
+         beside this file). A comparison counts only where the two rows' 95% intervals do not \
+         overlap; where they do, or where a row was flagged as measured in a drifting device \
+         state, it is inconclusive. A claim is refuted where any experiment refutes it, else \
+         inconclusive where any is. Every device's \
          verdicts side by side: `fluidform compare` writes them to ../devices.md.\n\n",
         env.meta.device
     );

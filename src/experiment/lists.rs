@@ -5,12 +5,15 @@
 //! the A-buffer and the raster-built S-buffer, tiles against every per-pixel list, the
 //! Lipschitz march's steps, and the speed targets of the best mode.
 use super::findings::{Finding, Verdict};
-use super::measure::{base, time_frame, Frame};
+use super::measure::base;
+use super::shots::{time_shots, Shot};
 use super::{write, Env, Experiment, Steps};
 use crate::bench::floor::Floor;
+use crate::bench::interval::Interval;
 use crate::bench::Measurer;
 use crate::config::{BuildKind, ListKind, MarchKind, Material, RenderKind};
 use crate::error::{Error, Result};
+use crate::gpu::Guard;
 use crate::render::metaball::MetaballSettings;
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -83,9 +86,13 @@ impl Mode {
 }
 
 /// One measured configuration.
+#[derive(Clone)]
 struct Cell {
     mode: Mode,
     ms: f64,
+    /// The median's 95% interval under the protocol.
+    interval: Interval,
+    flagged: bool,
     passes: String,
     list_mb: f64,
     steps: f64,
@@ -121,65 +128,67 @@ fn thesis_frame(
     let n = centers.len();
     let opts = env.bench_options(Measurer::Experiment(Experiment::Lists), Experiment::Lists);
     let floor = Floor::measure(ctx, &opts)?;
-    let mut buf = ctx.storage_buffer("thesis centers", (n * 16) as u64)?;
-    let mut out = Vec::new();
-    let result = (|| -> Result<()> {
-        ctx.upload(&mut buf, 0, &centers)?;
-        for (label, material, depth, modes) in LOOKS {
-            let mut row = Vec::new();
-            for mode in MODES.iter().filter(|m| modes(m)) {
-                steps.start(&format!("{label} {}", mode.name()));
-                let mut s = base(env.width, env.height)?;
-                (s.material, s.depth) = (material, depth);
-                mode.apply(&mut s);
-                s.validate()?;
-                let (r, b) = env.renderer(ctx, &s, n as u64)?;
-                let (st, redos) = r.render_sync(ctx, b, &buf, n as u32, &cam, 0)?;
-                let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
-                    "particles": n, "redos": redos });
-                let variant = format!("{}-{}", material.as_str(), mode.name().replace(' ', "-"));
-                let frame = Frame {
-                    r,
-                    b,
-                    centers: &buf,
-                    n: n as u32,
-                    cam: &cam,
-                };
-                let m = time_frame(ctx, &opts, &variant, detail, &frame)?;
-                let after = r.frame_stats(b, 0);
-                if after.budget_pixels > 0 || after.overflow > 0 {
-                    return Err(Error::Param(format!(
-                        "lists: {label} {}: {} pixels past the loop budget, {} entries overflowed",
-                        mode.name(),
-                        after.budget_pixels,
-                        after.overflow
-                    )));
-                }
-                let px = s.pixels() as f64;
-                let (st_px, ev_px, _) = after.march.per_pixel(s.pixels());
-                let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
-                let passes = (m.passes.iter())
-                    .filter_map(|(k, v)| Some((k.strip_prefix("render/")?, v.median)))
-                    .map(|(k, v)| format!("{k} {v:.2}"))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                row.push(Cell {
-                    mode: *mode,
-                    ms: m.main.median,
-                    passes,
-                    list_mb: st.list_bytes as f64 / 1e6,
-                    steps: st_px,
-                    evals: ev_px,
-                    floor: floor.ms(bytes, after.march.evaluations as f64),
-                });
-                steps.tick();
-            }
-            out.push(row);
+    let mut buf = Guard::new(ctx, ctx.storage_buffer("thesis centers", (n * 16) as u64)?);
+    ctx.upload(&mut buf, 0, &centers)?;
+    // Every look's modes, timed together (the protocol interleaves them).
+    let mut shots = Vec::new();
+    let mut which = Vec::new();
+    for (k, (label, material, depth, modes)) in LOOKS.into_iter().enumerate() {
+        for mode in MODES.iter().filter(|m| modes(m)) {
+            let mut s = base(env.width, env.height)?;
+            (s.material, s.depth) = (material, depth);
+            mode.apply(&mut s);
+            s.validate()?;
+            let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
+                "particles": n });
+            shots.push(Shot {
+                variant: format!("{}-{}", material.as_str(), mode.name().replace(' ', "-")),
+                settings: s,
+                centers: &buf,
+                centers_key: format!("thesis {n}"),
+                n: n as u32,
+                cam,
+                detail,
+            });
+            which.push((k, label, *mode));
         }
-        Ok(())
-    })();
-    ctx.destroy_buffer(&mut buf);
-    result.map(|_| out)
+    }
+    steps.start("every look and mode, interleaved");
+    let timed = time_shots(ctx, env, &opts, &shots)?;
+    steps.tick();
+    let mut out: Vec<Vec<Cell>> = LOOKS.iter().map(|_| Vec::new()).collect();
+    for ((t, shot), (k, label, mode)) in timed.iter().zip(&shots).zip(which) {
+        let (st, after) = (&t.sized, &t.after);
+        if after.budget_pixels > 0 || after.overflow > 0 {
+            return Err(Error::Param(format!(
+                "lists: {label} {}: {} pixels past the loop budget, {} entries overflowed",
+                mode.name(),
+                after.budget_pixels,
+                after.overflow
+            )));
+        }
+        let s = &shot.settings;
+        let px = s.pixels() as f64;
+        let (st_px, ev_px, _) = after.march.per_pixel(s.pixels());
+        let bytes = 16.0 * n as f64 + 4.0 * px + 2.0 * st.list_bytes as f64;
+        let passes = (t.row.passes.iter())
+            .filter_map(|(k, v)| Some((k.strip_prefix("render/")?, v.median)))
+            .map(|(k, v)| format!("{k} {v:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        out[k].push(Cell {
+            mode,
+            ms: t.row.main.median,
+            interval: t.row.interval.unwrap_or_default(),
+            flagged: t.row.flagged,
+            passes,
+            list_mb: st.list_bytes as f64 / 1e6,
+            steps: st_px,
+            evals: ev_px,
+            floor: floor.ms(bytes, after.march.evaluations as f64),
+        });
+    }
+    Ok(out)
 }
 
 /// Frames the character plays per mode.
@@ -325,88 +334,99 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
 }
 
 fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
-    let ms = |row: &[Cell], m: Mode| row.iter().find(|c| c.mode == m).map_or(f64::NAN, |c| c.ms);
-    let fixed = |row: &[Cell]| -> Vec<(Mode, f64)> {
-        (row.iter())
-            .filter(|c| c.mode.4 == FIXED)
-            .map(|c| (c.mode, c.ms))
-            .collect()
+    let cell = |row: &'_ [Cell], m: Mode| row.iter().find(|c| c.mode == m).cloned();
+    let fixed =
+        |row: &[Cell]| -> Vec<Cell> { row.iter().filter(|c| c.mode.4 == FIXED).cloned().collect() };
+    let best = |v: &[Cell]| v.iter().cloned().min_by(|a, b| a.ms.total_cmp(&b.ms));
+    // Timings compare beyond their 95% intervals (a flagged cell decides nothing).
+    let less = |a: &Cell, b: &Cell| match a.flagged || b.flagged {
+        true => Verdict::Inconclusive,
+        false => Verdict::less(&a.interval, &b.interval),
     };
-    let best = |v: &[(Mode, f64)]| v.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
     let (phong, glass) = (&cells[0], &cells[1]);
-    let abuf = ms(phong, MODES[0]);
     let compute = best(
         &fixed(phong)
             .into_iter()
-            .filter(|(m, _)| m.0 == S && m.2 == C)
+            .filter(|c| c.mode.0 == S && c.mode.2 == C)
             .collect::<Vec<_>>(),
     );
     let mut found = Vec::new();
-    found.push(match compute {
-        Some((m, t)) => Finding::new(
+    found.push(match (compute, cell(phong, MODES[0])) {
+        (Some(c), Some(a)) => Finding::new(
             COMPUTE_BEATS_ABUFFER,
-            Verdict::of(t < abuf),
+            less(&c, &a),
             format!(
-                "{}: {t:.2} ms, A-buffer {abuf:.2} ms ({:.2}x)",
-                m.name(),
-                abuf / t
+                "{}: {}, A-buffer {} ({:.2}x)",
+                c.mode.name(),
+                c.interval.text(),
+                a.interval.text(),
+                a.ms / c.ms
             ),
         ),
-        None => Finding::new(COMPUTE_BEATS_ABUFFER, Verdict::NotMeasured, String::new()),
+        _ => Finding::new(COMPUTE_BEATS_ABUFFER, Verdict::NotMeasured, String::new()),
     });
-    let mut holds = true;
-    let mut ev = Vec::new();
+    let (mut vs, mut ev) = (Vec::new(), Vec::new());
     for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
         for sorted in [false, true] {
-            let (r, c) = (
-                ms(row, Mode(S, sorted, R, 16, FIXED)),
-                ms(row, Mode(S, sorted, C, 16, FIXED)),
-            );
-            if r.is_nan() || c.is_nan() {
+            let (Some(r), Some(c)) = (
+                cell(row, Mode(S, sorted, R, 16, FIXED)),
+                cell(row, Mode(S, sorted, C, 16, FIXED)),
+            ) else {
                 continue;
-            }
-            holds &= c <= r;
+            };
+            // At least as fast: refuted only where compute is slower beyond the intervals.
+            let v = match less(&r, &c) {
+                Verdict::Confirmed => Verdict::Refuted,
+                Verdict::Refuted => Verdict::Confirmed,
+                v => v,
+            };
+            vs.push(v);
             ev.push(format!(
-                "{label} {}: {:.2}x",
+                "{label} {}: {:.2}x ({}, raster {}, compute {})",
                 if sorted { "sorted" } else { "unsorted" },
-                r / c
+                r.ms / c.ms,
+                v.word(),
+                r.interval.text(),
+                c.interval.text()
             ));
         }
     }
     found.push(Finding::new(
         COMPUTE_AS_FAST,
-        Verdict::of(holds),
+        Verdict::all(vs),
         format!("raster ms / compute ms: {}", ev.join("; ")),
     ));
-    let (mut holds, mut ev) = (true, Vec::new());
+    let (mut vs, mut ev) = (Vec::new(), Vec::new());
     for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
         let f = fixed(row);
         let tiles = best(
             &f.iter()
-                .copied()
-                .filter(|(m, _)| !m.per_pixel())
+                .cloned()
+                .filter(|c| !c.mode.per_pixel())
                 .collect::<Vec<_>>(),
         );
         let lists = best(
             &f.iter()
-                .copied()
-                .filter(|(m, _)| m.per_pixel())
+                .cloned()
+                .filter(|c| c.mode.per_pixel())
                 .collect::<Vec<_>>(),
         );
         if let (Some(t), Some(l)) = (tiles, lists) {
-            holds &= t.1 < l.1;
+            let v = less(&t, &l);
+            vs.push(v);
             ev.push(format!(
-                "{label}: {} {:.2} ms, best list {} {:.2} ms",
-                t.0.name(),
-                t.1,
-                l.0.name(),
-                l.1
+                "{label} ({}): {} {}, best list {} {}",
+                v.word(),
+                t.mode.name(),
+                t.interval.text(),
+                l.mode.name(),
+                l.interval.text()
             ));
         }
     }
     found.push(Finding::new(
         TILES_BEAT_LISTS,
-        Verdict::of(holds),
+        Verdict::all(vs),
         ev.join("; "),
     ));
     let (mut holds, mut ev) = (true, Vec::new());
@@ -433,24 +453,28 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
         ev.join("; "),
     ));
     for (claim, row, reference) in [(BEST_PHONG, phong, MODES[1]), (BEST_GLASS, glass, MODES[2])] {
-        let all: Vec<(Mode, f64)> = row.iter().map(|c| (c.mode, c.ms)).collect();
-        let r = ms(row, reference);
-        found.push(match best(&all) {
-            Some((m, t)) => Finding::new(
+        found.push(match (best(row), cell(row, reference)) {
+            (Some(t), Some(r)) => Finding::new(
                 claim,
-                Verdict::of(r / t >= 2.0),
+                match t.flagged || r.flagged {
+                    true => Verdict::Inconclusive,
+                    false => Verdict::ratio_at_least(&r.interval, &t.interval, 2.0),
+                },
                 format!(
-                    "{}: {t:.2} ms against {} {r:.2} ms ({:.2}x)",
-                    m.name(),
+                    "{}: {} against {} {} ({:.2}x)",
+                    t.mode.name(),
+                    t.interval.text(),
                     reference.name(),
-                    r / t
+                    r.interval.text(),
+                    r.ms / t.ms
                 ),
             ),
-            None => Finding::new(claim, Verdict::NotMeasured, String::new()),
+            _ => Finding::new(claim, Verdict::NotMeasured, String::new()),
         });
     }
     let d0 = demo.first().map_or(f64::NAN, |d| d.1);
-    found.push(match best(demo) {
+    let fastest = demo.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
+    found.push(match fastest {
         Some((m, t)) => Finding::new(
             DEMO_FASTER,
             Verdict::of(d0 / t >= 2.0),

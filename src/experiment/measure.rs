@@ -1,12 +1,13 @@
 //! Measure one thesis table on the thesis scene and write its CSV, markdown, plot, image
 //! sheet and findings.
 use super::findings::{self, Finding, Verdict};
+use super::shots::{time_shots, Shot};
 use super::tables::{value, Col, TableDef, SBUFFER};
 use super::{write, Env, Steps};
-use crate::bench::{measure as bench_measure, Measurer};
-use crate::config::ListKind;
+use crate::bench::interval::Interval;
+use crate::bench::Measurer;
 use crate::error::Result;
-use crate::gpu::Context;
+use crate::gpu::{Context, Guard};
 use crate::render::metaball::MetaballSettings;
 use crate::report::Stat;
 use serde_json::json;
@@ -15,6 +16,9 @@ use std::path::PathBuf;
 /// One (row, column) of a table.
 pub struct Cell {
     pub stat: Stat,
+    /// The median's 95% interval under the protocol.
+    pub interval: Interval,
+    pub flagged: bool,
     pub reps: u64,
     pub fps: f64,
     pub list_bytes: u64,
@@ -59,8 +63,7 @@ pub fn table(ctx: &Context, env: &mut Env, def: TableDef) -> Result<(Vec<PathBuf
     Ok((files, found))
 }
 
-/// Every cell of the table, row by row. Long because a row's centre buffer must be freed
-/// on every path, so its lists' measurements sit inside one closure.
+/// Every cell of the table, timed together under the protocol (shots.rs).
 fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     let seed = env.switches.common.seed;
     let base_centers = env.scene(ctx)?.centers.clone();
@@ -69,16 +72,15 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     let (width, height) = (env.width, env.height);
     let mut steps = Steps::new(
         &def.name.as_str(),
-        (def.rows.len() * def.cols.len()) as u64,
+        def.rows.len() as u64 + 1,
         env.switches.common.quiet,
     );
-    let mut out = Measured {
-        labels: Vec::new(),
-        particles: Vec::new(),
-        cells: Vec::new(),
-        images: Vec::new(),
-    };
+    // Every row's centres first: the protocol interleaves every cell of the table.
+    let mut labels = Vec::new();
+    let mut particles = Vec::new();
+    let mut bufs = Guard::new(ctx, Vec::new());
     for row in &def.rows {
+        steps.start(&format!("{} centres", row.label));
         let centers = match row.change.particles {
             Some(f) => {
                 let n = (base_centers.len() as f64 * f).round() as usize;
@@ -87,101 +89,73 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
             None => base_centers.clone(),
         };
         let n = centers.len();
-        let label = match row.change.particles {
+        labels.push(match row.change.particles {
             Some(_) => format!("N={n}"),
             None => row.label.clone(),
-        };
-        let mut buf = ctx.storage_buffer("thesis centers", (n * 16) as u64)?;
-        let mut cells = Vec::new();
+        });
+        particles.push(n);
+        bufs.push(ctx.storage_buffer("thesis centers", (n * 16) as u64)?);
+        ctx.upload(bufs.last_mut().expect("pushed"), 0, &centers)?;
+        steps.tick();
+    }
+    let mut shots = Vec::new();
+    for (r, row) in def.rows.iter().enumerate() {
+        for col in &def.cols {
+            let mut s = base(width, height)?;
+            row.change.apply(&mut s);
+            s.list = col.list;
+            s.sorted = col.sorted;
+            s.validate()?;
+            let label = &labels[r];
+            let detail = json!({ "table": def.name.as_str(), "row": label, "list": col.name,
+                "settings": s, "particles": particles[r] });
+            shots.push(Shot {
+                variant: format!("{}-{}", slug(label), col.name),
+                settings: s,
+                centers: &bufs[r],
+                centers_key: format!("thesis {} seed {seed}", particles[r]),
+                n: particles[r] as u32,
+                cam,
+                detail,
+            });
+        }
+    }
+    steps.start("every cell, interleaved");
+    let timed = time_shots(ctx, env, &opts, &shots)?;
+    steps.tick();
+    steps.finish();
+    let mut out = Measured {
+        labels,
+        particles,
+        cells: Vec::new(),
+        images: Vec::new(),
+    };
+    for row in timed.chunks(def.cols.len()) {
         let mut image = Vec::new();
-        let result = (|| -> Result<()> {
-            ctx.upload(&mut buf, 0, &centers)?;
-            for col in &def.cols {
-                steps.start(&format!("{label} {}", col.name));
-                let mut s = base(width, height)?;
-                row.change.apply(&mut s);
-                s.list = col.list;
-                s.sorted = col.sorted;
-                s.validate()?;
-                let (r, b) = env.renderer(ctx, &s, n as u64)?;
-                // Size the lists before timing (none has none: its frames are the slowest,
-                // so it is not drawn once more; its statistics come from the timed frames).
-                let sized = match col.list {
-                    ListKind::None => None,
-                    _ => Some(r.render_sync(ctx, b, &buf, n as u32, &cam, 0)?),
-                };
-                let redos = sized.map_or(0, |s| s.1);
+        let cells = row
+            .iter()
+            .zip(&def.cols)
+            .map(|(t, col)| {
                 if *col == SBUFFER {
-                    image = b.pixels(0).to_vec();
+                    image = t.pixels.clone();
                 }
-                let detail = json!({ "table": def.name.as_str(), "row": label, "list": col.name,
-                    "settings": s, "particles": n, "redos": redos });
-                let variant = format!("{}-{}", slug(&label), col.name);
-                let frame = Frame {
-                    r,
-                    b,
-                    centers: &buf,
-                    n: n as u32,
-                    cam: &cam,
-                };
-                let row = time_frame(ctx, &opts, &variant, detail, &frame)?;
-                let after = r.frame_stats(b, 0);
-                let st = sized.map_or(after, |s| s.0);
-                cells.push(Cell {
-                    stat: row.main,
-                    reps: row.reps,
-                    fps: 1000.0 / row.main.median,
-                    list_bytes: st.list_bytes,
-                    fragments: st.fragments,
-                    longest: st.longest,
-                    budget_pixels: st.budget_pixels.max(after.budget_pixels) as u64,
-                });
-                steps.tick();
-            }
-            Ok(())
-        })();
-        ctx.destroy_buffer(&mut buf);
-        result?;
-        out.labels.push(label);
-        out.particles.push(n);
+                Cell {
+                    stat: t.row.main,
+                    interval: t.row.interval.unwrap_or_default(),
+                    flagged: t.row.flagged,
+                    reps: t.row.reps,
+                    fps: 1000.0 / t.row.main.median,
+                    list_bytes: t.sized.list_bytes,
+                    fragments: t.sized.fragments,
+                    longest: t.sized.longest,
+                    budget_pixels: t.sized.budget_pixels.max(t.after.budget_pixels) as u64,
+                }
+            })
+            .collect();
         out.cells.push(cells);
         out.images.push(image);
     }
-    steps.finish();
     Ok(out)
-}
-
-/// A renderer's frame of `n` metaballs at `centers` seen by `cam`.
-pub struct Frame<'a> {
-    pub r: &'a crate::render::metaball::FluidRenderer,
-    pub b: &'a crate::render::metaball::MetaballBuffers,
-    pub centers: &'a crate::gpu::Buffer,
-    pub n: u32,
-    pub cam: &'a crate::render::Camera,
-}
-
-/// The bench's timed repetitions of one frame, the `render` scope its headline.
-pub fn time_frame(
-    ctx: &Context,
-    opts: &crate::bench::BenchOptions,
-    variant: &str,
-    detail: serde_json::Value,
-    f: &Frame,
-) -> Result<crate::bench::Row> {
-    bench_measure(
-        ctx,
-        opts,
-        variant,
-        f.n as u64,
-        crate::render::SCOPE,
-        detail,
-        |prof, cmd| {
-            prof.begin(ctx, cmd, crate::render::SCOPE.name());
-            f.r.record(ctx, cmd, prof, f.b, f.centers, f.n, f.cam, 0)?;
-            prof.end(ctx, cmd);
-            Ok(())
-        },
-    )
 }
 
 fn col_index(def: &TableDef, name: &str) -> Option<usize> {
@@ -197,15 +171,25 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
         col_index(def, "sbuffer").expect("sbuffer"),
     );
     let mut found = Vec::new();
+    // Per row: S faster than A, A faster than none, each beyond the intervals.
+    let per_row: Vec<Verdict> = m
+        .cells
+        .iter()
+        .map(|c| Verdict::all([less(&c[s], &c[a]), less(&c[a], &c[none])]))
+        .collect();
     let bad: Vec<String> = m
         .cells
         .iter()
         .zip(&m.labels)
-        .filter(|(c, _)| !(c[s].fps > c[a].fps && c[a].fps > c[none].fps))
-        .map(|(c, l)| {
+        .zip(&per_row)
+        .filter(|(_, v)| **v != Verdict::Confirmed)
+        .map(|((c, l), v)| {
             format!(
-                "{l}: S {:.2}, A {:.2}, none {:.2} fps",
-                c[s].fps, c[a].fps, c[none].fps
+                "{l} ({}): S {}, A {}, none {}",
+                v.word(),
+                c[s].interval.text(),
+                c[a].interval.text(),
+                c[none].interval.text()
             )
         })
         .collect();
@@ -216,10 +200,10 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
     let sa: Vec<f64> = m.cells.iter().map(|c| c[s].fps / c[a].fps).collect();
     found.push(Finding::new(
         findings::ORDER,
-        Verdict::of(bad.is_empty()),
+        Verdict::all(per_row.iter().copied()),
         format!(
-            "{} of {} rows hold; mean speed-up over none: S-buffer {:.1}x, A-buffer {:.1}x; \
-             S over A {:.2}x to {:.2}x{}",
+            "{} of {} rows hold beyond their intervals; mean speed-up over none: S-buffer \
+             {:.1}x, A-buffer {:.1}x; S over A {:.2}x to {:.2}x{}",
             m.cells.len() - bad.len(),
             m.cells.len(),
             ratio(s),
@@ -228,7 +212,7 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
             sa.iter().cloned().fold(0.0, f64::max),
             match bad.is_empty() {
                 true => String::new(),
-                false => format!(" (fails: {})", bad.join("; ")),
+                false => format!(" (not: {})", bad.join("; ")),
             }
         ),
     ));
@@ -284,39 +268,51 @@ fn rise_finding(
     groups: &[Vec<usize>],
 ) -> Finding {
     let mut fails = Vec::new();
-    let mut checks = 0;
+    let mut verdicts = Vec::new();
     for g in groups {
         for (k, col) in def.cols.iter().enumerate() {
-            let ms: Vec<f64> = g.iter().map(|&r| m.cells[r][k].stat.median).collect();
-            checks += 1;
-            if !ms.windows(2).all(|w| w[1] > w[0]) {
+            let cells: Vec<&Cell> = g.iter().map(|&r| &m.cells[r][k]).collect();
+            let v = Verdict::all(cells.windows(2).map(|w| less(w[0], w[1])));
+            verdicts.push(v);
+            if v != Verdict::Confirmed {
                 fails.push(format!(
-                    "{} over {}: {} ms",
+                    "{} over {} ({}): {}",
                     col.name,
                     g.iter()
                         .map(|&r| m.labels[r].as_str())
                         .collect::<Vec<_>>()
                         .join(" < "),
-                    ms.iter()
-                        .map(|v| format!("{v:.2}"))
+                    v.word(),
+                    cells
+                        .iter()
+                        .map(|c| c.interval.text())
                         .collect::<Vec<_>>()
                         .join(", ")
                 ));
             }
         }
     }
+    let checks = verdicts.len();
     Finding::new(
         claim,
-        Verdict::of(fails.is_empty()),
+        Verdict::all(verdicts),
         format!(
-            "{} of {checks} series (per list) rise{}",
+            "{} of {checks} series (per list) rise beyond their intervals{}",
             checks - fails.len(),
             match fails.is_empty() {
                 true => String::new(),
-                false => format!("; not in: {}", fails.join("; ")),
+                false => format!("; not: {}", fails.join("; ")),
             }
         ),
     )
+}
+
+/// `a` faster than `b` beyond their intervals; inconclusive where either was flagged.
+fn less(a: &Cell, b: &Cell) -> Verdict {
+    match a.flagged || b.flagged {
+        true => Verdict::Inconclusive,
+        false => Verdict::less(&a.interval, &b.interval),
+    }
 }
 
 fn thesis_ratio(def: &TableDef, r: usize, k: usize) -> Option<f64> {
@@ -328,7 +324,7 @@ fn thesis_ratio(def: &TableDef, r: usize, k: usize) -> Option<f64> {
 fn write_table(env: &Env, def: &TableDef, m: &Measured) -> Result<Vec<PathBuf>> {
     let csv = table_csv(env, def, m);
     let mut md = format!("# {}\n\n", def.title);
-    md.push_str(&setup_text(env, m)?);
+    md.push_str(&setup_text(env, def, m)?);
     for n in &def.notes {
         md.push_str(&format!("- {n}\n"));
     }
@@ -366,7 +362,8 @@ fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
     let mut csv = String::from(
         "table,row,list,particles,width,height,reps,median_ms,min_ms,max_ms,fps,speedup_vs_none,\
          list_mb,fragments,fragments_per_metaball,longest_list,pixels_past_loop_budget,\
-         thesis_k1_fps,thesis_k2_fps,thesis_k2_speedup_vs_none,thesis_memory_mb\n",
+         thesis_k1_fps,thesis_k2_fps,thesis_k2_speedup_vs_none,thesis_memory_mb,ci_lo_ms,ci_hi_ms,\
+         flagged\n",
     );
     for (r, cells) in m.cells.iter().enumerate() {
         for (k, c) in cells.iter().enumerate() {
@@ -378,7 +375,7 @@ fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
                 _ => "",
             };
             csv.push_str(&format!(
-                "{},\"{}\",{},{},{},{},{},{:.4},{:.4},{:.4},{:.3},{:.3},{:.3},{},{:.1},{},{},{},{},{},{}\n",
+                "{},\"{}\",{},{},{},{},{},{:.4},{:.4},{:.4},{:.3},{:.3},{:.3},{},{:.1},{},{},{},{},{},{},{:.4},{:.4},{}\n",
                 def.name,
                 m.labels[r],
                 col.name,
@@ -399,7 +396,10 @@ fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
                 th.k1,
                 th.k2,
                 thesis_ratio(def, r, k).map(|v| format!("{v:.3}")).unwrap_or_default(),
-                mem
+                mem,
+                c.interval.lo,
+                c.interval.hi,
+                c.flagged
             ));
         }
     }
@@ -407,7 +407,7 @@ fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
 }
 
 /// The paragraph on the setup: scene, camera, timing.
-fn setup_text(env: &Env, m: &Measured) -> Result<String> {
+fn setup_text(env: &Env, def: &TableDef, m: &Measured) -> Result<String> {
     let scene = env.scene_ref()?;
     let mut md = String::new();
     md.push_str(&format!(
@@ -420,9 +420,8 @@ fn setup_text(env: &Env, m: &Measured) -> Result<String> {
          moved until an S-buffer frame holds {} fragments ({} measured, {:.0} per metaball). \
          A frame is the renderer alone (bounds, lists, march) on a frozen scene: the \
          thesis's frame rates include its simulation step. Frame rates are 1000 / median GPU \
-         time over {} timed repetitions after {} warm-up (fewer where a configuration \
-         would exceed {} s: the detail table gives each). Speed-ups are over the row's \
-         `none`, so devices compare.\n\n",
+         time under the protocol below (the detail table gives each cell's frames). Speed-ups \
+         are over the row's `none`, so devices compare. {}\n\n",
         m.particles.first().copied().unwrap_or(0),
         scene.spacing,
         scene.body.height,
@@ -434,9 +433,7 @@ fn setup_text(env: &Env, m: &Measured) -> Result<String> {
         scene.target_fragments,
         scene.fragments,
         scene.fragments as f64 / scene.centers.len() as f64,
-        env.frames,
-        env.warmup,
-        env.budget_s,
+        crate::bench::protocol_text(&env.bench_options(Measurer::Experiment(def.name), def.name)),
     ));
     Ok(md)
 }
@@ -494,7 +491,10 @@ fn table_md(def: &TableDef, m: &Measured) -> String {
 /// Timing detail per cell and the loop-budget warning.
 fn detail_md(def: &TableDef, m: &Measured) -> String {
     let mut md = String::new();
-    md.push_str("\nTiming detail: median ms [min, max] over the repetitions (reps).\n\n| row |");
+    md.push_str(
+        "\nTiming detail: median of the per-round medians, ms, [its 95% interval] (frames); \
+         flagged: a round stayed off after its rerun (rounds.csv).\n\n| row |",
+    );
     for c in &def.cols {
         md.push_str(&format!(" {} |", c.name));
     }
@@ -505,8 +505,12 @@ fn detail_md(def: &TableDef, m: &Measured) -> String {
         md.push_str(&format!("| {} |", m.labels[r]));
         for c in cells {
             md.push_str(&format!(
-                " {:.2} [{:.2}, {:.2}] ({}) |",
-                c.stat.median, c.stat.min, c.stat.max, c.reps
+                " {:.2} [{:.2}, {:.2}] ({}){} |",
+                c.stat.median,
+                c.interval.lo,
+                c.interval.hi,
+                c.reps,
+                if c.flagged { " flagged" } else { "" }
             ));
         }
         md.push('\n');

@@ -8,6 +8,7 @@ pub mod fidelity;
 pub mod findings;
 pub mod lists;
 pub mod measure;
+pub mod shots;
 pub mod surfaces;
 pub mod surge;
 pub mod sweeps;
@@ -74,6 +75,12 @@ pub struct Env {
     /// Renderers made once per shader configuration (llvmpipe takes about a second to
     /// compile one), with buffers for up to the count beside them.
     renderers: HashMap<String, (FluidRenderer, MetaballBuffers, u64)>,
+    /// Renderers without buffers, one per shader configuration, shared by the cells of a
+    /// table that are timed interleaved (shots.rs).
+    shared: HashMap<String, FluidRenderer>,
+    /// Timed frames by (settings, centres): a frame asked for again (the `none` rows
+    /// several tables share) is measured once per invocation.
+    pub(crate) timed: HashMap<String, shots::Timed>,
 }
 
 impl Env {
@@ -101,8 +108,7 @@ impl Env {
         s: &MetaballSettings,
         n: u64,
     ) -> Result<(&FluidRenderer, &mut MetaballBuffers)> {
-        // The build and tile size choose passes and buffers beside the defines.
-        let key = format!("{:?} {:?} {}", s.shader_defines(), s.build, s.tile);
+        let key = renderer_key(s);
         let fits = self.renderers.get(&key).is_some_and(|e| e.2 >= n);
         if !fits {
             if let Some((mut r, mut b, _)) = self.renderers.remove(&key) {
@@ -118,7 +124,33 @@ impl Env {
         Ok((&*r, b))
     }
 
+    /// The renderer of `s`'s shader configuration, made once and retuned to `s`.
+    pub fn shared_renderer(
+        &mut self,
+        ctx: &Context,
+        s: &MetaballSettings,
+    ) -> Result<&mut FluidRenderer> {
+        let key = renderer_key(s);
+        if !self.shared.contains_key(&key) {
+            self.shared
+                .insert(key.clone(), FluidRenderer::new(ctx, s.clone())?);
+        }
+        let r = self.shared.get_mut(&key).expect("inserted");
+        r.retune(s.clone())?;
+        Ok(r)
+    }
+
+    /// The renderer `shared_renderer` made for `s`'s shader configuration.
+    pub fn made_renderer(&self, s: &MetaballSettings) -> Result<&FluidRenderer> {
+        self.shared
+            .get(&renderer_key(s))
+            .ok_or_else(|| Error::Bug("no shared renderer for these settings".into()))
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
+        for (_, mut r) in self.shared.drain() {
+            r.destroy(ctx);
+        }
         for (_, (mut r, mut b, _)) in self.renderers.drain() {
             b.destroy(ctx);
             r.destroy(ctx);
@@ -147,6 +179,8 @@ impl Env {
             frames: self.frames,
             warmup: self.warmup,
             budget_s: self.budget_s,
+            rounds: crate::bench::protocol::MIN_ROUNDS,
+            warmup_s: if self.quick { 0.5 } else { 2.0 },
             switches,
             character: None,
             vertices: None,
@@ -155,6 +189,20 @@ impl Env {
             seconds: crate::bench::sph::STABILITY_SECONDS,
         }
     }
+}
+
+/// A renderer's shader configuration: the build and tile size choose passes and buffers
+/// beside the defines.
+fn renderer_key(s: &MetaballSettings) -> String {
+    format!(
+        "{:?} {:?} {} {}x{} {:?}",
+        s.shader_defines(),
+        s.build,
+        s.tile,
+        s.width,
+        s.height,
+        s.sky
+    )
 }
 
 /// Where and when the numbers were measured.
@@ -341,6 +389,8 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
         budget_s: if q { 4.0 } else { 10.0 },
         scene: None,
         renderers: HashMap::new(),
+        shared: HashMap::new(),
+        timed: HashMap::new(),
     };
     let result = run_all(&ctx, &mut env, &opts.experiments);
     env.destroy(&ctx);

@@ -6,7 +6,7 @@ use super::{write, Env, Experiment, Steps};
 use crate::bench::{Bench, Measurer, Row};
 use crate::config::{ListKind, Neighbors, SortAlgo};
 use crate::error::{Error, Result};
-use crate::gpu::Context;
+use crate::gpu::{Context, Guard};
 use std::path::PathBuf;
 
 fn per_particle_ns(r: &Row) -> f64 {
@@ -413,29 +413,21 @@ fn render_row(
     let centers = env.scene(ctx)?.with_particles(n, seed)?;
     let mut s = super::measure::base(env.width, env.height)?;
     s.list = list;
-    let mut buf = ctx.storage_buffer("scaling centers", (n * 16) as u64)?;
-    let result = (|| -> Result<Row> {
-        ctx.upload(&mut buf, 0, &centers)?;
-        let (r, b) = env.renderer(ctx, &s, n as u64)?;
-        r.render_sync(ctx, b, &buf, n as u32, cam, 0)?;
-        let detail = serde_json::json!({ "settings": s, "particles": n });
-        let mut row = crate::bench::measure(
-            ctx,
-            opts,
-            list.as_str().as_str(),
-            n as u64,
-            crate::render::SCOPE,
-            detail,
-            |prof, cmd| {
-                prof.begin(ctx, cmd, crate::render::SCOPE.name());
-                r.record(ctx, cmd, prof, b, &buf, n as u32, cam, 0)?;
-                prof.end(ctx, cmd);
-                Ok(())
-            },
-        )?;
-        row.variant = list.as_str();
-        Ok(row)
-    })();
-    ctx.destroy_buffer(&mut buf);
-    result
+    let mut buf = Guard::new(ctx, ctx.storage_buffer("scaling centers", (n * 16) as u64)?);
+    ctx.upload(&mut buf, 0, &centers)?;
+    let detail = serde_json::json!({ "settings": s, "particles": n });
+    // One N at a time (the series stops at the time cap), each under the protocol.
+    let shot = super::shots::Shot {
+        variant: list.as_str().to_string(),
+        settings: s,
+        centers: &buf,
+        centers_key: format!("scaling {n} seed {seed}"),
+        n: n as u32,
+        cam: *cam,
+        detail,
+    };
+    let t = super::shots::time_shots(ctx, env, opts, std::slice::from_ref(&shot))?;
+    let mut row = t.into_iter().next().expect("one shot").row;
+    row.variant = list.as_str();
+    Ok(row)
 }

@@ -123,6 +123,13 @@ impl FluidRenderer {
     /// Take settings that compile to the same shaders at the same frame size (threshold,
     /// radius, step, refinement, depth, ...), so sweeps over them reuse the pipelines.
     pub fn retune(&mut self, settings: MetaballSettings) -> Result<()> {
+        self.check_retune(&settings)?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Whether `settings` need only this renderer's shaders and frame size.
+    fn check_retune(&self, settings: &MetaballSettings) -> Result<()> {
         settings.validate()?;
         let same = settings.shader_defines() == self.settings.shader_defines()
             && (settings.build, settings.tile) == (self.settings.build, self.settings.tile)
@@ -133,7 +140,6 @@ impl FluidRenderer {
                 "retune: these settings need other shaders or another frame size".into(),
             ));
         }
-        self.settings = settings;
         Ok(())
     }
 
@@ -208,8 +214,28 @@ impl FluidRenderer {
         cam: &Camera,
         slot: usize,
     ) -> Result<()> {
-        self.record_picture(ctx, cmd, scopes, b, centers, n, cam)?;
+        self.record_picture_as(&self.settings, ctx, cmd, scopes, b, centers, n, cam)?;
         self.record_readback(ctx, cmd, b, slot);
+        Ok(())
+    }
+
+    /// `record` with settings that need this renderer's shaders and frame size (as
+    /// `retune` checks): one renderer serves several table cells, timed interleaved.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_as(
+        &self,
+        s: &MetaballSettings,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        b: &MetaballBuffers,
+        centers: &Buffer,
+        n: u32,
+        cam: &Camera,
+    ) -> Result<()> {
+        self.check_retune(s)?;
+        self.record_picture_as(s, ctx, cmd, scopes, b, centers, n, cam)?;
+        self.record_readback(ctx, cmd, b, 0);
         Ok(())
     }
 
@@ -226,7 +252,21 @@ impl FluidRenderer {
         n: u32,
         cam: &Camera,
     ) -> Result<()> {
-        let s = &self.settings;
+        self.record_picture_as(&self.settings, ctx, cmd, scopes, b, centers, n, cam)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record_picture_as(
+        &self,
+        s: &MetaballSettings,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scopes: &mut dyn Scopes,
+        b: &MetaballBuffers,
+        centers: &Buffer,
+        n: u32,
+        cam: &Camera,
+    ) -> Result<()> {
         let (w, h) = (s.width, s.height);
         let px = s.pixels();
         if (s.sorts_lists() || s.bins_tiles()) && n as u64 * 4 > b.depths.size {
