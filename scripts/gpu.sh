@@ -28,7 +28,7 @@ while [ $# -gt 0 ]; do
     *) echo "gpu.sh: unknown argument '$1' (see the header of scripts/gpu.sh)" >&2; exit 2 ;;
   esac
 done
-[ -n "$budget" ] || budget=$([ $quick = 1 ] && echo 150 || echo 480)
+[ -n "$budget" ] || budget=$([ $quick = 1 ] && echo 150 || echo 420)
 if ! [[ "$budget" =~ ^[0-9]+$ ]] || [ "$budget" -lt 10 ]; then
   echo "gpu.sh: --budget-s must be a whole number of seconds, at least 10 (got '$budget')" >&2
   exit 2
@@ -55,7 +55,7 @@ logs=${FLUIDFORM_LOGS:-out/gpu}
 mkdir -p "$out" "$logs"
 export FLUIDFORM_RESULTS=$out
 t0=$(date +%s)
-rows=() cut_names=() cut_shares=() cut_cmds=()
+rows=() cut_names=() cut_shares=() cut_cmds=() spans=()
 
 now() { echo $(( $(date +%s) - t0 )); }
 say() { echo "[gpu.sh $(now)/$budget s] $*" >&2; }
@@ -74,8 +74,12 @@ step() {
   fi
   say "$name: up to $left s"
   start=$(now)
+  local e0 e1
+  e0=$(date +%s.%N)
   timeout --kill-after=5 "$left" "$@" > "$logs/$name.log" 2>&1
   rc=$?
+  e1=$(date +%s.%N)
+  spans+=("$name|$e0|$e1")
   case $rc in
     0) status=ran; note= ;;
     124 | 137)
@@ -89,9 +93,26 @@ step() {
   say "$name: $status after $(( $(now) - start )) s${note:+ ($note)}"
 }
 
-# 1. The device.
+# 1. The device, and its state while the steps run: clocks, power and throttle reasons
+# every 200 ms, read-only (nothing here changes a clock).
 "$bin" devices > "$out/devices.txt" 2>&1
 say "device $slug; writing $out"
+state=$out/device-state.csv smi=
+if command -v nvidia-smi > /dev/null 2>&1; then
+  reasons=clocks_throttle_reasons.active
+  nvidia-smi --help-query-gpu 2> /dev/null | grep -q clocks_event_reasons.active &&
+    reasons=clocks_event_reasons.active
+  q=timestamp,clocks.sm,clocks.mem,power.draw,temperature.gpu,$reasons,pstate
+  nvidia-smi --query-gpu=$q --format=csv,nounits -lms 200 > "$state" 2> "$logs/nvidia-smi.log" &
+  smi=$!
+  trap '[ -n "$smi" ] && kill "$smi" 2> /dev/null' EXIT
+  nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,clocks.max.mem,power.limit \
+    --format=csv > "$out/device-limits.csv" 2>> "$logs/nvidia-smi.log"
+else
+  say "nvidia-smi not found: the device's clocks, power and throttle reasons are not recorded; going on"
+  state=
+  rm -f "$out/device-state.csv" "$out/device-limits.csv"
+fi
 
 # 2. The bench scripts, repetitions sized to the budget.
 if [ $quick = 1 ]; then
@@ -169,14 +190,22 @@ if [ -f "$logs/dambreak/stability.json" ]; then
   python3 scripts/gpu_report.py dambreak "$out/dambreak.json" "$db_cmd" > "$out/dambreak.md"
 fi
 
-# 8. Every device side by side, and what each step took. (A cut script can leave a .tmp.)
+# 8. The device's state during each step, on its pages and in gpu.md.
+[ -n "$smi" ] && kill "$smi" 2> /dev/null && wait "$smi" 2> /dev/null
+smi=
+printf '%s\n' "${spans[@]}" > "$logs/spans.txt"
+python3 scripts/gpu_report.py state "${state:-none}" "$logs/spans.txt" "$out" > "$logs/state.md" 2> "$logs/state.log" ||
+  echo "(the device-state report failed: $(tail -1 "$logs/state.log"))" > "$logs/state.md"
+
+# 9. Every device side by side, and what each step took. (A cut script can leave a .tmp.)
 rm -f "$out"/*.tmp
 "$bin" compare --results "$(dirname "$out")" > /dev/null 2> "$logs/compare.log" ||
   rows+=("compare|-|0|failed|$(tail -1 "$logs/compare.log")")
 {
   echo "# scripts/gpu.sh on $slug"
   echo
-  echo "Made by \`scripts/gpu.sh$([ $quick = 1 ] && echo ' --quick') --budget-s $budget\` on $(date -u +%Y-%m-%d), $(now) s in all."
+  echo "Made by \`scripts/gpu.sh$([ $quick = 1 ] && echo ' --quick') --budget-s $budget\` on $(date -u +%Y-%m-%dT%H:%M:%SZ), $(now) s in all,"
+  echo "with $("$bin" --version) (commit, compiler)."
   echo "Each step's share ends at a fixed second of the budget; one that would overrun it is"
   echo "stopped there (cut) or not started (skipped). Logs were in $logs/."
   echo
@@ -185,6 +214,8 @@ rm -f "$out"/*.tmp
   echo "| step | share s | took s | status | note |"
   echo "|---|---|---|---|---|"
   for r in "${rows[@]}"; do echo "| ${r//|/ | } |"; done
+  echo
+  cat "$logs/state.md"
   echo
   echo "Pages: [findings](findings.md), [character](character.md), [dam break](dambreak.md),"
   echo "[every device side by side](../devices.md)."

@@ -8,7 +8,13 @@ use std::path::PathBuf;
 #[derive(Parser)]
 #[command(
     name = "fluidform",
-    version,
+    version = concat!(
+        env!("CARGO_PKG_VERSION"),
+        ", commit ",
+        env!("FLUIDFORM_COMMIT"),
+        ", ",
+        env!("FLUIDFORM_RUSTC")
+    ),
     about = "Rust + Vulkan testbed for liquid characters",
     after_help = overview()
 )]
@@ -267,6 +273,9 @@ fn real_main() -> Result<()> {
                 "all" => Experiment::all().to_vec(),
                 one => vec![one.parse::<Experiment>().map_err(anyhow::Error::msg)?],
             };
+            if common.trace.is_some() {
+                bail!("experiment: --trace is for run and bench (an experiment measures many tables; trace one configuration with bench)");
+            }
             if common.particles.is_some() {
                 bail!("experiment: --particles is not used (each experiment sets its own counts)");
             }

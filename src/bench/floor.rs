@@ -47,6 +47,7 @@ impl Floor {
         // Its own folder: the table it serves writes rounds.csv of its own.
         let mut opts = opts.clone();
         opts.out = opts.out.join("floor");
+        opts.switches.common.trace = None;
         let (src, dst, out) = (&*src, &*dst, &*out);
         let fma = &*fma;
         let cases = vec![

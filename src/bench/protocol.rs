@@ -23,6 +23,7 @@ use crate::gpu::{
     FRAME,
 };
 use crate::report::{pass_stats, stat, Report};
+use crate::trace::Traced;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
@@ -45,6 +46,9 @@ pub const PERTURB_ENV: &str = "FLUIDFORM_PERTURB";
 /// Iterations per invocation of the sentinel (bench/fma.comp, 64 FLOPs each).
 const SENTINEL_ITERS: u32 = 256;
 
+/// What a case records into each of its frames.
+pub type Record<'a> = Box<dyn FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()> + 'a>;
+
 /// One configuration of a table: what to record each frame, and how to label it.
 pub struct Case<'a> {
     pub variant: String,
@@ -55,7 +59,7 @@ pub struct Case<'a> {
     /// Passes that do not depend on the table's variable: a round where one moved more
     /// than `DRIFT` from its median over the rounds is flagged like a sentinel drift.
     pub steady: Vec<ScopeKey>,
-    pub record: Box<dyn FnMut(&mut Profiler, vk::CommandBuffer) -> Result<()> + 'a>,
+    pub record: Record<'a>,
 }
 
 impl<'a> Case<'a> {
@@ -256,6 +260,24 @@ pub fn run(ctx: &Context, opts: &BenchOptions, mut cases: Vec<Case>) -> Result<V
         frames.extend(redo.into_iter().map(|f| (slots[f.frame as usize], f)));
     }
     let still = drifted(&cases, &frames, rounds, run_sentinel);
+    if let Some(path) = &opts.switches.common.trace {
+        // In the order they ran, numbered so (case, frame) names one frame.
+        let mut order: Vec<(usize, FrameTiming)> =
+            frames.iter().map(|(s, t)| (s.case, t.clone())).collect();
+        order.sort_by(|a, b| a.1.gpu_ns.total_cmp(&b.1.gpu_ns));
+        for (i, (_, t)) in order.iter_mut().enumerate() {
+            t.frame = i as u64;
+        }
+        let traced: Vec<Traced> = order
+            .iter()
+            .map(|(c, t)| Traced {
+                label: &labels[*c],
+                timing: t,
+            })
+            .collect();
+        let cal = crate::gpu::clock::calibrate(ctx);
+        crate::trace::write_trace(path, &traced, cal, &ctx.info.name)?;
+    }
     let mut rows = Vec::new();
     let mut csv = String::from("round,position,variant,n,frames,main_ms,sentinel_ms,rerun,off\n");
     let seed = opts.switches.common.seed;

@@ -399,18 +399,9 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
     let (mut vs, mut ev) = (Vec::new(), Vec::new());
     for ((label, _, _, _), row) in LOOKS.iter().zip(cells) {
         let f = fixed(row);
-        let tiles = best(
-            &f.iter()
-                .cloned()
-                .filter(|c| !c.mode.per_pixel())
-                .collect::<Vec<_>>(),
-        );
-        let lists = best(
-            &f.iter()
-                .cloned()
-                .filter(|c| c.mode.per_pixel())
-                .collect::<Vec<_>>(),
-        );
+        let (lists, tiles): (Vec<Cell>, Vec<Cell>) =
+            f.iter().cloned().partition(|c| c.mode.per_pixel());
+        let (tiles, lists) = (best(&tiles), best(&lists));
         if let (Some(t), Some(l)) = (tiles, lists) {
             let v = less(&t, &l);
             vs.push(v);

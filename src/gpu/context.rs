@@ -77,6 +77,8 @@ pub struct Context {
     pub queue_family: u32,
     pub push_descriptor: ash::khr::push_descriptor::Device,
     pub shaders: ShaderCompiler,
+    /// The driver's pipeline cache, kept between processes (gpu/cache.rs).
+    pub pipeline_cache: vk::PipelineCache,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -203,10 +205,15 @@ impl Context {
                 unsafe { device.create_command_pool(&pool_info, None) }.ctx("command pool")?;
             Ok((shaders, allocator, pool))
         })();
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let pipeline_cache = super::cache::open_pipeline_cache(&device, &props);
         let (shaders, allocator, pool) = match rest {
             Ok(r) => r,
             Err(e) => {
-                unsafe { device.destroy_device(None) };
+                unsafe {
+                    device.destroy_pipeline_cache(pipeline_cache, None);
+                    device.destroy_device(None);
+                }
                 cleanup(&debug_instance);
                 return Err(e);
             }
@@ -222,6 +229,7 @@ impl Context {
             queue_family,
             push_descriptor,
             shaders,
+            pipeline_cache,
             debug_instance,
             debug_device,
             messenger,
@@ -373,6 +381,9 @@ fn open_device(
         .queue_family_index(family)
         .queue_priorities(&priorities)];
     let mut exts = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+    if info.calibrated {
+        exts.push(ash::ext::calibrated_timestamps::NAME.as_ptr());
+    }
     if present {
         let has = unsafe { instance.enumerate_device_extension_properties(physical) }
             .unwrap_or_default()
@@ -417,6 +428,8 @@ impl Drop for Context {
                 eprintln!("fluidform: GPU objects not destroyed: {leaked:?} {objects:?}");
             }
             ManuallyDrop::drop(&mut self.allocator);
+            let props = self.instance.get_physical_device_properties(self.physical);
+            super::cache::close_pipeline_cache(&self.device, &props, self.pipeline_cache);
             self.device
                 .destroy_command_pool(*self.one_shot_pool.lock().unwrap(), None);
             self.device.destroy_device(None);

@@ -42,6 +42,9 @@ pub struct DeviceInfo {
     pub max_point_size: f32,
     #[serde(skip)]
     pub type_rank: u32,
+    /// VK_EXT_calibrated_timestamps: GPU timestamps on the CPU's clock (traces).
+    #[serde(skip)]
+    pub calibrated: bool,
 }
 
 impl DeviceInfo {
@@ -111,7 +114,9 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
     };
     let driver_name = cstr(&driver.driver_name);
     let driver_info = cstr(&driver.driver_info);
+    let calibrated = has_ext(ash::ext::calibrated_timestamps::NAME);
     DeviceInfo {
+        calibrated,
         index,
         name: cstr(&props.device_name),
         kind: kind.0.to_string(),

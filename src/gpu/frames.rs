@@ -105,6 +105,7 @@ impl FrameLoop {
     pub fn step(&mut self, ctx: &Context, frame: u64, work: &mut dyn FrameWork) -> Result<()> {
         let slot = (frame % self.slots.len() as u64) as usize;
         self.retire(ctx, slot, work)?;
+        let cpu_begin = super::clock::monotonic_ns();
         let (cmd, fence, _) = self.slots[slot];
         unsafe {
             ctx.device
@@ -133,6 +134,8 @@ impl FrameLoop {
             return Err(e);
         }
         ctx.submit(cmd, fence)?;
+        self.profiler
+            .note_cpu(slot, cpu_begin, super::clock::monotonic_ns());
         self.slots[slot].2 = Some(frame);
         Ok(())
     }

@@ -4,6 +4,8 @@
 //! grid and neighbour searches), the library's error type and the closed sets of choices
 //! (`kinds`). Knows no fluid, character or command line; the only crate that calls ash.
 pub mod access;
+pub mod cache;
+pub mod clock;
 pub mod context;
 pub mod device;
 pub mod error;

@@ -235,7 +235,7 @@ impl<I: Interface> ComputePipeline<I> {
             .layout(layout);
         let r = unsafe {
             ctx.device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+                .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
         };
         unsafe { ctx.device.destroy_shader_module(module, None) };
         let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
@@ -463,7 +463,7 @@ fn fixed_function(
         .push_next(&mut rendering);
     unsafe {
         ctx.device
-            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+            .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
     }
 }
 

@@ -8,12 +8,24 @@ use super::Context;
 use crate::error::{Error, Result, VkContext};
 use ash::vk;
 
-/// GPU time of one frame: its scopes in order (key, ms) and the whole frame in ms.
-#[derive(Clone, Debug)]
+/// GPU time of one frame: its scopes in order (key, ms) and the whole frame in ms; where
+/// each scope starts, for timelines (`trace`).
+#[derive(Clone, Debug, Default)]
 pub struct FrameTiming {
     pub frame: u64,
     pub passes: Vec<(String, f64)>,
     pub frame_ms: f64,
+    /// Each pass's start, ms after the frame's (parallel to `passes`).
+    pub starts: Vec<f64>,
+    /// The pass each pass was opened inside, as an index into `passes` (None: the frame).
+    /// A key's path names its parents by convention only (`sph/health` is opened at the
+    /// top), so a timeline nests by this.
+    pub parents: Vec<Option<usize>>,
+    /// The frame's first timestamp on the device's clock, ns (ticks times the period).
+    pub gpu_ns: f64,
+    /// When the CPU began recording the frame and when its submit returned, ns of
+    /// CLOCK_MONOTONIC (`clock::monotonic_ns`).
+    pub cpu_ns: Option<(f64, f64)>,
 }
 
 /// Queries per pool (a begin and an end per scope).
@@ -23,8 +35,11 @@ struct Slot {
     pools: Vec<vk::QueryPool>,
     /// (key, begin query, end query); query q lives in pool q / POOL_QUERIES.
     scopes: Vec<(String, u32, u32)>,
+    /// The scope each scope was opened inside (an index into `scopes`).
+    parents: Vec<Option<usize>>,
     used: u32,
     frame: Option<u64>,
+    cpu_ns: Option<(f64, f64)>,
 }
 
 pub struct Profiler {
@@ -147,8 +162,10 @@ impl Profiler {
             v.push(Slot {
                 pools: Vec::new(),
                 scopes: Vec::new(),
+                parents: Vec::new(),
                 used: 0,
                 frame: None,
+                cpu_ns: None,
             });
         }
         let bits = ctx.info.timestamp_valid_bits;
@@ -199,6 +216,7 @@ impl Profiler {
             unsafe { ctx.device.cmd_reset_query_pool(cmd, pool, 0, POOL_QUERIES) };
         }
         s.scopes.clear();
+        s.parents.clear();
         s.used = 0;
         s.frame = Some(frame);
         self.current = slot;
@@ -251,8 +269,10 @@ impl Profiler {
             // No query pool could be made: keep the label, report at collect.
             _ => (u32::MAX, u32::MAX),
         };
+        let parent = self.stack.last().map(|(i, _)| *i);
         let s = &mut self.slots[self.current];
         s.scopes.push((key.clone(), b, e));
+        s.parents.push(parent);
         self.stack.push((s.scopes.len() - 1, key));
     }
 
@@ -313,21 +333,39 @@ impl Profiler {
             let ticks = raw[b as usize].wrapping_sub(raw[a as usize]) & self.mask;
             ticks as f64 * self.period_ns / 1e6
         };
+        // The frame scope is opened first: query 0 is the frame's first timestamp.
+        let first = raw.first().copied().unwrap_or(0);
         let mut passes = Vec::new();
+        let mut starts = Vec::new();
+        let mut parents = Vec::new();
+        // Scope index -> pass index (the frame scope is no pass).
+        let mut pass_of = vec![None; s.scopes.len()];
         let mut frame_ms = 0.0;
-        for (name, a, b) in &s.scopes {
-            if name == FRAME_SCOPE {
+        for (k, (name, a, b)) in s.scopes.iter().enumerate() {
+            if name == FRAME_SCOPE && s.parents[k].is_none() {
                 frame_ms = ms(*a, *b);
             } else {
+                pass_of[k] = Some(passes.len());
+                parents.push(s.parents[k].and_then(|p| pass_of[p]));
                 passes.push((name.clone(), ms(*a, *b)));
+                starts.push(ms(0, *a));
             }
         }
         self.results.push(FrameTiming {
             frame,
             passes,
             frame_ms,
+            starts,
+            parents,
+            gpu_ns: (first & self.mask) as f64 * self.period_ns,
+            cpu_ns: s.cpu_ns.take(),
         });
         Ok(())
+    }
+
+    /// When the CPU recorded and submitted the frame in `slot` (CLOCK_MONOTONIC ns).
+    pub fn note_cpu(&mut self, slot: usize, begin_ns: f64, end_ns: f64) {
+        self.slots[slot].cpu_ns = Some((begin_ns, end_ns));
     }
 
     /// Drop a slot's recording that was never submitted.

@@ -36,6 +36,11 @@ pub struct CommonArgs {
     /// Particle count
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 26)))]
     pub particles: Option<u32>,
+    /// Write the GPU passes of every (timed) frame as Chrome trace JSON to FILE: open it in
+    /// Perfetto (ui.perfetto.dev) or chrome://tracing
+    #[arg(long, value_name = "FILE")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trace: Option<std::path::PathBuf>,
 }
 
 /// Size of rendered frames.
@@ -407,6 +412,7 @@ impl Default for CommonArgs {
             quiet: false,
             seed: 1,
             particles: None,
+            trace: None,
         }
     }
 }

@@ -10,6 +10,7 @@ pub mod progress;
 pub mod report;
 pub mod scene;
 pub mod settings;
+pub mod trace;
 
 // The lower layers under the names this crate's modules use for them.
 pub use fluidform_gpu as gpu;

@@ -210,14 +210,23 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
             path: csv_path.display().to_string(),
             source: e.into(),
         };
-        w.write_record(["frame", "pass", "ms"]).map_err(csv_err)?;
+        // start_ms: where the pass starts, ms after the frame's start (the frame: 0).
+        w.write_record(["frame", "pass", "ms", "start_ms"])
+            .map_err(csv_err)?;
         for t in self.timings {
             let frame = t.frame.to_string();
-            w.write_record([frame.as_str(), "frame", &format!("{:.6}", t.frame_ms)])
+            let ms = format!("{:.6}", t.frame_ms);
+            w.write_record([frame.as_str(), "frame", &ms, "0.000000"])
                 .map_err(csv_err)?;
-            for (name, ms) in &t.passes {
-                w.write_record([frame.as_str(), name.as_str(), &format!("{ms:.6}")])
-                    .map_err(csv_err)?;
+            for (k, (name, ms)) in t.passes.iter().enumerate() {
+                let start = t.starts.get(k).copied().unwrap_or(f64::NAN);
+                w.write_record([
+                    frame.as_str(),
+                    name.as_str(),
+                    &format!("{ms:.6}"),
+                    &format!("{start:.6}"),
+                ])
+                .map_err(csv_err)?;
             }
         }
         w.flush().map_err(io(&csv_path))?;

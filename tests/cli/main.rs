@@ -64,7 +64,7 @@ fn run_writes_frames_timings_and_summary() {
     }
     let csv = std::fs::read_to_string(out.join("timings.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("frame,pass,ms"));
+    assert_eq!(lines.next(), Some("frame,pass,ms,start_ms"));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     for pass in ["frame", "simulate", "points", "readback"] {
         let n = rows.iter().filter(|r| r[1] == pass).count();
@@ -73,6 +73,9 @@ fn run_writes_frames_timings_and_summary() {
     for r in &rows {
         let ms: f64 = r[2].parse().unwrap();
         assert!(ms >= 0.0 && ms.is_finite());
+        // Each pass starts inside its frame.
+        let start: f64 = r[3].parse().unwrap();
+        assert!(start >= 0.0 && start.is_finite(), "{r:?}");
     }
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

@@ -307,6 +307,9 @@ pub(crate) fn finish_fluidless(
         barriers: ctx.tracked_barriers(),
     };
     let summary = report.write(&opts.out)?;
+    if let Some(path) = &sw.common.trace {
+        crate::trace::write_run_trace(ctx, path, timings)?;
+    }
     check_validation(ctx)?;
     Ok(RunResult {
         summary,

@@ -508,6 +508,9 @@ impl SphWork {
             barriers: ctx.tracked_barriers(),
         };
         let summary = report.write(&opts.out)?;
+        if let Some(path) = &sw.common.trace {
+            crate::trace::write_run_trace(ctx, path, &timings)?;
+        }
         check_validation(ctx)?;
         check(&physics)?;
         Ok(RunResult {
