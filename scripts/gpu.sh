@@ -2,9 +2,11 @@
 # One command for a lent GPU: every GPU table, inside a time budget. In order, each part
 # with its share of the budget (time a part leaves unused goes to the next):
 #   devices; the bench scripts (primitives, sph, render, solvers) 26%; every experiment in
-#   full 46%; the default liquid character at 1280x720 and 64K particles 8%; the 1M DFSPH
-#   dam break for 3 simulated seconds, rendering off 10%; then the steps that were cut run
-#   again with what is left, if that is at least twice their first share; 3% for the pages.
+#   full, in one process, 46%; the default liquid character at 1280x720 and 64K particles
+#   8%; the 1M DFSPH dam break for 3 simulated seconds, rendering off 10% (--quick: 62%,
+#   18%, 8%, 6%); then the steps that were cut run again with what is left, if that is at
+#   least twice their first share; 3% for the pages. nvidia-smi logs the device's clocks,
+#   power and throttle reasons all along (read-only); each page gets its steps' ranges.
 # A step that would overrun its share is cut (killed at it) or skipped, with a line saying so.
 # Writes <out> (default results/<device-slug>/, with --quick out/gpu-quick/<slug>/): every table, findings.md, character.md,
 # dambreak.md and gpu.md (what each step took); then devices.md beside it (every device
@@ -61,6 +63,13 @@ now() { echo $(( $(date +%s) - t0 )); }
 say() { echo "[gpu.sh $(now)/$budget s] $*" >&2; }
 # The second by which the budget's first FRACTION (in percent) is spent.
 until_pct() { echo $(( budget * $1 / 100 )); }
+# Where each step's share ends (percent of the budget). A GPU spends its time in the
+# experiments; lavapipe's quick run in the bench scripts' compiles and slow frames.
+if [ $quick = 1 ]; then
+  ends=(5 12 35 62 80 88 94)
+else
+  ends=(5 12 16 26 72 80 90)
+fi
 
 # step NAME UNTIL CMD...: run CMD until second UNTIL of the budget, logged to out/gpu/NAME.log.
 step() {
@@ -126,24 +135,38 @@ else
   small=() render=() sph=()
   solvers=(--seconds $([ "$budget" -ge 900 ] && echo 10 || echo 3))
 fi
-step bench-primitives "$(until_pct 5)" bash scripts/bench_primitives.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}"
-step bench-sph "$(until_pct 12)" bash scripts/bench_sph.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}" "${sph[@]}"
-step bench-render "$(until_pct 16)" bash scripts/bench_render.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${render[@]}"
-step bench-solvers "$(until_pct 26)" bash scripts/bench_solvers.sh "${dev[@]}" "${val[@]}" "${solvers[@]}"
+step bench-primitives "$(until_pct "${ends[0]}")" bash scripts/bench_primitives.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}"
+step bench-sph "$(until_pct "${ends[1]}")" bash scripts/bench_sph.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}" "${sph[@]}"
+step bench-render "$(until_pct "${ends[2]}")" bash scripts/bench_render.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${render[@]}"
+step bench-solvers "$(until_pct "${ends[3]}")" bash scripts/bench_solvers.sh "${dev[@]}" "${val[@]}" "${solvers[@]}"
 
-# 3. The experiments, each with a share by weight (the heavier runs get more).
+# 3. The experiments in one process, sharing pipelines, SPIR-V and the thesis scene; each
+#    notes its span (FLUIDFORM_SPANS) for its row in gpu.md and the device state on its page.
 mapfile -t names < <("$bin" experiment list)
 [ $quick = 1 ] && names=(table8 fig9 scaling)
 qx=()
 [ $quick = 1 ] && qx=(--quick)
-weight() { case $1 in fidelity) echo 3 ;; surfaces | lists) echo 2 ;; adaptive | scaling) echo 2 ;; *) echo 1 ;; esac; }
-total=0
-for n in "${names[@]}"; do total=$(( total + $(weight "$n") )); done
-from=$(now) span=$(( $(until_pct 72) - $(now) )) acc=0
+exp_spans=$logs/experiment-spans.txt
+: > "$exp_spans"
+export FLUIDFORM_SPANS=$exp_spans
+from=$(now)
+step experiments "$(until_pct "${ends[4]}")" "$bin" experiment "$(IFS=,; echo "${names[*]}")" --out "$out" --quiet "${dev[@]}" "${qx[@]}" "${val[@]}"
+# One row per experiment: its own time, or why it has none.
+missing=()
 for n in "${names[@]}"; do
-  acc=$(( acc + $(weight "$n") ))
-  step "experiment-$n" $(( from + span * acc / total )) "$bin" experiment "$n" --out "$out" --quiet "${dev[@]}" "${qx[@]}" "${val[@]}"
+  line=$(grep "^experiment-$n|" "$exp_spans" | tail -1)
+  if [ -n "$line" ]; then
+    IFS='|' read -r _ a b <<< "$line"
+    rows+=("experiment-$n|-|$(python3 -c "print(round($b - $a))")|ran|")
+  else
+    missing+=("$n")
+    rows+=("experiment-$n|-|0|cut|the experiments step ended before it finished")
+  fi
 done
+# A cut experiments step runs again with the experiments it did not finish.
+if [ ${#missing[@]} -gt 0 ] && [ ${#cut_names[@]} -gt 0 ] && [ "${cut_names[-1]}" = experiments ]; then
+  cut_cmds[-1]=$(printf '%q ' "$bin" experiment "$(IFS=,; echo "${missing[*]}")" --out "$out" --quiet "${dev[@]}" "${qx[@]}" "${val[@]}")
+fi
 [ $quick = 1 ] && rows+=("other experiments|-|0|skipped|--quick runs ${names[*]} only (tests/experiment.rs runs every experiment quick)")
 
 # 4. The default liquid character at 1280x720 and 64K particles.
@@ -154,7 +177,7 @@ else
 fi
 cmd=("$bin" run --scene character "${ch[@]}" --out "$logs/character" --quiet "${dev[@]}" "${val[@]}")
 rm -rf "$logs/character"
-step character "$(until_pct 80)" "${cmd[@]}"
+step character "$(until_pct "${ends[5]}")" "${cmd[@]}"
 char_cmd="fluidform ${cmd[*]:1}"
 
 # 5. The 1M DFSPH dam break for 3 simulated seconds (rendering off).
@@ -165,7 +188,7 @@ else
 fi
 cmd=("$bin" bench stability --solver dfsph "${db[@]}" --out "$logs/dambreak" "${dev[@]}" "${val[@]}")
 rm -rf "$logs/dambreak"
-step dambreak "$(until_pct 90)" "${cmd[@]}"
+step dambreak "$(until_pct "${ends[6]}")" "${cmd[@]}"
 db_cmd="fluidform ${cmd[*]:1}"
 
 # 6. The cut steps again, in order, where what is left is at least twice their first share.
@@ -193,7 +216,7 @@ fi
 # 8. The device's state during each step, on its pages and in gpu.md.
 [ -n "$smi" ] && kill "$smi" 2> /dev/null && wait "$smi" 2> /dev/null
 smi=
-printf '%s\n' "${spans[@]}" > "$logs/spans.txt"
+{ printf '%s\n' "${spans[@]}"; cat "$exp_spans"; } > "$logs/spans.txt"
 python3 scripts/gpu_report.py state "${state:-none}" "$logs/spans.txt" "$out" > "$logs/state.md" 2> "$logs/state.log" ||
   echo "(the device-state report failed: $(tail -1 "$logs/state.log"))" > "$logs/state.md"
 

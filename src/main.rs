@@ -154,6 +154,7 @@ enum SceneWhat {
 
 /// Errors print as one line: the error and any cause its message does not already hold.
 fn main() -> std::process::ExitCode {
+    fluidform::provenance::init();
     match real_main() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
@@ -271,7 +272,10 @@ fn real_main() -> Result<()> {
                     return Ok(());
                 }
                 "all" => Experiment::all().to_vec(),
-                one => vec![one.parse::<Experiment>().map_err(anyhow::Error::msg)?],
+                some => some
+                    .split(',')
+                    .map(|one| one.parse::<Experiment>().map_err(anyhow::Error::msg))
+                    .collect::<Result<Vec<_>, _>>()?,
             };
             if common.trace.is_some() {
                 bail!("experiment: --trace is for run and bench (an experiment measures many tables; trace one configuration with bench)");
@@ -378,13 +382,22 @@ impl clap::builder::TypedValueParser for ExperimentName {
     ) -> Result<String, clap::Error> {
         let v = value.to_string_lossy().to_string();
         let names = Self::names();
-        if names.iter().any(|n| n.matches(&v, false)) {
+        // One name, or several joined by commas (run in one process, sharing pipelines).
+        let parts: Vec<&str> = v.split(',').collect();
+        let bad = parts.iter().find(|p| {
+            !names.iter().any(|n| n.matches(p, false))
+                || (parts.len() > 1 && (**p == "all" || **p == "list"))
+        });
+        let Some(bad) = bad else {
             return Ok(v);
-        }
+        };
         let all: Vec<&str> = names.iter().map(|n| n.get_name()).collect();
         Err(clap::Error::raw(
             clap::error::ErrorKind::InvalidValue,
-            format!("unknown experiment '{v}' (one of: {})\n", all.join(", ")),
+            format!(
+                "unknown experiment '{bad}' (one of: {}, or several joined by commas)\n",
+                all.join(", ")
+            ),
         ))
     }
 

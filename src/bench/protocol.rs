@@ -56,9 +56,13 @@ pub struct Case<'a> {
     /// The headline scope (`FRAME` for the whole frame).
     pub main: ScopeKey,
     pub detail: Value,
-    /// Passes that do not depend on the table's variable: a round where one moved more
-    /// than `DRIFT` from its median over the rounds is flagged like a sentinel drift.
-    pub steady: Vec<ScopeKey>,
+    /// Passes (timestamp keys) that do not depend on the table's variable: a round where
+    /// one moved more than `DRIFT` from its median over the rounds of every case in
+    /// `group` (the case alone without one) is flagged like a sentinel drift.
+    pub steady: Vec<String>,
+    /// Cases whose steady passes do the same work (a table's cells that differ only in
+    /// what the steady passes do not depend on).
+    pub group: Option<String>,
     pub record: Record<'a>,
 }
 
@@ -76,6 +80,7 @@ impl<'a> Case<'a> {
             main,
             detail,
             steady: Vec::new(),
+            group: None,
             record: Box::new(record),
         }
     }
@@ -384,42 +389,66 @@ fn main_ms(key: ScopeKey, f: &FrameTiming) -> Result<f64> {
     key.ms_in(f)
 }
 
-/// (case, round, why) of every round whose sentinel or steady pass moved past `DRIFT`.
+/// A pass's ms in one frame (summed over its repeats); None where it did not run.
+fn pass_ms(f: &FrameTiming, key: &str) -> Option<f64> {
+    let mut v = f.passes.iter().filter(|(k, _)| k == key).peekable();
+    v.peek()?;
+    Some(v.map(|(_, ms)| ms).sum())
+}
+
+/// (case, round, why) of every round whose sentinel or steady pass moved past `DRIFT`:
+/// the sentinel against the run's median, a steady pass against its median over every
+/// round of every case in the same steady group (or of the case alone).
 fn drifted(
     cases: &[Case],
     frames: &[(Slot, FrameTiming)],
     rounds: u64,
     run_sentinel: f64,
 ) -> Vec<(usize, u64, String)> {
+    let of = |c: usize, r: Option<u64>, key: &str| -> Option<f64> {
+        let v: Vec<f64> = frames
+            .iter()
+            .filter(|(s, _)| s.case == c && r.is_none_or(|r| s.round == r))
+            .filter_map(|(_, f)| pass_ms(f, key))
+            .collect();
+        median(&v)
+    };
     let mut out = Vec::new();
     for (c, case) in cases.iter().enumerate() {
-        let of = |r: u64, key: ScopeKey| -> Option<f64> {
-            let v: Vec<f64> = frames
-                .iter()
-                .filter(|(s, _)| s.case == c && s.round == r)
-                .filter_map(|(_, f)| key.ms_in(f).ok())
-                .collect();
-            median(&v)
+        let group: Vec<usize> = match &case.group {
+            Some(g) => (0..cases.len())
+                .filter(|&k| cases[k].group.as_ref() == Some(g))
+                .collect(),
+            None => vec![c],
         };
-        let steady: Vec<(ScopeKey, f64)> = case
+        // A pass under 5% of the case's frame is left out: its timer's own jitter would
+        // pass for drift.
+        let frame: Vec<f64> = frames
+            .iter()
+            .filter(|(s, _)| s.case == c)
+            .map(|(_, f)| f.frame_ms)
+            .collect();
+        let floor = 0.05 * median(&frame).unwrap_or(0.0);
+        let steady: Vec<(&str, f64)> = case
             .steady
             .iter()
-            .filter_map(|&k| {
-                let v: Vec<f64> = (0..rounds).filter_map(|r| of(r, k)).collect();
-                Some((k, median(&v)?))
+            .filter_map(|k| {
+                let v: Vec<f64> = group.iter().filter_map(|&g| of(g, None, k)).collect();
+                Some((k.as_str(), median(&v)?))
             })
+            .filter(|(_, mid)| *mid >= floor)
             .collect();
         for r in 0..rounds {
             let mut why = Vec::new();
-            let mut check = |key: ScopeKey, mid: f64| {
-                if let Some(v) = of(r, key) {
+            let mut check = |key: &str, mid: f64| {
+                if let Some(v) = of(c, Some(r), key) {
                     let d = v / mid.max(1e-12) - 1.0;
                     if d.abs() > DRIFT {
                         why.push(format!("{key} {:+.0}%", 100.0 * d));
                     }
                 }
             };
-            check(SENTINEL, run_sentinel);
+            check(SENTINEL.path(), run_sentinel);
             for &(k, mid) in &steady {
                 check(k, mid);
             }
@@ -531,7 +560,7 @@ fn write_protocol(
     let json = serde_json::json!({
         "rounds": rounds, "seed": opts.switches.common.seed, "drift": DRIFT,
         "warmup": warm, "sentinel_median_ms": sentinel,
-        "provenance": crate::provenance::Provenance::now(opts.frames, opts.warmup),
+        "provenance": crate::provenance::measured(opts.frames, opts.warmup),
     });
     let p = opts.out.join("protocol.json");
     let text = serde_json::to_string_pretty(&json).unwrap_or_default();

@@ -399,10 +399,36 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
+/// Set to a file: each experiment appends `experiment-<name>|start|end` (epoch seconds),
+/// so scripts/gpu.sh can put the device's state beside each page of a one-process run.
+pub const SPANS_ENV: &str = "FLUIDFORM_SPANS";
+
+fn epoch_s() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
+}
+
+fn note_span(name: Experiment, started: f64) {
+    if let Some(p) = std::env::var_os(SPANS_ENV) {
+        use std::io::Write;
+        let line = format!("experiment-{name}|{started:.3}|{:.3}\n", epoch_s());
+        let f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(p);
+        if let Ok(mut f) = f {
+            let _ = f.write_all(line.as_bytes());
+        }
+    }
+}
+
 fn run_all(ctx: &Context, env: &mut Env, names: &[Experiment]) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for &name in names {
         let t = Instant::now();
+        let started = epoch_s();
         let (written, found) = match name {
             Experiment::Fig9 => sweeps::fig9(ctx, env)?,
             Experiment::Adaptive => adaptive::adaptive(env)?,
@@ -424,6 +450,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[Experiment]) -> Result<Vec<Pat
             }
         };
         findings::save(env, name, &found)?;
+        note_span(name, started);
         files.extend(written);
         files.push(env.out.join(format!("{name}.findings.json")));
         eprintln!(

@@ -39,6 +39,21 @@ pub struct Timed {
     pub pixels: Vec<u8>,
 }
 
+/// The renderer's passes before the march: bounds, lists and tiles.
+const LIST_PASSES: [&str; 7] = ["bounds", "count", "scan", "fill", "sort", "bin", "ranges"];
+
+/// Shots that differ only in what the march alone reads (material, recursion depth,
+/// refinement steps) do the same work before the march.
+fn steady_group(s: &Shot) -> String {
+    let mut v = serde_json::to_value(&s.settings).unwrap_or_default();
+    if let Some(m) = v.as_object_mut() {
+        for k in ["material", "depth", "refine"] {
+            m.remove(k);
+        }
+    }
+    format!("{v} {} {} {:?}", s.centers_key, s.n, s.cam)
+}
+
 fn memo_key(s: &Shot) -> Option<String> {
     (s.settings.list == ListKind::None).then(|| {
         format!(
@@ -84,7 +99,7 @@ pub fn time_shots(
         let s = &shots[i];
         let r = env.made_renderer(&s.settings)?;
         let b = &bufs[k];
-        cases.push(Case::new(
+        let mut case = Case::new(
             s.variant.clone(),
             s.n as u64,
             crate::render::SCOPE,
@@ -95,7 +110,11 @@ pub fn time_shots(
                 prof.end(ctx, cmd);
                 Ok(())
             },
-        ));
+        );
+        // The passes before the march do not depend on what only the march reads.
+        case.steady = LIST_PASSES.iter().map(|p| format!("render/{p}")).collect();
+        case.group = Some(steady_group(s));
+        cases.push(case);
     }
     let rows = protocol::run(ctx, opts, cases)?;
     for ((k, &i), row) in fresh.iter().enumerate().zip(rows) {

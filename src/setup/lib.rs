@@ -7,6 +7,7 @@ pub mod animation;
 pub mod config;
 pub mod export;
 pub mod progress;
+pub mod provenance;
 pub mod report;
 pub mod scene;
 pub mod settings;

@@ -146,6 +146,9 @@ pub struct Summary<C, S> {
     /// complete).
     #[serde(default)]
     pub barriers: TrackedBarriers,
+    /// The build and the time it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<crate::provenance::Provenance>,
 }
 
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
@@ -195,6 +198,10 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
                 placed: self.barriers.0,
                 unplaced: self.barriers.1,
             },
+            provenance: Some(crate::provenance::Provenance::now(
+                Some(self.timings.len() as u64),
+                None,
+            )),
         }
     }
 
