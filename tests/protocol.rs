@@ -329,3 +329,33 @@ fn experiments_refuse_a_trace() {
         text(&o)
     );
 }
+
+#[test]
+fn verdicts_know_their_noise() {
+    use fluidform::experiment::findings::Verdict;
+    let iv = |lo: f64, median: f64, hi: f64| Interval {
+        median,
+        lo,
+        hi,
+        ..Default::default()
+    };
+    let (fast, slow, near) = (iv(0.9, 1.0, 1.1), iv(2.0, 2.1, 2.3), iv(1.05, 1.2, 1.4));
+    assert_eq!(Verdict::less(&fast, &slow), Verdict::Confirmed);
+    assert_eq!(Verdict::less(&slow, &fast), Verdict::Refuted);
+    assert_eq!(Verdict::less(&fast, &near), Verdict::Inconclusive);
+    // Speed-ups: at least 1.8x for sure, 2x maybe, 2.6x not at all.
+    assert_eq!(
+        Verdict::ratio_at_least(&slow, &fast, 1.8),
+        Verdict::Confirmed
+    );
+    assert_eq!(
+        Verdict::ratio_at_least(&slow, &fast, 2.0),
+        Verdict::Inconclusive
+    );
+    assert_eq!(Verdict::ratio_at_least(&slow, &fast, 2.6), Verdict::Refuted);
+    use Verdict::*;
+    assert_eq!(Verdict::all([Confirmed, Confirmed]), Confirmed);
+    assert_eq!(Verdict::all([Confirmed, Inconclusive]), Inconclusive);
+    assert_eq!(Verdict::all([Inconclusive, Refuted]), Refuted);
+    assert_eq!(Verdict::all([]), NotMeasured);
+}

@@ -32,25 +32,35 @@ fn csv(rows: &[(String, Row)]) -> String {
     s
 }
 
-/// Markdown rows: variant, N, reps, median [min, max] ms, fps, ns per particle.
+/// Markdown rows: variant, N, reps, median [95% interval] ms, fps, ns per particle.
 fn md_rows(rows: &[&Row]) -> String {
     let mut s = String::from(
-        "| variant | N | reps | median ms [min, max] | fps | ns per particle |\n|---|---|---|---|---|---|\n",
+        "| variant | N | reps | median ms [95% interval] | fps | ns per particle |\n|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s.push_str(&format!(
-            "| {} | {} | {} | {:.3} [{:.3}, {:.3}] | {:.2} | {:.1} |\n",
+            "| {} | {} | {} | {:.3} [{:.3}, {:.3}]{} | {:.2} | {:.1} |\n",
             r.variant,
             r.n,
             r.reps,
             r.main.median,
-            r.main.min,
-            r.main.max,
+            r.interval.map_or(r.main.min, |i| i.lo),
+            r.interval.map_or(r.main.max, |i| i.hi),
+            if r.flagged { " flagged" } else { "" },
             1000.0 / r.main.median,
             per_particle_ns(r)
         ));
     }
     s
+}
+
+/// `a` faster than `b` beyond their intervals (inconclusive where either was flagged or
+/// has none).
+fn row_less(a: &Row, b: &Row) -> Verdict {
+    match (a.interval, b.interval, a.flagged || b.flagged) {
+        (Some(x), Some(y), false) => Verdict::less(&x, &y),
+        _ => Verdict::Inconclusive,
+    }
 }
 
 /// Grid against hash at each N (`a` and `b` variants), and the grid's growth of cost per
@@ -61,7 +71,7 @@ fn grid_findings(rows: &[&Row], a: &str, b: &str, what: &str) -> Vec<Finding> {
     let mut wins = Vec::new();
     for g in &ga {
         if let Some(h) = hb.iter().find(|h| h.n == g.n) {
-            wins.push((g.n, h.main.median / g.main.median));
+            wins.push((g.n, h.main.median / g.main.median, row_less(g, h)));
         }
     }
     let mut out = Vec::new();
@@ -73,11 +83,11 @@ fn grid_findings(rows: &[&Row], a: &str, b: &str, what: &str) -> Vec<Finding> {
         ),
         false => Finding::new(
             findings::GRID_BEATS,
-            Verdict::of(wins.iter().all(|w| w.1 > 1.0)),
+            Verdict::all(wins.iter().map(|w| w.2)),
             format!(
                 "{what}: {b} / {a} time {}",
                 wins.iter()
-                    .map(|(n, r)| format!("{r:.2}x at N = {n}"))
+                    .map(|(n, r, v)| format!("{r:.2}x at N = {n} ({})", v.word()))
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
@@ -373,19 +383,22 @@ fn scaling_render(
 fn scaling_findings(sph: &[&Row], render: &[&Row], lists: &[ListKind]) -> Vec<Finding> {
     let mut found = grid_findings(sph, "grid/counting", "hash/bitonic", "SPH step");
     let mut fails = Vec::new();
+    let mut verdicts = Vec::new();
     for list in lists {
-        let ms: Vec<f64> = render
+        let rows: Vec<&Row> = render
             .iter()
+            .copied()
             .filter(|r| r.variant == list.as_str())
-            .map(|r| r.main.median)
             .collect();
-        if !ms.windows(2).all(|w| w[1] > w[0]) {
-            fails.push(list.as_str());
+        let v = Verdict::all(rows.windows(2).map(|w| row_less(w[0], w[1])));
+        if v != Verdict::Confirmed {
+            fails.push(format!("{} ({})", list.as_str(), v.word()));
         }
+        verdicts.push(v);
     }
     found.push(Finding::new(
         "cost rises with the particle count N",
-        Verdict::of(fails.is_empty()),
+        Verdict::all(verdicts),
         format!(
             "render frame time over N = {}..{} rises for {} of 3 lists{}",
             render.first().map(|r| r.n).unwrap_or(0),

@@ -4,15 +4,16 @@
 //! minima over a window, and the thesis's own: the fluid of the controlled groups inside
 //! the current (skinned) target, control particles covered by fluid (density >= 50%
 //! rho_0), the fluid's density error.
-use super::fidelity::{self, Fidelity};
+use super::fidelity;
 use super::force::{ControlForce, ALL_GROUPS};
-use super::inside::InsideTest;
+use super::metrics_worker::{Job, Workers};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, MemoryLocation};
 use crate::sph::SphState;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ControlRow {
@@ -115,6 +116,7 @@ pub struct ControlMetrics {
     m: u32,
     pub rows: Vec<ControlRow>,
     pub stats: ControlStats,
+    workers: Workers,
 }
 
 impl ControlMetrics {
@@ -152,6 +154,7 @@ impl ControlMetrics {
             n,
             m,
             rows: Vec::new(),
+            workers: Workers::new(),
             stats: ControlStats {
                 target: target.into(),
                 control_particles: m,
@@ -179,20 +182,21 @@ impl ControlMetrics {
         Ok(())
     }
 
-    /// After the slot's fence: the row of frame `frame` at scene time `time`, with the
-    /// target mesh skinned to that frame (`mesh`: positions and triangles) whose skin
-    /// points move at most `skin_speed` m/s.
+    /// After the slot's fence: queue the row of frame `frame` at scene time `time`, with
+    /// the target mesh skinned to that frame (`mesh`: positions and triangles) whose skin
+    /// points move at most `skin_speed` m/s. The row is computed on a worker thread
+    /// (metrics_worker.rs); rows already done are folded in now, the rest by `flush`.
     #[allow(clippy::too_many_arguments)]
     pub fn retire(
         &mut self,
         slot: usize,
         frame: u64,
         time: f64,
-        (mesh, skin_speed): ((&[Vec3], &[u32]), f32),
+        (mesh, skin_speed): ((Vec<Vec3>, Arc<Vec<u32>>), f32),
         force: &ControlForce,
         group: u32,
         fluid: &fidelity::Fluid,
-    ) -> Result<&ControlRow> {
+    ) -> Result<()> {
         let s = &self.slots[slot];
         fn read(b: &Buffer) -> Result<&[u8]> {
             b.mapped()
@@ -208,65 +212,39 @@ impl ControlMetrics {
             .check_counts([counts[0], counts[1], counts[2], counts[3]])?
             .min(self.m);
         let crho: &[f32] = bytemuck::cast_slice(&read(&s.crho)?[..live as usize * 4]);
-        let rest_density = fluid.rest_density;
         // Live particles only (emission's dead slots have w < 0).
         let alive: Vec<usize> = (0..n).filter(|&i| pos[i][3] >= 0.0).collect();
         let v3 = |a: &[f32; 4]| Vec3::new(a[0], a[1], a[2]);
-        let p: Vec<Vec3> = alive.iter().map(|&i| v3(&pos[i])).collect();
-        let v: Vec<Vec3> = alive.iter().map(|&i| v3(&vel[i])).collect();
-        let r: Vec<f32> = alive.iter().map(|&i| rho[i][0]).collect();
-        let controlled: Vec<bool> = alive
-            .iter()
-            .map(|&i| group == ALL_GROUPS || attr[i][3].to_bits() == group)
-            .collect();
-        let fid: Fidelity = fidelity::measure(
-            &fidelity::Frame {
-                pos: &p,
-                vel: &v,
-                rho: &r,
-                controlled: &controlled,
-            },
-            mesh,
-            skin_speed,
-            fluid,
-        );
-        let inside = InsideTest::new(mesh.0, mesh.1);
-        let ours: Vec<Vec3> = p
-            .iter()
-            .zip(&controlled)
-            .filter(|(_, c)| **c)
-            .map(|(p, _)| *p)
-            .collect();
-        let inside_count = ours.iter().filter(|p| inside.inside(**p)).count();
-        let covered = crho.iter().filter(|&&r| r >= 0.5 * rest_density).count();
-        let errs: Vec<f64> = r
-            .iter()
-            .map(|r| (*r as f64 / rest_density as f64 - 1.0).abs())
-            .collect();
-        let row = ControlRow {
+        self.workers.send(Job {
             frame,
             time,
             target: self.stats.target.clone(),
-            fill: fid.fill,
-            iou: fid.iou,
-            spray: fid.spray,
-            surface_p95: fid.surface_p95,
-            density_in_shape: fid.density_in_shape,
-            speed_excess: fid.speed_excess,
-            skin_speed: skin_speed as f64,
-            inside_fraction: inside_count as f64 / ours.len().max(1) as f64,
-            coverage: covered as f64 / live.max(1) as f64,
-            density_error_mean: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
-            density_error_max: errs.iter().cloned().fold(0.0, f64::max),
-            density_ratio_max: r
-                .iter()
-                .map(|r| *r as f64 / rest_density as f64)
-                .fold(0.0, f64::max),
-            control_particles: live,
-        };
+            pos: alive.iter().map(|&i| v3(&pos[i])).collect(),
+            vel: alive.iter().map(|&i| v3(&vel[i])).collect(),
+            rho: alive.iter().map(|&i| rho[i][0]).collect(),
+            controlled: (alive.iter())
+                .map(|&i| group == ALL_GROUPS || attr[i][3].to_bits() == group)
+                .collect(),
+            crho: crho.to_vec(),
+            mesh,
+            skin_speed,
+            fluid: *fluid,
+            live,
+        });
         self.stats.control_particles = live;
-        self.push(row, time);
-        Ok(self.rows.last().unwrap())
+        for row in self.workers.ready(false) {
+            let t = row.time;
+            self.push(row, t);
+        }
+        Ok(())
+    }
+
+    /// Wait for every queued row and fold it in (the summaries call this first).
+    pub fn flush(&mut self) {
+        for row in self.workers.ready(true) {
+            let t = row.time;
+            self.push(row, t);
+        }
     }
 
     /// Keep `row` (at scene time `time`) and fold it into the run's statistics.
@@ -294,6 +272,7 @@ impl ControlMetrics {
     /// The fidelity window: the frames from scene time `from` on (None: the second half
     /// of the rows' time span).
     pub fn finish_window(&mut self, from: Option<f64>) {
+        self.flush();
         let (Some(a), Some(b)) = (self.rows.first(), self.rows.last()) else {
             return;
         };
@@ -315,6 +294,7 @@ impl ControlMetrics {
 
     /// `cycle_s` and `mean_inside_last_cycle` for a target animated with period `cycle`.
     pub fn finish_cycle(&mut self, cycle: Option<f64>) {
+        self.flush();
         let st = &mut self.stats;
         st.cycle_s = cycle;
         st.mean_inside_last_cycle = match (cycle, self.rows.first(), self.rows.last()) {
@@ -333,6 +313,7 @@ impl ControlMetrics {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        self.workers.stop();
         for s in &mut self.slots {
             for b in [
                 &mut s.pos,

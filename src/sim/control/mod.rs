@@ -9,6 +9,7 @@ pub mod grid;
 pub mod inside;
 pub mod mesh_distance;
 pub mod metrics;
+mod metrics_worker;
 pub mod placement;
 pub mod rays;
 pub mod settings;

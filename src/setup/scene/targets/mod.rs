@@ -44,6 +44,8 @@ struct Live {
     /// Per slot: the placed joint matrices of the frame and of a moment before it (the
     /// skin's speed), and the scene time, when attached.
     poses: Vec<Option<FramePose>>,
+    /// The character's triangles, shared with the metrics' worker threads.
+    indices: std::sync::Arc<Vec<u32>>,
 }
 
 /// The skin's speed is its motion over this many seconds before the frame.
@@ -137,10 +139,12 @@ impl SceneTargets {
                 }
                 None => None,
             };
+            let character = character.take();
             out.live.push(Live {
                 desc: scene_desc,
                 name,
-                character: character.take(),
+                indices: std::sync::Arc::new(character.ch.mesh.indices.clone()),
+                character,
                 control,
                 poses: vec![None; slots],
             });
@@ -421,7 +425,7 @@ impl SceneTargets {
                 slot,
                 frame,
                 time,
-                ((&mesh, &ch.ch.mesh.indices), skin_speed),
+                ((mesh, l.indices.clone()), skin_speed),
                 &c.force,
                 c.force.settings.group,
                 &constants,
