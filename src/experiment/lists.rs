@@ -66,6 +66,14 @@ const CHARACTER: &[Mode] = &[
     Mode(T, false, C, 16, LIP),
 ];
 
+/// A cell's median and interval, and whether it was flagged.
+fn cell_text(c: &Cell) -> String {
+    match c.flagged {
+        true => format!("{} flagged", c.interval.text()),
+        false => c.interval.text(),
+    }
+}
+
 impl Mode {
     fn apply(&self, s: &mut MetaballSettings) {
         (s.list, s.sorted, s.build, s.tile, s.march) = (self.0, self.1, self.2, self.3, self.4);
@@ -358,8 +366,8 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
             format!(
                 "{}: {}, A-buffer {} ({:.2}x)",
                 c.mode.name(),
-                c.interval.text(),
-                a.interval.text(),
+                cell_text(&c),
+                cell_text(&a),
                 a.ms / c.ms
             ),
         ),
@@ -386,8 +394,8 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
                 if sorted { "sorted" } else { "unsorted" },
                 r.ms / c.ms,
                 v.word(),
-                r.interval.text(),
-                c.interval.text()
+                cell_text(&r),
+                cell_text(&c)
             ));
         }
     }
@@ -409,9 +417,9 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
                 "{label} ({}): {} {}, best list {} {}",
                 v.word(),
                 t.mode.name(),
-                t.interval.text(),
+                cell_text(&t),
                 l.mode.name(),
-                l.interval.text()
+                cell_text(&l)
             ));
         }
     }
@@ -454,9 +462,9 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
                 format!(
                     "{}: {} against {} {} ({:.2}x)",
                     t.mode.name(),
-                    t.interval.text(),
+                    cell_text(&t),
                     reference.name(),
-                    r.interval.text(),
+                    cell_text(&r),
                     r.ms / t.ms
                 ),
             ),

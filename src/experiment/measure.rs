@@ -187,9 +187,9 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
             format!(
                 "{l} ({}): S {}, A {}, none {}",
                 v.word(),
-                c[s].interval.text(),
-                c[a].interval.text(),
-                c[none].interval.text()
+                cell_text(&c[s]),
+                cell_text(&c[a]),
+                cell_text(&c[none])
             )
         })
         .collect();
@@ -285,7 +285,7 @@ fn rise_finding(
                     v.word(),
                     cells
                         .iter()
-                        .map(|c| c.interval.text())
+                        .map(|c| cell_text(c))
                         .collect::<Vec<_>>()
                         .join(", ")
                 ));
@@ -305,6 +305,14 @@ fn rise_finding(
             }
         ),
     )
+}
+
+/// A cell's median and interval, and whether it was flagged.
+fn cell_text(c: &Cell) -> String {
+    match c.flagged {
+        true => format!("{} flagged", c.interval.text()),
+        false => c.interval.text(),
+    }
 }
 
 /// `a` faster than `b` beyond their intervals; inconclusive where either was flagged.
