@@ -22,6 +22,11 @@ def character(path, command):
     render = stats.get("render", {}).get("settings", {})
     print("# The default liquid character\n")
     print(f"Made by `{command}`.\n")
+    prov = j.get("provenance")
+    if prov:
+        d = j["device"]
+        print(f"Measured {prov['date']} on {d['name']} ({d['driver']}), commit {prov['commit']}, "
+              f"{prov['rustc']}.\n")
     print(f"{stats['particles']} particles, {render.get('width')}x{render.get('height')}, "
           f"{j['frames']} frames ({stats['steps']} SPH steps, {num(stats['simulated_seconds'], 2)} "
           f"simulated s), list {render.get('list')}, material {render.get('material')}.\n")
@@ -56,6 +61,9 @@ def dambreak(path, command):
     unstable = j.get("unstable")
     print(f"# The DFSPH dam break at {j['particles']} particles, rendering off\n")
     print(f"Made by `{command}`.\n")
+    prov = j.get("provenance")
+    if prov:
+        print(f"Measured {prov['date']}, commit {prov['commit']}, {prov['rustc']}.\n")
     print(f"{j['particles']} particles, solver {j['fluid']['solver']}, {j['steps']} steps.\n")
     print(f"- simulated: **{num(sim, 2)} s**; "
           f"{'**unstable**: ' + unstable if unstable else 'stable to the end'}")
