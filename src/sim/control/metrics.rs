@@ -6,6 +6,7 @@
 //! rho_0), the fluid's density error.
 use super::fidelity;
 use super::force::{ControlForce, ALL_GROUPS};
+pub use super::metrics_worker::Skin;
 use super::metrics_worker::{Job, Workers};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
@@ -13,7 +14,6 @@ use crate::gpu::{Buffer, Context, MemoryLocation};
 use crate::sph::SphState;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ControlRow {
@@ -183,16 +183,16 @@ impl ControlMetrics {
     }
 
     /// After the slot's fence: queue the row of frame `frame` at scene time `time`, with
-    /// the target mesh skinned to that frame (`mesh`: positions and triangles) whose skin
-    /// points move at most `skin_speed` m/s. The row is computed on a worker thread
-    /// (metrics_worker.rs); rows already done are folded in now, the rest by `flush`.
+    /// the target posed as `skin` says (skinned on the worker, with its skin speed). The
+    /// row is computed on a worker thread (metrics_worker.rs); rows already done are folded
+    /// in now, the rest by `flush`.
     #[allow(clippy::too_many_arguments)]
     pub fn retire(
         &mut self,
         slot: usize,
         frame: u64,
         time: f64,
-        (mesh, skin_speed): ((Vec<Vec3>, Arc<Vec<u32>>), f32),
+        skin: Skin,
         force: &ControlForce,
         group: u32,
         fluid: &fidelity::Fluid,
@@ -226,25 +226,26 @@ impl ControlMetrics {
                 .map(|&i| group == ALL_GROUPS || attr[i][3].to_bits() == group)
                 .collect(),
             crho: crho.to_vec(),
-            mesh,
-            skin_speed,
+            skin,
             fluid: *fluid,
             live,
         });
         self.stats.control_particles = live;
-        for row in self.workers.ready(false) {
+        for row in self.workers.ready(false)? {
             let t = row.time;
             self.push(row, t);
         }
         Ok(())
     }
 
-    /// Wait for every queued row and fold it in (the summaries call this first).
-    pub fn flush(&mut self) {
-        for row in self.workers.ready(true) {
+    /// Wait for every queued row and fold it in; call before `finish_cycle` and
+    /// `finish_window`.
+    pub fn flush(&mut self) -> Result<()> {
+        for row in self.workers.ready(true)? {
             let t = row.time;
             self.push(row, t);
         }
+        Ok(())
     }
 
     /// Keep `row` (at scene time `time`) and fold it into the run's statistics.
@@ -272,7 +273,6 @@ impl ControlMetrics {
     /// The fidelity window: the frames from scene time `from` on (None: the second half
     /// of the rows' time span).
     pub fn finish_window(&mut self, from: Option<f64>) {
-        self.flush();
         let (Some(a), Some(b)) = (self.rows.first(), self.rows.last()) else {
             return;
         };
@@ -294,7 +294,6 @@ impl ControlMetrics {
 
     /// `cycle_s` and `mean_inside_last_cycle` for a target animated with period `cycle`.
     pub fn finish_cycle(&mut self, cycle: Option<f64>) {
-        self.flush();
         let st = &mut self.stats;
         st.cycle_s = cycle;
         st.mean_inside_last_cycle = match (cycle, self.rows.first(), self.rows.last()) {

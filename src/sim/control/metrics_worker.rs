@@ -1,11 +1,15 @@
 //! The control metrics' CPU work off the frame loop: a frame's readback is copied into a
-//! job and computed on worker threads (the fidelity metrics' voxel loop and inside tests,
-//! the hash-map density, the thesis's inside fraction), so a frame never waits for them.
-//! Rows come back in frame order; every frame still gets its row.
+//! job and computed on worker threads (the target skinned twice on the CPU for its mesh
+//! and skin speed, the fidelity metrics' voxel loop and inside tests, the hash-map
+//! density, the thesis's inside fraction), so a frame never waits for them. Rows come
+//! back in frame order; every frame still gets its row.
 use super::fidelity::{self, Fidelity};
 use super::inside::InsideTest;
 use super::metrics::ControlRow;
-use glam::Vec3;
+use crate::character::Character;
+use crate::error::{Error, Result};
+use crate::kinds::Skinning;
+use glam::{Mat4, Vec3};
 use std::collections::BTreeMap;
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::{Arc, Mutex};
@@ -22,17 +26,32 @@ pub(super) struct Job {
     pub controlled: Vec<bool>,
     /// Densities at the live control particles.
     pub crho: Vec<f32>,
-    /// The target skinned to the frame: positions and triangles.
-    pub mesh: (Vec<Vec3>, Arc<Vec<u32>>),
-    pub skin_speed: f32,
+    pub skin: Skin,
     pub fluid: fidelity::Fluid,
     pub live: u32,
 }
 
+/// The target's character posed by the frame's joint matrices and by those `dt` seconds
+/// before (its skin speed).
+pub struct Skin {
+    pub ch: Arc<Character>,
+    pub mats: Vec<Mat4>,
+    pub before: Vec<Mat4>,
+    pub method: Skinning,
+    pub dt: f64,
+}
+
 /// The frame's row: the fidelity metrics, the fluid inside the target, the covered control
 /// particles and the density error.
-pub(super) fn compute(j: &Job) -> ControlRow {
-    let mesh = (j.mesh.0.as_slice(), j.mesh.1.as_slice());
+pub(super) fn compute(j: &Job) -> Result<ControlRow> {
+    let k = &j.skin;
+    let (posed, _) = k.ch.skinned_at(&k.mats, k.method)?;
+    let (prev, _) = k.ch.skinned_at(&k.before, k.method)?;
+    let skin_speed = (posed.iter().zip(&prev))
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f32::max)
+        / k.dt as f32;
+    let mesh = (posed.as_slice(), k.ch.mesh.indices.as_slice());
     let fid: Fidelity = fidelity::measure(
         &fidelity::Frame {
             pos: &j.pos,
@@ -41,7 +60,7 @@ pub(super) fn compute(j: &Job) -> ControlRow {
             controlled: &j.controlled,
         },
         mesh,
-        j.skin_speed,
+        skin_speed,
         &j.fluid,
     );
     let rest_density = j.fluid.rest_density;
@@ -55,7 +74,7 @@ pub(super) fn compute(j: &Job) -> ControlRow {
     let errs: Vec<f64> = (j.rho.iter())
         .map(|r| (*r as f64 / rest_density as f64 - 1.0).abs())
         .collect();
-    ControlRow {
+    Ok(ControlRow {
         frame: j.frame,
         time: j.time,
         target: j.target.clone(),
@@ -65,7 +84,7 @@ pub(super) fn compute(j: &Job) -> ControlRow {
         surface_p95: fid.surface_p95,
         density_in_shape: fid.density_in_shape,
         speed_excess: fid.speed_excess,
-        skin_speed: j.skin_speed as f64,
+        skin_speed: skin_speed as f64,
         inside_fraction: inside_count as f64 / ours.len().max(1) as f64,
         coverage: covered as f64 / j.live.max(1) as f64,
         density_error_mean: errs.iter().sum::<f64>() / errs.len().max(1) as f64,
@@ -74,17 +93,17 @@ pub(super) fn compute(j: &Job) -> ControlRow {
             .map(|r| *r as f64 / rest_density as f64)
             .fold(0.0, f64::max),
         control_particles: j.live,
-    }
+    })
 }
 
 /// Worker threads fed by a queue that never blocks the sender.
 pub(super) struct Workers {
     tx: Option<Sender<(u64, Job)>>,
-    rx: Receiver<(u64, ControlRow)>,
+    rx: Receiver<(u64, Result<ControlRow>)>,
     handles: Vec<JoinHandle<()>>,
     sent: u64,
     /// Rows computed out of order, by sequence number, until their turn.
-    done: BTreeMap<u64, ControlRow>,
+    done: BTreeMap<u64, Result<ControlRow>>,
     next: u64,
 }
 
@@ -136,8 +155,9 @@ impl Workers {
         }
     }
 
-    /// The rows ready in frame order; with `all`, wait for every row sent so far.
-    pub fn ready(&mut self, all: bool) -> Vec<ControlRow> {
+    /// The rows ready in frame order; with `all`, wait for every row sent so far. A frame
+    /// whose row failed (its skinning) is the error.
+    pub fn ready(&mut self, all: bool) -> Result<Vec<ControlRow>> {
         loop {
             while let Ok((seq, row)) = self.rx.try_recv() {
                 self.done.insert(seq, row);
@@ -155,10 +175,15 @@ impl Workers {
         }
         let mut out = Vec::new();
         while let Some(row) = self.done.remove(&self.next) {
-            out.push(row);
             self.next += 1;
+            out.push(row?);
         }
-        out
+        if all && self.next < self.sent {
+            return Err(Error::Bug(
+                "control metrics: a worker stopped before its rows were done".into(),
+            ));
+        }
+        Ok(out)
     }
 
     /// Close the queue and join the workers.

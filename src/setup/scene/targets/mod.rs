@@ -44,8 +44,8 @@ struct Live {
     /// Per slot: the placed joint matrices of the frame and of a moment before it (the
     /// skin's speed), and the scene time, when attached.
     poses: Vec<Option<FramePose>>,
-    /// The character's triangles, shared with the metrics' worker threads.
-    indices: std::sync::Arc<Vec<u32>>,
+    /// The character, shared with the metrics' worker threads (which skin it).
+    shared: std::sync::Arc<crate::character::Character>,
 }
 
 /// The skin's speed is its motion over this many seconds before the frame.
@@ -143,7 +143,7 @@ impl SceneTargets {
             out.live.push(Live {
                 desc: scene_desc,
                 name,
-                indices: std::sync::Arc::new(character.ch.mesh.indices.clone()),
+                shared: std::sync::Arc::new(character.ch.clone()),
                 character,
                 control,
                 poses: vec![None; slots],
@@ -405,15 +405,14 @@ impl SceneTargets {
             else {
                 continue;
             };
-            let ch = &l.character;
-            let (mesh, _) = ch.ch.skinned_at(&mats, ch.method)?;
-            let (prev, _) = ch.ch.skinned_at(&before, ch.method)?;
-            let skin_speed = mesh
-                .iter()
-                .zip(&prev)
-                .map(|(a, b)| (*a - *b).length())
-                .fold(0.0, f32::max)
-                / SKIN_SPEED_DT as f32;
+            // Skinned on the metrics' worker, off the frame loop.
+            let skin = crate::control::metrics::Skin {
+                ch: l.shared.clone(),
+                mats,
+                before,
+                method: l.character.method,
+                dt: SKIN_SPEED_DT,
+            };
             let constants = crate::control::fidelity::Fluid {
                 h: fluid.h,
                 mass: fluid.mass,
@@ -425,7 +424,7 @@ impl SceneTargets {
                 slot,
                 frame,
                 time,
-                ((mesh, l.indices.clone()), skin_speed),
+                skin,
                 &c.force,
                 c.force.settings.group,
                 &constants,
@@ -451,6 +450,7 @@ impl SceneTargets {
                 .filter(|d| *d > 0.0 && ch.speed > 0.0)
                 .map(|d| d / ch.speed as f64);
             if let Some((_, m)) = &mut l.control {
+                m.flush()?;
                 m.finish_cycle(cycle);
                 m.finish_window(self.metrics_from);
             }
