@@ -143,6 +143,35 @@ pub fn wrap(data: &[u8], build: u64, props: &vk::PhysicalDeviceProperties) -> Ve
     v
 }
 
+/// Files of the cache older than this are removed (each rebuild keys its own files, so a
+/// developer's cache would otherwise only grow).
+const KEEP_DAYS: u64 = 14;
+
+/// Remove files under `dir` (and its `spirv/`) not modified for `days`; returns how many.
+pub fn prune(dir: &std::path::Path, days: u64) -> usize {
+    let old = std::time::Duration::from_secs(days * 86_400);
+    let mut removed = 0;
+    for d in [dir.to_path_buf(), dir.join("spirv")] {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            let stale = e
+                .metadata()
+                .ok()
+                .filter(|m| m.is_file())
+                .and_then(|m| m.modified().ok())
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age > old);
+            if stale && std::fs::remove_file(&p).is_ok() {
+                removed += 1;
+            }
+        }
+    }
+    removed
+}
+
 /// Make the pipeline cache from the kept file where it is this device's and binary's; a
 /// stale or broken one is ignored with one line.
 pub fn open_pipeline_cache(
@@ -150,6 +179,9 @@ pub fn open_pipeline_cache(
     props: &vk::PhysicalDeviceProperties,
 ) -> vk::PipelineCache {
     let build = build_id();
+    if let Some(d) = dir() {
+        prune(&d, KEEP_DAYS);
+    }
     let initial = pipeline_path(props).and_then(|p| {
         let bytes = std::fs::read(&p).ok()?;
         match accept(&bytes, build, props) {
@@ -266,6 +298,27 @@ mod tests {
         assert_eq!(load_spirv(&bad), None);
         std::fs::write(&bad, [3u8; 7]).unwrap();
         assert_eq!(load_spirv(&bad), None);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn prune_removes_only_old_files() {
+        let d = tempfile_dir().join("prune");
+        std::fs::create_dir_all(d.join("spirv")).unwrap();
+        let (a, b) = (d.join("pipelines-x.bin"), d.join("spirv").join("y.spv"));
+        std::fs::write(&a, b"a").unwrap();
+        std::fs::write(&b, b"b").unwrap();
+        // Nothing is 14 days old: nothing goes.
+        assert_eq!(prune(&d, 14), 0);
+        assert!(a.exists() && b.exists());
+        // Backdated a month: both go.
+        let month = std::time::SystemTime::now() - std::time::Duration::from_secs(30 * 86_400);
+        for p in [&a, &b] {
+            let f = std::fs::File::options().write(true).open(p).unwrap();
+            f.set_modified(month).unwrap();
+        }
+        assert_eq!(prune(&d, 14), 2);
+        assert!(!a.exists() && !b.exists());
         let _ = std::fs::remove_dir_all(&d);
     }
 
