@@ -74,6 +74,14 @@ fn rows(p: &Path) -> Vec<HashMap<String, String>> {
         .collect()
 }
 
+/// The tests that launch benchmarks take turns: lavapipe is the CPU, so a sibling test's
+/// benchmark would load the device the perturbation test expects to be steady.
+static DEVICE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn device() -> std::sync::MutexGuard<'static, ()> {
+    DEVICE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn bench_sort(out: &Path, frames: &str, env: &[(&str, &str)], extra: &[&str]) -> String {
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_fluidform"));
     cmd.args([
@@ -98,6 +106,7 @@ fn bench_sort(out: &Path, frames: &str, env: &[(&str, &str)], extra: &[&str]) ->
 
 #[test]
 fn rounds_are_interleaved_in_a_seeded_shuffled_order() {
+    let _device = device();
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     bench_sort(&a, "5", &[], &[]);
@@ -160,6 +169,7 @@ fn rounds_are_interleaved_in_a_seeded_shuffled_order() {
 
 #[test]
 fn a_perturbation_is_flagged_in_every_perturbed_row_and_no_other() {
+    let _device = device();
     let dir = tempfile::tempdir().unwrap();
     // Three frames a round, so one noisy frame does not move a round's median.
     let hit = ["odd-even-2048@1", "counting-2048@3"];
@@ -237,6 +247,7 @@ fn check_nesting(trace: &serde_json::Value) -> usize {
 
 #[test]
 fn trace_nests_every_scope_with_and_without_calibrated_timestamps() {
+    let _device = device();
     let dir = tempfile::tempdir().unwrap();
     let cal = dir.path().join("cal.json");
     bench_sort(
