@@ -58,6 +58,24 @@ impl Interval {
     }
 }
 
+/// What a finding compares: a row's interval, and whether the protocol flagged the row
+/// (a round stayed off after its rerun), in which case it decides nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    pub interval: Interval,
+    pub flagged: bool,
+}
+
+impl Estimate {
+    /// "0.712 ms [0.70, 0.73]", with " flagged" after a flagged row's.
+    pub fn text(&self) -> String {
+        match self.flagged {
+            true => format!("{} flagged", self.interval.text()),
+            false => self.interval.text(),
+        }
+    }
+}
+
 /// Where one interval stands against another.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Standing {

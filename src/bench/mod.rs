@@ -133,6 +133,14 @@ pub struct Row {
 }
 
 impl Row {
+    /// The headline's estimate under the protocol (None for rows outside it).
+    pub fn estimate(&self) -> Option<interval::Estimate> {
+        self.interval.map(|interval| interval::Estimate {
+            interval,
+            flagged: self.flagged,
+        })
+    }
+
     /// The statistics of timestamp scope `key`; an error where it was not recorded.
     pub fn pass(&self, key: ScopeKey) -> Result<&Stat> {
         self.passes

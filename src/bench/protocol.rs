@@ -125,7 +125,7 @@ pub struct Warmup {
     pub sentinel_ms: f64,
 }
 
-/// Which frame is which: case, round, and whether it is a rerun.
+/// Which frame is which: its case and round, and whether the test hook slows its sentinel.
 #[derive(Clone, Copy)]
 struct Slot {
     case: usize,
@@ -389,13 +389,6 @@ fn main_ms(key: ScopeKey, f: &FrameTiming) -> Result<f64> {
     key.ms_in(f)
 }
 
-/// A pass's ms in one frame (summed over its repeats); None where it did not run.
-fn pass_ms(f: &FrameTiming, key: &str) -> Option<f64> {
-    let mut v = f.passes.iter().filter(|(k, _)| k == key).peekable();
-    v.peek()?;
-    Some(v.map(|(_, ms)| ms).sum())
-}
-
 /// (case, round, why) of every round whose sentinel or steady pass moved past `DRIFT`:
 /// the sentinel against the run's median, a steady pass against its median over every
 /// round of every case in the same steady group (or of the case alone).
@@ -409,7 +402,7 @@ fn drifted(
         let v: Vec<f64> = frames
             .iter()
             .filter(|(s, _)| s.case == c && r.is_none_or(|r| s.round == r))
-            .filter_map(|(_, f)| pass_ms(f, key))
+            .filter_map(|(_, f)| f.pass_ms(key))
             .collect();
         median(&v)
     };

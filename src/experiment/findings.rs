@@ -2,7 +2,7 @@
 //! Every experiment saves its verdicts as `<name>.findings.json`; `findings.md` is rebuilt
 //! from all of them, one section per claim.
 use super::{io, write, Env, Experiment};
-use crate::bench::interval::{Interval, Standing};
+use crate::bench::interval::{Estimate, Interval, Standing};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -59,6 +59,22 @@ impl Verdict {
             Verdict::Refuted
         } else {
             Verdict::Inconclusive
+        }
+    }
+
+    /// `less` on two rows' estimates: inconclusive where either row was flagged.
+    pub fn faster(a: &Estimate, b: &Estimate) -> Self {
+        match a.flagged || b.flagged {
+            true => Verdict::Inconclusive,
+            false => Verdict::less(&a.interval, &b.interval),
+        }
+    }
+
+    /// `ratio_at_least` on two rows' estimates: inconclusive where either was flagged.
+    pub fn speedup_at_least(slow: &Estimate, fast: &Estimate, k: f64) -> Self {
+        match slow.flagged || fast.flagged {
+            true => Verdict::Inconclusive,
+            false => Verdict::ratio_at_least(&slow.interval, &fast.interval, k),
         }
     }
 

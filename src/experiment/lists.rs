@@ -9,7 +9,7 @@ use super::measure::base;
 use super::shots::{time_shots, Shot};
 use super::{write, Env, Experiment, Steps};
 use crate::bench::floor::Floor;
-use crate::bench::interval::Interval;
+use crate::bench::interval::Estimate;
 use crate::bench::Measurer;
 use crate::config::{BuildKind, ListKind, MarchKind, Material, RenderKind};
 use crate::error::{Error, Result};
@@ -66,14 +66,6 @@ const CHARACTER: &[Mode] = &[
     Mode(T, false, C, 16, LIP),
 ];
 
-/// A cell's median and interval, and whether it was flagged.
-fn cell_text(c: &Cell) -> String {
-    match c.flagged {
-        true => format!("{} flagged", c.interval.text()),
-        false => c.interval.text(),
-    }
-}
-
 impl Mode {
     fn apply(&self, s: &mut MetaballSettings) {
         (s.list, s.sorted, s.build, s.tile, s.march) = (self.0, self.1, self.2, self.3, self.4);
@@ -98,9 +90,8 @@ impl Mode {
 struct Cell {
     mode: Mode,
     ms: f64,
-    /// The median's 95% interval under the protocol.
-    interval: Interval,
-    flagged: bool,
+    /// The median's 95% interval under the protocol, and whether the row was flagged.
+    est: Estimate,
     passes: String,
     list_mb: f64,
     steps: f64,
@@ -187,8 +178,7 @@ fn thesis_frame(
         out[k].push(Cell {
             mode,
             ms: t.row.main.median,
-            interval: t.row.interval.unwrap_or_default(),
-            flagged: t.row.flagged,
+            est: t.row.estimate().unwrap_or_default(),
             passes,
             list_mb: st.list_bytes as f64 / 1e6,
             steps: st_px,
@@ -347,10 +337,7 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
         |row: &[Cell]| -> Vec<Cell> { row.iter().filter(|c| c.mode.4 == FIXED).cloned().collect() };
     let best = |v: &[Cell]| v.iter().cloned().min_by(|a, b| a.ms.total_cmp(&b.ms));
     // Timings compare beyond their 95% intervals (a flagged cell decides nothing).
-    let less = |a: &Cell, b: &Cell| match a.flagged || b.flagged {
-        true => Verdict::Inconclusive,
-        false => Verdict::less(&a.interval, &b.interval),
-    };
+    let less = |a: &Cell, b: &Cell| Verdict::faster(&a.est, &b.est);
     let (phong, glass) = (&cells[0], &cells[1]);
     let compute = best(
         &fixed(phong)
@@ -366,8 +353,8 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
             format!(
                 "{}: {}, A-buffer {} ({:.2}x)",
                 c.mode.name(),
-                cell_text(&c),
-                cell_text(&a),
+                c.est.text(),
+                a.est.text(),
                 a.ms / c.ms
             ),
         ),
@@ -394,8 +381,8 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
                 if sorted { "sorted" } else { "unsorted" },
                 r.ms / c.ms,
                 v.word(),
-                cell_text(&r),
-                cell_text(&c)
+                r.est.text(),
+                c.est.text()
             ));
         }
     }
@@ -417,9 +404,9 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
                 "{label} ({}): {} {}, best list {} {}",
                 v.word(),
                 t.mode.name(),
-                cell_text(&t),
+                t.est.text(),
                 l.mode.name(),
-                cell_text(&l)
+                l.est.text()
             ));
         }
     }
@@ -455,16 +442,13 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
         found.push(match (best(row), cell(row, reference)) {
             (Some(t), Some(r)) => Finding::new(
                 claim,
-                match t.flagged || r.flagged {
-                    true => Verdict::Inconclusive,
-                    false => Verdict::ratio_at_least(&r.interval, &t.interval, 2.0),
-                },
+                Verdict::speedup_at_least(&r.est, &t.est, 2.0),
                 format!(
                     "{}: {} against {} {} ({:.2}x)",
                     t.mode.name(),
-                    cell_text(&t),
+                    t.est.text(),
                     reference.name(),
-                    cell_text(&r),
+                    r.est.text(),
                     r.ms / t.ms
                 ),
             ),

@@ -4,7 +4,7 @@ use super::findings::{self, Finding, Verdict};
 use super::shots::{time_shots, Shot};
 use super::tables::{value, Col, TableDef, SBUFFER};
 use super::{write, Env, Steps};
-use crate::bench::interval::Interval;
+use crate::bench::interval::Estimate;
 use crate::bench::Measurer;
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
@@ -16,9 +16,8 @@ use std::path::PathBuf;
 /// One (row, column) of a table.
 pub struct Cell {
     pub stat: Stat,
-    /// The median's 95% interval under the protocol.
-    pub interval: Interval,
-    pub flagged: bool,
+    /// The median's 95% interval under the protocol, and whether the row was flagged.
+    pub est: Estimate,
     pub reps: u64,
     pub fps: f64,
     pub list_bytes: u64,
@@ -141,8 +140,7 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
                 }
                 Cell {
                     stat: t.row.main,
-                    interval: t.row.interval.unwrap_or_default(),
-                    flagged: t.row.flagged,
+                    est: t.row.estimate().unwrap_or_default(),
                     reps: t.row.reps,
                     fps: 1000.0 / t.row.main.median,
                     list_bytes: t.sized.list_bytes,
@@ -175,7 +173,12 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
     let per_row: Vec<Verdict> = m
         .cells
         .iter()
-        .map(|c| Verdict::all([less(&c[s], &c[a]), less(&c[a], &c[none])]))
+        .map(|c| {
+            Verdict::all([
+                Verdict::faster(&c[s].est, &c[a].est),
+                Verdict::faster(&c[a].est, &c[none].est),
+            ])
+        })
         .collect();
     let bad: Vec<String> = m
         .cells
@@ -187,9 +190,9 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
             format!(
                 "{l} ({}): S {}, A {}, none {}",
                 v.word(),
-                cell_text(&c[s]),
-                cell_text(&c[a]),
-                cell_text(&c[none])
+                c[s].est.text(),
+                c[a].est.text(),
+                c[none].est.text()
             )
         })
         .collect();
@@ -272,7 +275,11 @@ fn rise_finding(
     for g in groups {
         for (k, col) in def.cols.iter().enumerate() {
             let cells: Vec<&Cell> = g.iter().map(|&r| &m.cells[r][k]).collect();
-            let v = Verdict::all(cells.windows(2).map(|w| less(w[0], w[1])));
+            let v = Verdict::all(
+                cells
+                    .windows(2)
+                    .map(|w| Verdict::faster(&w[0].est, &w[1].est)),
+            );
             verdicts.push(v);
             if v != Verdict::Confirmed {
                 fails.push(format!(
@@ -285,7 +292,7 @@ fn rise_finding(
                     v.word(),
                     cells
                         .iter()
-                        .map(|c| cell_text(c))
+                        .map(|c| c.est.text())
                         .collect::<Vec<_>>()
                         .join(", ")
                 ));
@@ -305,22 +312,6 @@ fn rise_finding(
             }
         ),
     )
-}
-
-/// A cell's median and interval, and whether it was flagged.
-fn cell_text(c: &Cell) -> String {
-    match c.flagged {
-        true => format!("{} flagged", c.interval.text()),
-        false => c.interval.text(),
-    }
-}
-
-/// `a` faster than `b` beyond their intervals; inconclusive where either was flagged.
-fn less(a: &Cell, b: &Cell) -> Verdict {
-    match a.flagged || b.flagged {
-        true => Verdict::Inconclusive,
-        false => Verdict::less(&a.interval, &b.interval),
-    }
 }
 
 fn thesis_ratio(def: &TableDef, r: usize, k: usize) -> Option<f64> {
@@ -405,9 +396,9 @@ fn table_csv(env: &Env, def: &TableDef, m: &Measured) -> String {
                 th.k2,
                 thesis_ratio(def, r, k).map(|v| format!("{v:.3}")).unwrap_or_default(),
                 mem,
-                c.interval.lo,
-                c.interval.hi,
-                c.flagged
+                c.est.interval.lo,
+                c.est.interval.hi,
+                c.est.flagged
             ));
         }
     }
@@ -515,10 +506,10 @@ fn detail_md(def: &TableDef, m: &Measured) -> String {
             md.push_str(&format!(
                 " {:.2} [{:.2}, {:.2}] ({}){} |",
                 c.stat.median,
-                c.interval.lo,
-                c.interval.hi,
+                c.est.interval.lo,
+                c.est.interval.hi,
                 c.reps,
-                if c.flagged { " flagged" } else { "" }
+                if c.est.flagged { " flagged" } else { "" }
             ));
         }
         md.push('\n');

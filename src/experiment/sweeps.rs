@@ -57,8 +57,8 @@ fn md_rows(rows: &[&Row]) -> String {
 /// `a` faster than `b` beyond their intervals (inconclusive where either was flagged or
 /// has none).
 fn row_less(a: &Row, b: &Row) -> Verdict {
-    match (a.interval, b.interval, a.flagged || b.flagged) {
-        (Some(x), Some(y), false) => Verdict::less(&x, &y),
+    match (a.estimate(), b.estimate()) {
+        (Some(x), Some(y)) => Verdict::faster(&x, &y),
         _ => Verdict::Inconclusive,
     }
 }

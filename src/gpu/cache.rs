@@ -2,8 +2,8 @@
 //! SPIR-V by (shader, defines) and the driver's Vulkan pipeline cache, under
 //! `FLUIDFORM_CACHE_DIR` (else `$XDG_CACHE_HOME/fluidform`, else `~/.cache/fluidform`;
 //! `FLUIDFORM_CACHE_DIR=off` keeps nothing). A file is trusted only when it names this
-//! binary (its commit, compiler and embedded GLSL) and, for pipelines, this device and
-//! driver; any other is ignored with one line and replaced.
+//! binary (`build_id`: the embedded GLSL is part of it) and, for pipelines, this device
+//! and driver; any other is ignored with one line and replaced.
 use ash::vk;
 use std::hash::{Hash, Hasher};
 use std::path::PathBuf;

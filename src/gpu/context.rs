@@ -181,7 +181,8 @@ impl Context {
             }
         };
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        let limits = unsafe { instance.get_physical_device_properties(physical) }.limits;
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let limits = props.limits;
         let push_descriptor = ash::khr::push_descriptor::Device::new(&instance, &device);
         let debug_device = debug_instance
             .as_ref()
@@ -205,7 +206,6 @@ impl Context {
                 unsafe { device.create_command_pool(&pool_info, None) }.ctx("command pool")?;
             Ok((shaders, allocator, pool))
         })();
-        let props = unsafe { instance.get_physical_device_properties(physical) };
         let pipeline_cache = super::cache::open_pipeline_cache(&device, &props);
         let (shaders, allocator, pool) = match rest {
             Ok(r) => r,

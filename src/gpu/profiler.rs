@@ -28,6 +28,15 @@ pub struct FrameTiming {
     pub cpu_ns: Option<(f64, f64)>,
 }
 
+impl FrameTiming {
+    /// Pass `key`'s ms in this frame, summed over its repeats; None where it did not run.
+    pub fn pass_ms(&self, key: &str) -> Option<f64> {
+        let mut found = self.passes.iter().filter(|(k, _)| k == key).peekable();
+        found.peek()?;
+        Some(found.map(|(_, ms)| ms).sum())
+    }
+}
+
 /// Queries per pool (a begin and an end per scope).
 const POOL_QUERIES: u32 = 256;
 
@@ -135,11 +144,8 @@ impl ScopeKey {
 
     /// This scope's milliseconds in one frame's timing (summed over its repeats).
     pub fn ms_in(self, t: &FrameTiming) -> Result<f64> {
-        let mut found = t.passes.iter().filter(|(k, _)| k == self.path).peekable();
-        if found.peek().is_none() {
-            return Err(self.missing(t.passes.iter().map(|(k, _)| k.as_str())));
-        }
-        Ok(found.map(|(_, ms)| ms).sum())
+        t.pass_ms(self.path)
+            .ok_or_else(|| self.missing(t.passes.iter().map(|(k, _)| k.as_str())))
     }
 }
 

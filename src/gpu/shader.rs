@@ -147,6 +147,18 @@ impl ShaderCompiler {
         defines: &[(&str, String)],
         level: shaderc::OptimizationLevel,
     ) -> Result<Vec<u32>> {
+        // Kept on disk between processes of this binary (gpu/cache.rs), unless the GLSL is
+        // read from FLUIDFORM_GLSL_DIR, whose includes may change under it.
+        let kept = std::env::var_os("FLUIDFORM_GLSL_DIR")
+            .is_none()
+            .then(|| {
+                let key = (name, source, defines, level as u32, kind as u32);
+                super::cache::spirv_path(super::cache::build_id(), &key)
+            })
+            .flatten();
+        if let Some(words) = kept.as_deref().and_then(super::cache::load_spirv) {
+            return Ok(words);
+        }
         let mut opts = shaderc::CompileOptions::new()
             .map_err(|e| Error::Unsupported(format!("shaderc options: {e}")))?;
         opts.set_target_env(
@@ -179,18 +191,6 @@ impl ShaderCompiler {
             Err(format!("cannot find include \"{requested}\" in glsl/"))
         });
         let file = format!("glsl/{name}");
-        // Kept on disk between processes of this binary (gpu/cache.rs), unless the GLSL is
-        // read from FLUIDFORM_GLSL_DIR, whose includes may change under it.
-        let kept = std::env::var_os("FLUIDFORM_GLSL_DIR")
-            .is_none()
-            .then(|| {
-                let key = (name, source, defines, level as u32, kind as u32);
-                super::cache::spirv_path(super::cache::build_id(), &key)
-            })
-            .flatten();
-        if let Some(words) = kept.as_deref().and_then(super::cache::load_spirv) {
-            return Ok(words);
-        }
         let compiler = self.compiler.lock().unwrap();
         let words = compiler
             .compile_into_spirv(source, kind, &file, "main", Some(&opts))
