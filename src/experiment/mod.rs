@@ -18,8 +18,8 @@ pub mod thesis;
 use crate::bench::Measurer;
 use crate::config::Switches;
 use crate::error::{Error, Result};
-use crate::gpu::{Context, ContextOptions, Guard};
-use crate::render::metaball::{FluidRenderer, MetaballBuffers, MetaballSettings};
+use crate::gpu::{Context, ContextOptions};
+use crate::render::metaball::{FluidRenderer, MetaballSettings};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::HashMap;
 use std::io::IsTerminal;
@@ -73,10 +73,8 @@ pub struct Env {
     pub budget_s: f64,
     scene: Option<thesis::ThesisScene>,
     /// Renderers made once per shader configuration (llvmpipe takes about a second to
-    /// compile one), with buffers for up to the count beside them.
-    renderers: HashMap<String, (FluidRenderer, MetaballBuffers, u64)>,
-    /// Renderers without buffers, one per shader configuration, shared by the cells of a
-    /// table that are timed interleaved (shots.rs).
+    /// compile one) and shared by the cells of a table, each with buffers of its own, that
+    /// are timed interleaved (shots.rs).
     shared: HashMap<String, FluidRenderer>,
     /// Timed frames by (settings, centres): a frame asked for again (the `none` rows
     /// several tables share) is measured once per invocation.
@@ -98,30 +96,6 @@ impl Env {
             )?);
         }
         Ok(self.scene.as_ref().expect("made"))
-    }
-
-    /// A renderer for `s` with buffers for `n` metaballs: made once per shader
-    /// configuration and retuned for the settings that do not change the shaders.
-    pub fn renderer(
-        &mut self,
-        ctx: &Context,
-        s: &MetaballSettings,
-        n: u64,
-    ) -> Result<(&FluidRenderer, &mut MetaballBuffers)> {
-        let key = renderer_key(s);
-        let fits = self.renderers.get(&key).is_some_and(|e| e.2 >= n);
-        if !fits {
-            if let Some((mut r, mut b, _)) = self.renderers.remove(&key) {
-                b.destroy(ctx);
-                r.destroy(ctx);
-            }
-            let r = Guard::new(ctx, FluidRenderer::new(ctx, s.clone())?);
-            let b = r.buffers(ctx, n, 2, false)?;
-            self.renderers.insert(key.clone(), (r.take(), b, n));
-        }
-        let (r, b, _) = self.renderers.get_mut(&key).expect("inserted");
-        r.retune(s.clone())?;
-        Ok((&*r, b))
     }
 
     /// The renderer of `s`'s shader configuration, made once and retuned to `s`.
@@ -149,10 +123,6 @@ impl Env {
 
     pub fn destroy(&mut self, ctx: &Context) {
         for (_, mut r) in self.shared.drain() {
-            r.destroy(ctx);
-        }
-        for (_, (mut r, mut b, _)) in self.renderers.drain() {
-            b.destroy(ctx);
             r.destroy(ctx);
         }
     }
@@ -388,7 +358,6 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
         warmup: if q { 1 } else { 3 },
         budget_s: if q { 4.0 } else { 10.0 },
         scene: None,
-        renderers: HashMap::new(),
         shared: HashMap::new(),
         timed: HashMap::new(),
     };
