@@ -149,7 +149,7 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
                 for p in passes(*solver) {
                     let mut d = sph.clone();
                     d.extend(pass_defines(&p));
-                    v.push(with::<PressureIo>(p.1, &d));
+                    v.push(with::<PressureIo>(p.shader, &d));
                 }
             }
             use crate::control::force::{ControlIo, ControlSettings};

@@ -335,11 +335,11 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             dt_prev, cfl, dt_max, cfl_speed, wall_offset, pad1, pad2),
         ),
         (
-            "sph/solve_loop.comp",
+            "sph/dfsph.comp",
             "SolveState",
             fields!(fluidform::sph::pressure::SolveState;
-            gx, gy, gz, iter, done, lx, ly, lz, density_iters, divergence_iters, density_err,
-            divergence_err),
+            gx, gy, gz, iter, done, arrived, pad0, pad1, density_iters, divergence_iters,
+            density_err, divergence_err),
         ),
         (
             "sph/integrate.comp",

@@ -8,7 +8,9 @@
 // have applied in this step, kept for the next step's warm start in vel.w (by euler.comp)
 // and vhalf.w (by PREDICT): reordered with them. No collision response inside a solve:
 // euler.comp's is the step's one.
-//   FACTOR    density (as density.comp), alpha, neighbours, the step's neighbour lists
+//   FACTOR    density (as density.comp), alpha, neighbours, the step's neighbour lists;
+//             and the divergence solve's WARM (its residual needs nothing FACTOR writes
+//             for other particles)
 //   WARM      kappa = 0; dk = last step's kappa rescaled to this dt where the particle
 //             is compressing (r > 0, below), else 0
 //   SOURCE    the signed residual r (density: rho*/rho0 - 1, rho* predicted from the
@@ -16,7 +18,9 @@
 //             dk = max(kappa + r alpha / 2 / dt^2 (density) or / dt (divergence), 0) - kappa;
 //             the iteration's error max(r, 0) (divergence: times dt)
 //   VELOCITY  v -= dt sum V (dk_i + dk_j) grad W + dt dk_i sum_b V grad W; kappa += dk
-//   PREDICT   v* = v + dt a_nonpressure; the divergence kappa kept
+// PREDICTED (the density solve's WARM and first VELOCITY): the predicted velocities
+// v* = v + dt a_nonpressure are read as v + dt a (WARM) and stored by the first VELOCITY,
+// which also keeps the divergence kappa: no predict pass of its own.
 // The other passes, and DFSPH's forces (forces.comp), read the lists through
 // FOR_NEIGHBORS (pressure.glsl).
 // DIVERGENCE: 1 for the divergence-free solve, 0 for the constant-density solve.
@@ -32,17 +36,18 @@
 #define KAPPA x
 #endif
 
-// The signed residual of particle i (see SOURCE) with the velocities as they are.
-float residual(uint i, float dt, float h2, float V) {
-    vec3 xi = pos[i].xyz;
-    vec3 vi = vel[i].xyz;
-    vec3 gw;
-    float rate;
-    boundary(xi, vi, gw, rate);
-#define VISIT(j) { vec3 d = xi - pos[j].xyz; float r2 = dot(d, d); \
-        if (j != i && r2 < h2) rate += V * dot(vi - vel[j].xyz, grad_w(d, r2)); }
-    FOR_NEIGHBORS(i, xi, VISIT)
-#undef VISIT
+// Particle j's velocity as the solve sees it (PREDICTED: before the first VELOCITY has
+// stored the prediction).
+vec3 velocity(uint j, float dt) {
+#if PREDICTED
+    return vel[j].xyz + dt * acc[j].xyz;
+#else
+    return vel[j].xyz;
+#endif
+}
+
+// The residual from the velocity divergence `rate` (see SOURCE).
+float residual_of(uint i, float rate, float dt) {
 #if DIVERGENCE
     // Too few neighbours for a meaningful divergence (the surface's spray): left out.
     return aux[i].z < float(P.min_neighbors) ? 0.0 : rate;
@@ -51,22 +56,63 @@ float residual(uint i, float dt, float h2, float V) {
 #endif
 }
 
+// The signed residual of particle i (see SOURCE) with the velocities as they are.
+float residual(uint i, float dt, float h2, float V) {
+    vec3 xi = pos[i].xyz;
+    vec3 vi = velocity(i, dt);
+    vec3 gw;
+    float rate;
+    boundary(xi, vi, gw, rate);
+#define VISIT(j) { vec3 d = xi - pos[j].xyz; float r2 = dot(d, d); \
+        if (j != i && r2 < h2) rate += V * dot(vi - velocity(j, dt), grad_w(d, r2)); }
+    FOR_NEIGHBORS(i, xi, VISIT)
+#undef VISIT
+    return residual_of(i, rate, dt);
+}
+
+// WARM's dk for a particle whose residual is r: the kept kappa (aux2 K's, in `kept`)
+// rescaled to this dt where it compresses.
+float warm_kappa(float r, float kept, float dt) {
+    // The kept kappa moves a particle by dt^2 kappa grad W (density) or dt kappa grad W
+    // (divergence): the same push at this step's dt takes it times (dt_prev / dt)^k.
+    float ratio = P.dt_prev / dt;
+#if DIVERGENCE
+    kept *= ratio;
+#else
+    kept *= ratio * ratio;
+#endif
+    // All of it: with SPlisHSPlasH's half the 16K dam break's measured error at 1.33 ms
+    // steps rose from 0.057% to 0.107% at a 0.1% target (a solve stops as soon as its
+    // estimate is in; a better start leaves a better step).
+    return r > 0.0 ? max(kept, 0.0) : 0.0;
+}
+
 void main() {
+    SOLVE_START()
     uint i = global_id();
     float dt = P.gravity.w;
     float h2 = P.h * P.h;
     float V = vol0();
 #if PASS == PASS_FACTOR
+#if !DIVERGENCE
+#error "FACTOR starts the divergence solve: build it with DIVERGENCE 1"
+#endif
     if (!sph_alive(i)) return;
     vec3 xi = pos[i].xyz;
+    vec3 vi = vel[i].xyz;
     vec3 sg = vec3(0.0);
     float s2 = 0.0, sum = 0.0;
     uint count = 0u;
+    // The divergence solve's warm start: residual() in the same neighbour order.
+    vec3 gv;
+    float div_rate;
+    boundary(xi, vi, gv, div_rate);
     NB_BEGIN(xi, P.h, j)
         vec3 d = xi - pos[j].xyz;
         float r2 = dot(d, d);
         sum += kernel_w(r2);  // density, self included
         if (j != i && r2 < h2) {
+            div_rate += V * dot(vi - vel[j].xyz, grad_w(d, r2));
             vec3 g = V * grad_w(d, r2);
             sg += g;
             s2 += dot(g, g);
@@ -86,20 +132,14 @@ void main() {
     sg += gw;  // the boundary adds to the gradient sum (it does not move: no square)
     float denom = dot(sg, sg) + s2;
     aux[i] = vec4(denom > 1e-3 * P.proto_grad2 ? 1.0 / denom : 0.0, 0.0, float(count), 0.0);
+    aux[i].y = warm_kappa(residual_of(i, div_rate, dt), vhalf[i].w, dt);
+    aux2[i].y = 0.0;
 #elif PASS == PASS_WARM
-    if (!sph_alive(i)) return;
-    // The kept kappa moves a particle by dt^2 kappa grad W (density) or dt kappa grad W
-    // (divergence): the same push at this step's dt takes it times (dt_prev / dt)^k.
-    float ratio = P.dt_prev / dt;
-#if DIVERGENCE
-    float kept = vhalf[i].w * ratio;
-#else
-    float kept = vel[i].w * ratio * ratio;
+#if DIVERGENCE || !PREDICTED
+#error "WARM is the density solve's (PREDICTED 1): FACTOR warms the divergence solve"
 #endif
-    // All of it: with SPlisHSPlasH's half the 16K dam break's measured error at 1.33 ms
-    // steps rose from 0.057% to 0.107% at a 0.1% target (a solve stops as soon as its
-    // estimate is in; a better start leaves a better step).
-    aux[i].y = residual(i, dt, h2, V) > 0.0 ? max(kept, 0.0) : 0.0;
+    if (!sph_alive(i)) return;
+    aux[i].y = warm_kappa(residual(i, dt, h2, V), vel[i].w, dt);
     aux2[i].KAPPA = 0.0;
 #elif PASS == PASS_SOURCE
     bool live = sph_alive(i);
@@ -131,12 +171,11 @@ void main() {
     FOR_NEIGHBORS(i, xi, VISIT)
 #undef VISIT
     // Neighbours read aux.y here, never vel.xyz or aux2.
-    vel[i].xyz += dv;
+    vel[i].xyz = velocity(i, dt) + dv;
     aux2[i].KAPPA += ki;
-#elif PASS == PASS_PREDICT
-    if (!sph_alive(i)) return;
-    vel[i].xyz += dt * acc[i].xyz;
-    vhalf[i].w = aux2[i].y;
+#if PREDICTED
+    vhalf[i].w = aux2[i].y;  // the divergence kappa, for the next step's warm start
+#endif
 #else
 #error "PASS names no DFSPH pass"
 #endif

@@ -17,6 +17,7 @@
 //              v += dt epsilon (N x omega) + dv
 #include "pressure.glsl"
 void main() {
+    SOLVE_START()
     uint i = global_id();
     float dt = P.gravity.w;
     float h2 = P.h * P.h;

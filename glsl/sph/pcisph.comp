@@ -1,7 +1,7 @@
 #version 450
 // PCISPH (Solenthaler & Pajarola 2009), one pass per PASS, neighbours from the step's start
 // positions. aux.xyz: predicted position x*, aux.w: delta; aux2.xyz: pressure acceleration
-// (zeroed at the solve's start); rho_p.y: pressure (0 from the density pass), in units of
+// (zeroed by FACTOR, which starts the solve); rho_p.y: pressure (0 from the density pass), in units of
 // rho0 (p / rho0; euler.comp leaves Pa). The solid boundary (boundary.glsl) counts in the
 // densities and pushes with the particle's own pressure; delta is the fluid's alone (with
 // the boundary's gradient in it, the solve at 0.1% diverged in a resting pool: near a
@@ -17,6 +17,7 @@
 // the prototype's diverged in our dam break. Relaxed by 1/2 as IISPH's Jacobi update.
 #include "pressure.glsl"
 void main() {
+    SOLVE_START()
     uint i = global_id();
     float dt = P.gravity.w;
     float h2 = P.h * P.h;
@@ -36,6 +37,7 @@ void main() {
     NB_END
     float k = max(dot(sg, sg) + s2, 1e-3 * P.proto_grad2);
     aux[i] = vec4(pos[i].xyz, 0.5 / (2.0 * dt * dt * k));
+    aux2[i] = vec4(0.0);  // the pressure acceleration starts at zero
 #elif PASS == PASS_PREDICT
     if (!sph_alive(i)) return;
     vec3 v = vel[i].xyz + dt * (acc[i].xyz + aux2[i].xyz);

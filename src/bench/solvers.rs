@@ -109,6 +109,8 @@ pub struct Outcome {
     /// GPU ms per step, one value per timed frame.
     pub per_step_ms: Vec<f64>,
     pub errors: DensityErrorStats,
+    /// Dispatches, barriers and empty dispatches per step (every played step).
+    pub commands: crate::sph::commands::CommandStats,
     /// Why the run stopped early (the health check's message), if it did.
     pub unstable: Option<String>,
 }
@@ -199,6 +201,7 @@ pub fn play(
         out.gpu_ms += ms;
         out.per_step_ms.push(ms / steps.len().max(1) as f64);
     }
+    out.commands = stepper.commands.finished();
     Ok(out)
 }
 
@@ -249,6 +252,12 @@ fn row(variant: String, f: &FluidParams, o: &Outcome) -> Result<Row> {
                 "ms per divergence iteration".into(),
                 per_iteration(o.solve_ms[1], e.divergence_iterations_mean, o.steps),
             ),
+            // The median step's commands (the first frame records max_iter iterations).
+            ("dispatches".into(), o.commands.median[0].to_string()),
+            ("barriers".into(), o.commands.median[1].to_string()),
+            ("solver dispatches".into(), o.commands.median[2].to_string()),
+            ("solver barriers".into(), o.commands.median[3].to_string()),
+            ("empty dispatches".into(), o.commands.median[4].to_string()),
             ("mean error %".into(), format!("{:.3}", e.mean * 100.0)),
             ("max error %".into(), format!("{:.2}", e.max * 100.0)),
             (

@@ -34,6 +34,7 @@ pub use memory::{Buffer, Image, MemoryLocation};
 pub use pipeline::{ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline};
 pub use profiler::{FrameTiming, Labels, Profiler, ScopeKey, Scopes, FRAME};
 pub use target::ColorTarget;
+pub use track::Recorded;
 
 pub use ash::vk;
 pub use error::{Error, Result};

@@ -312,6 +312,7 @@ impl<I: Interface> ComputePipeline<I> {
         let gx = groups.min(MAX_GROUPS_X as u64) as u32;
         let gy = groups.div_ceil(gx as u64) as u32;
         self.bind(ctx, cmd, bufs, push, None);
+        ctx.count_dispatch(cmd, false);
         unsafe { ctx.device.cmd_dispatch(cmd, gx, gy, 1) };
     }
 
@@ -345,6 +346,7 @@ impl<I: Interface> ComputePipeline<I> {
         offset: u64,
     ) {
         self.bind(ctx, cmd, bufs, push, Some(args));
+        ctx.count_dispatch(cmd, true);
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
     }
 

@@ -309,7 +309,7 @@ impl Profiler {
         }
         // lavapipe executes a pipeline barrier as a stall (flush and wait), which resolves
         // the timestamp just binned before any later work starts.
-        ctx.barrier(cmd, super::sync::ALL, super::sync::ALL);
+        ctx.profiler_stall(cmd);
     }
 
     /// Read `slot`'s results; call only after that slot's fence has signalled.

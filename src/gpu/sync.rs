@@ -108,6 +108,13 @@ impl Context {
         self.record_barrier(cmd, from, to);
     }
 
+    /// A stall the profiler needs (every stage to every stage), not counted among the
+    /// barriers `recorded` reports: instrumentation, not the work's own.
+    pub fn profiler_stall(&self, cmd: vk::CommandBuffer) {
+        self.trackers.lock().unwrap().get(cmd).barrier(ALL, ALL);
+        self.record_barrier_uncounted(cmd, ALL, ALL);
+    }
+
     /// Record the buffer uses of the next command (`gpu::track`); `place`: record the
     /// barrier it needs, if any (never inside a rendering scope).
     pub fn track(&self, cmd: vk::CommandBuffer, uses: &[BufferUse], place: bool) {
@@ -161,6 +168,11 @@ impl Context {
     }
 
     fn record_barrier(&self, cmd: vk::CommandBuffer, from: Access, to: Access) {
+        self.trackers.lock().unwrap().get(cmd).recorded.barriers += 1;
+        self.record_barrier_uncounted(cmd, from, to);
+    }
+
+    fn record_barrier_uncounted(&self, cmd: vk::CommandBuffer, from: Access, to: Access) {
         let b = [vk::MemoryBarrier2::default()
             .src_stage_mask(from.stage)
             .src_access_mask(from.access)
@@ -168,6 +180,28 @@ impl Context {
             .dst_access_mask(to.access)];
         let dep = vk::DependencyInfo::default().memory_barriers(&b);
         unsafe { self.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+
+    fn count_transfer(&self, cmd: vk::CommandBuffer) {
+        self.trackers.lock().unwrap().get(cmd).recorded.transfers += 1;
+    }
+
+    /// A dispatch was recorded into `cmd` (`indirect`: its group counts on the device).
+    pub(crate) fn count_dispatch(&self, cmd: vk::CommandBuffer, indirect: bool) {
+        let mut t = self.trackers.lock().unwrap();
+        let r = &mut t.get(cmd).recorded;
+        r.dispatches += 1;
+        r.indirect += indirect as u32;
+    }
+
+    /// The recording `cmd` is in: a command buffer begun again is another recording.
+    pub fn recording(&self, cmd: vk::CommandBuffer) -> u64 {
+        self.trackers.lock().unwrap().get(cmd).serial
+    }
+
+    /// The commands recorded into `cmd` so far (take two and subtract: a sequence's cost).
+    pub fn recorded(&self, cmd: vk::CommandBuffer) -> super::track::Recorded {
+        self.trackers.lock().unwrap().get(cmd).recorded
     }
 
     /// Compute writes visible to later compute reads and writes: the common case.
@@ -190,6 +224,7 @@ impl Context {
             BufferUse::transfer(dst.raw, true).bytes(dst_offset, size),
         ];
         self.track(cmd, &uses, true);
+        self.count_transfer(cmd);
         let region = vk::BufferCopy {
             src_offset,
             dst_offset,
@@ -204,6 +239,7 @@ impl Context {
     /// Fill the whole buffer with a u32 value.
     pub fn fill(&self, cmd: vk::CommandBuffer, b: &super::Buffer, value: u32) {
         self.track(cmd, &[BufferUse::transfer(b.raw, true)], true);
+        self.count_transfer(cmd);
         unsafe {
             self.device
                 .cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, value)
@@ -222,6 +258,7 @@ impl Context {
         if !bytes.is_empty() {
             let u = BufferUse::transfer(b.raw, true).bytes(offset, bytes.len() as u64);
             self.track(cmd, &[u], true);
+            self.count_transfer(cmd);
             unsafe { self.device.cmd_update_buffer(cmd, b.raw, offset, bytes) };
         }
     }

@@ -200,10 +200,53 @@ impl State {
     }
 }
 
+/// Commands recorded into one command buffer so far: what a pass sequence costs the
+/// device's front end (each barrier drains the compute pipe; an indirect dispatch with
+/// zero groups still costs its launch and its barrier).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Recorded {
+    /// Compute dispatches, direct and indirect.
+    pub dispatches: u32,
+    /// Of them, indirect (their group counts live on the device: may be empty).
+    pub indirect: u32,
+    /// Pipeline barriers (placed by the tracker or recorded by hand).
+    pub barriers: u32,
+    /// Buffer updates and fills (transfer commands).
+    pub transfers: u32,
+}
+
+impl std::ops::Add for Recorded {
+    type Output = Recorded;
+    fn add(self, o: Recorded) -> Recorded {
+        Recorded {
+            dispatches: self.dispatches + o.dispatches,
+            indirect: self.indirect + o.indirect,
+            barriers: self.barriers + o.barriers,
+            transfers: self.transfers + o.transfers,
+        }
+    }
+}
+
+impl std::ops::Sub for Recorded {
+    type Output = Recorded;
+    fn sub(self, o: Recorded) -> Recorded {
+        Recorded {
+            dispatches: self.dispatches - o.dispatches,
+            indirect: self.indirect - o.indirect,
+            barriers: self.barriers - o.barriers,
+            transfers: self.transfers - o.transfers,
+        }
+    }
+}
+
 /// The hazards of one command buffer being recorded.
 #[derive(Default)]
 pub struct Tracker {
     buffers: HashMap<vk::Buffer, State>,
+    /// The commands recorded so far.
+    pub recorded: Recorded,
+    /// Which recording this is: a command buffer begun again gets a new one.
+    pub serial: u64,
     /// Barriers the tracker placed, and hazards it found where it may place none.
     pub placed: u32,
     pub unplaced: u32,
@@ -355,6 +398,8 @@ pub struct Trackers {
     pub unplaced: u64,
     /// `FLUIDFORM_TRACK_DEBUG` set (read once, with the context): print each barrier placed.
     pub debug: bool,
+    /// Recordings begun so far.
+    serials: u64,
 }
 
 impl Trackers {
@@ -366,11 +411,27 @@ impl Trackers {
     }
 
     pub fn begin(&mut self, cmd: vk::CommandBuffer) {
-        self.open.insert(cmd, Tracker::default());
+        self.serials += 1;
+        let serial = self.serials;
+        self.open.insert(
+            cmd,
+            Tracker {
+                serial,
+                ..Tracker::default()
+            },
+        );
     }
 
     pub fn get(&mut self, cmd: vk::CommandBuffer) -> &mut Tracker {
-        self.open.entry(cmd).or_default()
+        let next = self.serials + 1;
+        let t = self.open.entry(cmd).or_insert_with(|| Tracker {
+            serial: next,
+            ..Tracker::default()
+        });
+        if t.serial == next {
+            self.serials = next;
+        }
+        t
     }
 
     /// The command buffer is submitted: its counts join the totals.

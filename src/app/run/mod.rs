@@ -92,6 +92,9 @@ pub struct SphRunStats {
     /// The density error of every step (per step in steps.csv).
     #[serde(default)]
     pub density_error: crate::sph::errors::DensityErrorStats,
+    /// Dispatches, barriers and empty dispatches per step.
+    #[serde(default)]
+    pub commands: crate::sph::commands::CommandStats,
     /// The scene's particle systems, if any.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub particle_systems: Vec<crate::run::particles::SystemStats>,

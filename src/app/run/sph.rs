@@ -483,6 +483,7 @@ impl SphWork {
             emission: emission_stats?,
             particle_systems: particle_systems?,
             density_error,
+            commands: self.stepper.commands.finished(),
         };
         steps_csv?;
         let config = RunConfig {

@@ -4,10 +4,13 @@
 //! (after the neighbourhoods and densities are new; the paper's end-of-step solve, moved to
 //! the next step's start), then the non-pressure forces, then the constant-density solve on
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
-//! Euler (glsl/sph/dfsph.comp, euler.comp).
+//! Euler (glsl/sph/dfsph.comp, euler.comp). The divergence solve's warm start is part of
+//! the factor pass, the prediction part of the density solve's first passes, and each
+//! iteration's source pass ends the iteration: a step at 2 + 1 iterations runs 15
+//! dispatches from factor to Euler, and each spare iteration recorded 2 empty ones.
 use super::pressure::{
     check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
-    EULER, LOOP_DENSITY, LOOP_DIVERGENCE,
+    EULER,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -128,63 +131,59 @@ impl DfsphParams {
 enum Pass {
     Factor,
     Forces,
-    Predict,
     WarmDensity,
+    PredictDensity,
     SourceDensity,
     VelocityDensity,
-    WarmDivergence,
-    SourceDivergence,
+    CheckDensity,
     VelocityDivergence,
-    LoopDivergence,
-    LoopDensity,
+    SourceDivergence,
+    CheckDivergence,
     Euler,
 }
 
-pub const PASSES: [PassDecl; 12] = [
-    ("factor", "sph/dfsph.comp", "PASS_FACTOR", false),
-    ("forces", "sph/forces.comp", "PASS_FORCES", false),
-    ("predict", "sph/dfsph.comp", "PASS_PREDICT", false),
-    ("warm/density", "sph/dfsph.comp", "PASS_WARM", false),
-    ("source/density", "sph/dfsph.comp", "PASS_SOURCE", false),
-    ("velocity/density", "sph/dfsph.comp", "PASS_VELOCITY", false),
-    ("warm/divergence", "sph/dfsph.comp", "PASS_WARM", true),
-    ("source/divergence", "sph/dfsph.comp", "PASS_SOURCE", true),
-    (
-        "velocity/divergence",
-        "sph/dfsph.comp",
-        "PASS_VELOCITY",
-        true,
-    ),
-    LOOP_DIVERGENCE,
-    LOOP_DENSITY,
+const SHADER: &str = "sph/dfsph.comp";
+
+pub const PASSES: [PassDecl; 11] = [
+    PassDecl::new("factor", SHADER, "PASS_FACTOR")
+        .divergence()
+        .starts(),
+    PassDecl::new("forces", "sph/forces.comp", "PASS_FORCES"),
+    PassDecl::new("warm/density", SHADER, "PASS_WARM")
+        .starts()
+        .predicted(),
+    PassDecl::new("predict/density", SHADER, "PASS_VELOCITY").predicted(),
+    PassDecl::new("source/density", SHADER, "PASS_SOURCE"),
+    PassDecl::new("velocity/density", SHADER, "PASS_VELOCITY"),
+    PassDecl::new("check/density", SHADER, "PASS_SOURCE").check(),
+    PassDecl::new("velocity/divergence", SHADER, "PASS_VELOCITY").divergence(),
+    PassDecl::new("source/divergence", SHADER, "PASS_SOURCE").divergence(),
+    PassDecl::new("check/divergence", SHADER, "PASS_SOURCE")
+        .divergence()
+        .check(),
     EULER,
 ];
 
-/// One of the two solves: its scope, passes and loop pass.
+/// One of the two solves after its warm start: its scope, the passes that apply the warm
+/// start's change and take the first residual, and an iteration's passes.
 struct Solve {
     scope: &'static str,
-    warm: Pass,
-    source: Pass,
-    velocity: Pass,
-    check: Pass,
+    first: [Pass; 2],
+    iteration: [Pass; 2],
     divergence: bool,
 }
 
 const DIVERGENCE: Solve = Solve {
     scope: super::DIVERGENCE_SCOPE.name(),
-    warm: Pass::WarmDivergence,
-    source: Pass::SourceDivergence,
-    velocity: Pass::VelocityDivergence,
-    check: Pass::LoopDivergence,
+    first: [Pass::VelocityDivergence, Pass::SourceDivergence],
+    iteration: [Pass::VelocityDivergence, Pass::CheckDivergence],
     divergence: true,
 };
 
 const DENSITY: Solve = Solve {
     scope: super::PRESSURE_SCOPE.name(),
-    warm: Pass::WarmDensity,
-    source: Pass::SourceDensity,
-    velocity: Pass::VelocityDensity,
-    check: Pass::LoopDensity,
+    first: [Pass::PredictDensity, Pass::SourceDensity],
+    iteration: [Pass::VelocityDensity, Pass::CheckDensity],
     divergence: false,
 };
 
@@ -195,33 +194,26 @@ impl Dfsph {
         Pipelines::new(ctx, Solver::Dfsph, &PASSES, base).map(Self)
     }
 
-    /// Warm start (gated, applied), sources, iterations of one solve.
+    /// One solve after its warm start (the factor pass's or the warm pass's, in `warm`):
+    /// the warm start applied, the first residual, the iterations.
     fn solve(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
-        s: &Solve,
+        (s, warm): (&Solve, Option<Pass>),
     ) -> Result<()> {
         let p = &self.0;
         scopes.begin(ctx, cmd, s.scope);
-        let body = [s.velocity as usize, s.source as usize];
-        let r = p
-            .run(ctx, cmd, st, s.warm as usize)
-            .and_then(|_| p.run(ctx, cmd, st, s.velocity as usize))
-            .and_then(|_| p.run(ctx, cmd, st, s.source as usize))
+        let iteration = s.iteration.map(|k| k as usize);
+        let r = warm
+            .into_iter()
+            .chain(s.first)
+            .try_for_each(|k| p.run(ctx, cmd, st, k as usize))
             .and_then(|_| {
-                let check = s.check as usize;
-                p.solve(
-                    ctx,
-                    cmd,
-                    scopes,
-                    st,
-                    "iterations",
-                    (&body, check),
-                    s.divergence,
-                )
+                let iterations = (&iteration[..], &[][..]);
+                p.solve(ctx, cmd, scopes, st, "iterations", iterations, s.divergence)
             });
         scopes.end(ctx, cmd);
         r
@@ -231,6 +223,10 @@ impl Dfsph {
 impl PressureSolver for Dfsph {
     fn kind(&self) -> Solver {
         Solver::Dfsph
+    }
+
+    fn iteration_dispatches(&self) -> u32 {
+        DENSITY.iteration.len() as u32
     }
 
     /// In place of the density and forces passes: densities, factors and the step's
@@ -244,11 +240,11 @@ impl PressureSolver for Dfsph {
         st: &SphState,
     ) -> Result<()> {
         self.0.scoped(ctx, cmd, scopes, st, Pass::Factor as usize)?;
-        self.solve(ctx, cmd, scopes, st, &DIVERGENCE)?;
+        self.solve(ctx, cmd, scopes, st, (&DIVERGENCE, None))?;
         self.0.scoped(ctx, cmd, scopes, st, Pass::Forces as usize)
     }
 
-    /// Predicted velocities, the constant-density solve, the positions.
+    /// The constant-density solve on the predicted velocities, the positions.
     fn record_solve(
         &self,
         _: &SphSolver,
@@ -257,9 +253,7 @@ impl PressureSolver for Dfsph {
         scopes: &mut dyn Scopes,
         st: &SphState,
     ) -> Result<()> {
-        self.0
-            .scoped(ctx, cmd, scopes, st, Pass::Predict as usize)?;
-        self.solve(ctx, cmd, scopes, st, &DENSITY)?;
+        self.solve(ctx, cmd, scopes, st, (&DENSITY, Some(Pass::WarmDensity)))?;
         self.0.scoped(ctx, cmd, scopes, st, Pass::Euler as usize)
     }
 

@@ -5,6 +5,7 @@
 pub mod boundary;
 pub mod cfl;
 pub mod collider;
+pub mod commands;
 pub mod cpu;
 pub mod cpu_pressure;
 pub mod dfsph;

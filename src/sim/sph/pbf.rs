@@ -4,7 +4,6 @@
 //! then vorticity confinement and XSPH viscosity (glsl/sph/pbf.comp).
 use super::pressure::{
     check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
-    LOOP_DENSITY,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -120,18 +119,22 @@ enum Pass {
     Velocity,
     Vorticity,
     Confine,
-    Loop,
 }
 
-pub const PASSES: [PassDecl; 8] = [
-    ("predict", "sph/pbf.comp", "PASS_PREDICT", false),
-    ("lambda", "sph/pbf.comp", "PASS_LAMBDA", false),
-    ("delta", "sph/pbf.comp", "PASS_DELTA", false),
-    ("apply", "sph/pbf.comp", "PASS_APPLY", false),
-    ("velocity", "sph/pbf.comp", "PASS_VELOCITY", false),
-    ("vorticity", "sph/pbf.comp", "PASS_VORTICITY", false),
-    ("confine", "sph/pbf.comp", "PASS_CONFINE", false),
-    LOOP_DENSITY,
+const SHADER: &str = "sph/pbf.comp";
+
+/// An iteration: the pass that checks, and the ones after it.
+const CHECKED: [Pass; 1] = [Pass::Lambda];
+const REST: [Pass; 2] = [Pass::Delta, Pass::Apply];
+
+pub const PASSES: [PassDecl; 7] = [
+    PassDecl::new("predict", SHADER, "PASS_PREDICT").starts(),
+    PassDecl::new("lambda", SHADER, "PASS_LAMBDA").check(),
+    PassDecl::new("delta", SHADER, "PASS_DELTA"),
+    PassDecl::new("apply", SHADER, "PASS_APPLY"),
+    PassDecl::new("velocity", SHADER, "PASS_VELOCITY"),
+    PassDecl::new("vorticity", SHADER, "PASS_VORTICITY"),
+    PassDecl::new("confine", SHADER, "PASS_CONFINE"),
 ];
 
 pub struct Pbf(Pipelines);
@@ -147,6 +150,10 @@ impl PressureSolver for Pbf {
         Solver::Pbf
     }
 
+    fn iteration_dispatches(&self) -> u32 {
+        (CHECKED.len() + REST.len()) as u32
+    }
+
     /// After the forces pass (no viscous force: XSPH replaces it) and the force hooks.
     fn record_solve(
         &self,
@@ -158,14 +165,14 @@ impl PressureSolver for Pbf {
     ) -> Result<()> {
         let p = &self.0;
         p.scoped(ctx, cmd, scopes, st, Pass::Predict as usize)?;
-        let body = [Pass::Lambda, Pass::Delta, Pass::Apply].map(|k| k as usize);
+        let (checked, rest) = (CHECKED.map(|k| k as usize), REST.map(|k| k as usize));
         p.solve(
             ctx,
             cmd,
             scopes,
             st,
             super::PRESSURE_SCOPE.name(),
-            (&body, Pass::Loop as usize),
+            (&checked, &rest),
             false,
         )?;
         p.scoped(ctx, cmd, scopes, st, Pass::Velocity as usize)?;

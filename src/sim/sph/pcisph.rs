@@ -3,7 +3,7 @@
 //! (glsl/sph/pcisph.comp, euler.comp).
 use super::pressure::{
     check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
-    EULER, LOOP_DENSITY,
+    EULER,
 };
 use super::solver::{SphSolver, SphState};
 use crate::error::Result;
@@ -75,16 +75,20 @@ enum Pass {
     Predict,
     Pressure,
     Accel,
-    Loop,
     Euler,
 }
 
-pub const PASSES: [PassDecl; 6] = [
-    ("factor", "sph/pcisph.comp", "PASS_FACTOR", false),
-    ("predict", "sph/pcisph.comp", "PASS_PREDICT", false),
-    ("pressure", "sph/pcisph.comp", "PASS_PRESSURE", false),
-    ("accel", "sph/pcisph.comp", "PASS_ACCEL", false),
-    LOOP_DENSITY,
+const SHADER: &str = "sph/pcisph.comp";
+
+/// An iteration: the passes up to the one that checks, and the one after it.
+const CHECKED: [Pass; 2] = [Pass::Predict, Pass::Pressure];
+const REST: [Pass; 1] = [Pass::Accel];
+
+pub const PASSES: [PassDecl; 5] = [
+    PassDecl::new("factor", SHADER, "PASS_FACTOR").starts(),
+    PassDecl::new("predict", SHADER, "PASS_PREDICT"),
+    PassDecl::new("pressure", SHADER, "PASS_PRESSURE").check(),
+    PassDecl::new("accel", SHADER, "PASS_ACCEL"),
     EULER,
 ];
 
@@ -101,6 +105,10 @@ impl PressureSolver for Pcisph {
         Solver::Pcisph
     }
 
+    fn iteration_dispatches(&self) -> u32 {
+        (CHECKED.len() + REST.len()) as u32
+    }
+
     /// acc = the non-pressure acceleration; the density pass left every pressure at 0.
     fn record_solve(
         &self,
@@ -111,18 +119,16 @@ impl PressureSolver for Pcisph {
         st: &SphState,
     ) -> Result<()> {
         let p = &self.0;
+        // The factor pass zeroes the pressure acceleration and starts the solve.
         p.scoped(ctx, cmd, scopes, st, Pass::Factor as usize)?;
-        // The pressure acceleration starts at zero.
-        let aux2 = st.pressure()?.aux2();
-        ctx.fill(cmd, aux2, 0);
-        let body = [Pass::Predict, Pass::Pressure, Pass::Accel].map(|k| k as usize);
+        let (checked, rest) = (CHECKED.map(|k| k as usize), REST.map(|k| k as usize));
         p.solve(
             ctx,
             cmd,
             scopes,
             st,
             super::PRESSURE_SCOPE.name(),
-            (&body, Pass::Loop as usize),
+            (&checked, &rest),
             false,
         )?;
         p.scoped(ctx, cmd, scopes, st, Pass::Euler as usize)

@@ -1,9 +1,11 @@
 //! The incompressible solvers' shared machinery (pcisph.rs, dfsph.rs, pbf.rs): their extra
 //! per-particle buffers, their passes (one table, also read by the every-shader-compiles
-//! registry), and the iteration loop. A solve records `max_iter` iterations; each ends in
-//! a one-workgroup pass (solve_loop.comp) that reduces the iteration's error on the GPU and,
-//! once the solve has converged, zeroes the group count of the indirect dispatches that
-//! remain: no read-back per iteration, and skipped iterations cost an empty dispatch.
+//! registry), and the iteration loop. A solve records the iterations its state's bound
+//! allows (the Stepper's, from the counts it reads back); the pass that reduces an
+//! iteration's error decides in its last workgroup to finish whether the solve goes on and,
+//! once it has converged, zeroes the group count of the indirect dispatches that remain:
+//! no read-back per iteration and no pass of its own, and an iteration past convergence
+//! costs its passes' empty dispatches (see `Stepper::retire_slot` for how few are recorded).
 use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
@@ -21,7 +23,7 @@ crate::gpu_interface! {
     }
 }
 
-/// Mirror of `SolveState` in glsl/sph/pressure.glsl.
+/// Mirror of `SolveState` in glsl/sph/pressure.glsl (the pass before a solve starts it).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct SolveState {
@@ -31,10 +33,10 @@ pub struct SolveState {
     pub gz: u32,
     pub iter: u32,
     pub done: u32,
-    /// The loop pass's own VkDispatchIndirectCommand (1, 1, 1); `lz` is 0 once converged.
-    pub lx: u32,
-    pub ly: u32,
-    pub lz: u32,
+    /// Workgroups of the checking pass that have written their partial error.
+    pub arrived: u32,
+    pub pad0: u32,
+    pub pad1: u32,
     pub density_iters: u32,
     pub divergence_iters: u32,
     /// The solves' own error estimates at their last iteration.
@@ -42,10 +44,6 @@ pub struct SolveState {
     pub divergence_err: f32,
 }
 const _: () = assert!(std::mem::size_of::<SolveState>() == 48);
-
-/// Byte offset of the loop pass's dispatch (lx) in SolveState.
-const LOOP_ARGS_OFFSET: u64 = 20;
-const _: () = assert!(std::mem::offset_of!(SolveState, lx) == LOOP_ARGS_OFFSET as usize);
 
 /// Bytes per particle the pressure solvers add (aux, aux2), besides the neighbour list.
 pub const BYTES_PER_PARTICLE: u64 = 32;
@@ -58,12 +56,63 @@ pub fn list_bytes(len: u32) -> u64 {
     }
 }
 
-/// A pass: (name, shader, PASS, DIVERGENCE).
-pub type PassDecl = (&'static str, &'static str, &'static str, bool);
+/// A solver pass: its name (pipeline label; the timestamp scope of a pass run on its own),
+/// its shader, and the variant it is built as.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassDecl {
+    pub name: &'static str,
+    pub shader: &'static str,
+    /// The shader's `PASS` (one of [`PASS_NAMES`]).
+    pub pass: &'static str,
+    /// DFSPH's divergence solve (its targets and iteration counts).
+    pub divergence: bool,
+    /// The pass before a solve's iterations: it starts the solve's state.
+    pub starts: bool,
+    /// The pass that reduces an iteration's error also ends the iteration.
+    pub check: bool,
+    /// DFSPH: the density solve's first passes, which read the predicted velocities.
+    pub predicted: bool,
+}
 
-pub const LOOP_DENSITY: PassDecl = ("loop/density", "sph/solve_loop.comp", "PASS_LOOP", false);
-pub const LOOP_DIVERGENCE: PassDecl = ("loop/divergence", "sph/solve_loop.comp", "PASS_LOOP", true);
-pub const EULER: PassDecl = ("euler", "sph/euler.comp", "PASS_EULER", false);
+impl PassDecl {
+    pub const fn new(name: &'static str, shader: &'static str, pass: &'static str) -> Self {
+        Self {
+            name,
+            shader,
+            pass,
+            divergence: false,
+            starts: false,
+            check: false,
+            predicted: false,
+        }
+    }
+    pub const fn divergence(self) -> Self {
+        Self {
+            divergence: true,
+            ..self
+        }
+    }
+    pub const fn starts(self) -> Self {
+        Self {
+            starts: true,
+            ..self
+        }
+    }
+    pub const fn check(self) -> Self {
+        Self {
+            check: true,
+            ..self
+        }
+    }
+    pub const fn predicted(self) -> Self {
+        Self {
+            predicted: true,
+            ..self
+        }
+    }
+}
+
+pub const EULER: PassDecl = PassDecl::new("euler", "sph/euler.comp", "PASS_EULER");
 
 /// A solver's constructor (`base`: the neighbour search's and the EOS's defines).
 type Make = fn(&Context, &[(&str, String)]) -> Result<Box<dyn PressureSolver>>;
@@ -102,6 +151,11 @@ pub fn build(
 pub trait PressureSolver {
     fn kind(&self) -> Solver;
 
+    /// Dispatches one recorded iteration of its solves takes (0: no iterative solve).
+    fn iteration_dispatches(&self) -> u32 {
+        0
+    }
+
     /// Whether its states need [`PressureBuffers`].
     fn buffers(&self) -> bool {
         true
@@ -135,7 +189,7 @@ pub trait PressureSolver {
     fn destroy(&mut self, ctx: &Context);
 }
 
-const PASS_NAMES: [&str; 15] = [
+const PASS_NAMES: [&str; 14] = [
     "PASS_PREDICT",
     "PASS_PRESSURE",
     "PASS_ACCEL",
@@ -148,13 +202,9 @@ const PASS_NAMES: [&str; 15] = [
     "PASS_APPLY",
     "PASS_VORTICITY",
     "PASS_CONFINE",
-    "PASS_LOOP",
     "PASS_EULER",
     "PASS_FORCES",
 ];
-
-/// Local size of the loop pass (one workgroup).
-const LOOP_WG: u32 = 256;
 
 /// The defines of one pass, on top of the neighbour search's and the EOS's.
 pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
@@ -163,8 +213,15 @@ pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
         .enumerate()
         .map(|(k, n)| (n.to_string(), (k + 1).to_string()))
         .collect();
-    v.push(("PASS".into(), d.2.into()));
-    v.push(("DIVERGENCE".into(), (d.3 as u32).to_string()));
+    v.push(("PASS".into(), d.pass.into()));
+    for (name, on) in [
+        ("DIVERGENCE", d.divergence),
+        ("START_SOLVE", d.starts),
+        ("CHECK", d.check),
+        ("PREDICTED", d.predicted),
+    ] {
+        v.push((name.into(), (on as u32).to_string()));
+    }
     v.push(("PARTICLE_WG".into(), format!("{LOCAL_SIZE}u")));
     v.extend(solver_defines());
     v
@@ -201,13 +258,9 @@ impl Pipelines {
             let own = pass_defines(d);
             let mut defines: Vec<(&str, String)> = base.to_vec();
             defines.extend(crate::gpu::pipeline::as_refs(&own));
-            let local = if d.2 == "PASS_LOOP" {
-                LOOP_WG
-            } else {
-                LOCAL_SIZE
-            };
-            let label = format!("{}/{}", solver.as_str(), d.0);
-            let p = ComputePipeline::new(ctx, &ComputeDesc::plain(&label, d.1, &defines, local))?;
+            let label = format!("{}/{}", solver.as_str(), d.name);
+            let desc = ComputeDesc::plain(&label, d.shader, &defines, LOCAL_SIZE);
+            let p = ComputePipeline::new(ctx, &desc)?;
             out.list.push(p);
         }
         Ok(out.take())
@@ -215,7 +268,7 @@ impl Pipelines {
 
     /// Pass `k` of the table: its name (the timestamp scope) and pipeline.
     fn pass(&self, k: usize) -> (&'static str, &ComputePipeline<PressureIo>) {
-        (self.table[k].0, &self.list[k])
+        (self.table[k].name, &self.list[k])
     }
 
     /// Pass `k` over every particle, then its writes -> the next pass.
@@ -248,8 +301,10 @@ impl Pipelines {
         r
     }
 
-    /// An iterative solve in the scope `scope`: the `body` passes per iteration (the one
-    /// that reduces the error among them), then the loop pass `check`, `max_iter` times;
+    /// An iterative solve in the scope `scope`, its state started by the pass before it:
+    /// `checked` are an iteration's passes up to the one that checks (last), `rest` the
+    /// ones after it. Recorded as `checked`, then (`rest`, `checked`) for each further
+    /// iteration, then `rest` once, directly: the iteration that stops still finishes.
     /// `divergence`: the divergence solve (its own iteration bound).
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
@@ -259,32 +314,23 @@ impl Pipelines {
         scopes: &mut dyn Scopes,
         st: &SphState,
         scope: &str,
-        (body, check): (&[usize], usize),
+        (checked, rest): (&[usize], &[usize]),
         divergence: bool,
     ) -> Result<()> {
         let b = st.pressure_bufs()?;
         let solve = st.pressure()?.solve();
         let push = st.neighbor_push();
-        let groups = (st.n as u64).div_ceil(LOCAL_SIZE as u64).max(1);
-        let gx = groups.min(crate::gpu::pipeline::MAX_GROUPS_X as u64) as u32;
-        let gy = groups.div_ceil(gx as u64) as u32;
-        let c = st.fluid.convergence();
-        let (min_iter, max_iter) = (c.min_iterations, c.max_iterations);
-        // The iterations recorded: the state's bound (set from earlier steps' counts by
-        // the Stepper), else max_iter.
-        let recorded = match st.iteration_bound[divergence as usize] {
-            0 => max_iter,
-            b => b.clamp(min_iter.max(1), max_iter),
-        };
         scopes.begin(ctx, cmd, scope);
-        ctx.update(cmd, solve, 0, &[gx, gy, 1, 0, 0, 1, 1, 1]);
-        let check = self.pass(check).1;
-        let body: Vec<_> = body.iter().map(|k| self.pass(*k).1).collect();
-        for _ in 0..recorded {
-            for p in &body {
+        let checked: Vec<_> = checked.iter().map(|k| self.pass(*k).1).collect();
+        let rest: Vec<_> = rest.iter().map(|k| self.pass(*k).1).collect();
+        for k in 0..st.recorded_iterations(divergence) {
+            let passes = if k == 0 { &rest[..0] } else { &rest[..] };
+            for p in passes.iter().chain(&checked) {
                 p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
             }
-            check.dispatch_indirect(ctx, cmd, &b, &push, solve, LOOP_ARGS_OFFSET);
+        }
+        for p in &rest {
+            p.dispatch(ctx, cmd, &b, &push, st.n as u64);
         }
         scopes.end(ctx, cmd);
         Ok(())
@@ -333,6 +379,8 @@ impl PressureBuffers {
             )?,
         );
         ctx.one_shot(|cmd| ctx.fill(cmd, &overflow, 0))?;
+        // Every solve writes its iterations and error at each iteration; a solver without
+        // a divergence solve reports 0 for it.
         let solve = ctx.create_buffer(
             "pressure solve state",
             std::mem::size_of::<SolveState>() as u64,
@@ -342,11 +390,13 @@ impl PressureBuffers {
                 | vk::BufferUsageFlags::TRANSFER_SRC,
             crate::gpu::MemoryLocation::GpuOnly,
         )?;
+        let solve = Guard::new(ctx, solve);
+        ctx.one_shot(|cmd| ctx.fill(cmd, &solve, 0))?;
         Ok(Self {
             aux: aux.take(),
             aux2: aux2.take(),
             partials: partials.take(),
-            solve,
+            solve: solve.take(),
             nb_list: nb_list.take(),
             overflow: overflow.take(),
         })
@@ -368,11 +418,6 @@ impl PressureBuffers {
         &self.aux2
     }
 
-    /// Zero the step's solve statistics (a step that solves nothing reports 0).
-    pub fn record_reset(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        ctx.update(cmd, &self.solve, 0, &[SolveState::default()]);
-    }
-
     pub fn destroy(&mut self, ctx: &Context) {
         for b in [
             &mut self.aux,
@@ -388,6 +433,16 @@ impl PressureBuffers {
 }
 
 impl SphState {
+    /// Iterations a solve records this step: the state's bound (set from earlier steps'
+    /// counts by the Stepper), else max_iter; at least min_iter.
+    pub fn recorded_iterations(&self, divergence: bool) -> u32 {
+        let c = self.fluid.convergence();
+        match self.iteration_bound[divergence as usize] {
+            0 => c.max_iterations,
+            b => b.clamp(c.min_iterations.max(1), c.max_iterations),
+        }
+    }
+
     /// See [`PressureBuffers::list_overflows`]; 0 for wcsph.
     pub fn list_overflows(&self) -> u64 {
         self.pressure.as_ref().map_or(0, |p| p.list_overflows())

@@ -117,6 +117,12 @@ pub struct SphState {
     /// Iterations the next steps record per solve (density, divergence); 0: max_iter.
     /// The Stepper lowers it from the counts it reads back (see `Stepper::retire_slot`).
     pub iteration_bound: [u32; 2],
+    /// What the last step recorded.
+    pub commands: super::commands::StepCommands,
+    /// The parameters and colliders last uploaded (their bytes), and the recording
+    /// (`Context::recording`) they were uploaded in: a step that would upload the same
+    /// in the same recording uploads nothing.
+    uploaded: Option<(u64, Vec<u8>)>,
     /// `fluid`'s rest-lattice sums, once (recomputed by `gpu_params` if `fluid` changed).
     lattice: LatticeTerms,
 }
@@ -372,6 +378,8 @@ impl SphSolver {
             clock: clock.take(),
             pressure: pressure.take(),
             iteration_bound: [0; 2],
+            commands: Default::default(),
+            uploaded: None,
             lattice: LatticeTerms::of(f),
         })
     }
@@ -381,8 +389,17 @@ impl SphSolver {
         let p = st.gpu_params();
         ctx.update(cmd, &st.params, 0, &[p]);
         ctx.update(cmd, &st.colliders, 0, &st.collider_list);
-        if let Some(b) = &st.pressure {
-            b.record_reset(ctx, cmd);
+    }
+
+    /// [`record_params`](Self::record_params) unless this recording has uploaded the same
+    /// already: the steps of a frame share their parameters (dt is the frame's estimate).
+    fn record_changed_params(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &mut SphState) {
+        let mut bytes = bytemuck::bytes_of(&st.gpu_params()).to_vec();
+        bytes.extend_from_slice(bytemuck::cast_slice(&st.collider_list));
+        let now = (ctx.recording(cmd), bytes);
+        if st.uploaded.as_ref() != Some(&now) {
+            self.record_params(ctx, cmd, st);
+            st.uploaded = Some(now);
         }
     }
 
@@ -492,17 +509,35 @@ impl SphSolver {
         if p.buffers() {
             st.pressure()?; // a state made for another solver: a clear error, nothing recorded
         }
+        let start = ctx.recorded(cmd);
         scopes.begin(ctx, cmd, super::SCOPE.name());
-        self.record_params(ctx, cmd, st);
+        self.record_changed_params(ctx, cmd, st);
         scopes.begin(ctx, cmd, super::cfl::CflPass::NAME);
         self.cfl.record(ctx, cmd, st);
         scopes.end(ctx, cmd);
         Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
+        let forces = ctx.recorded(cmd);
         p.record_forces(self, ctx, cmd, scopes, st)?;
+        let hooked = ctx.recorded(cmd);
         Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
+        let solve = ctx.recorded(cmd);
         p.record_solve(self, ctx, cmd, scopes, st)?;
+        let end = ctx.recorded(cmd);
         scopes.end(ctx, cmd);
+        let iterations = match p.iteration_dispatches() {
+            0 => [0; 2],
+            _ => [false, true].map(|d| match d && solver != Solver::Dfsph {
+                true => 0,
+                false => st.recorded_iterations(d),
+            }),
+        };
+        st.commands = super::commands::StepCommands {
+            step: end - start,
+            solver: (hooked - forces) + (end - solve),
+            iterations,
+            per_iteration: p.iteration_dispatches(),
+        };
         Ok(())
     }
 

@@ -1,6 +1,7 @@
 //! Playing an SPH scene: steps per frame (fixed, or as many as the GPU's own CFL-limited
 //! steps take to cover the frame: sph/cfl.rs), the state's health every frame, and
 //! end-of-run statistics.
+use super::commands::{CommandStats, StepCommands};
 use super::errors::{DensityErrorStats, StepError, StepErrors};
 use super::health::Health;
 use super::setup::Domain;
@@ -21,6 +22,12 @@ pub struct Stepper {
     /// Per slot: the steps recorded into it and the
     /// iterations each solve recorded (density, divergence; 0: max_iter).
     pending: Vec<(u32, [u32; 2])>,
+    /// Per slot: what each of its steps recorded.
+    recorded: Vec<Vec<StepCommands>>,
+    /// Dispatches, barriers and empty dispatches per step over the finished frames.
+    pub commands: CommandStats,
+    /// The last frame with a step that used every iteration recorded.
+    pub last_bounded_frame: Option<u64>,
     /// Iterations the next frame records per solve (see `retire_slot`).
     bound: [u32; 2],
     /// Per slot: the time its steps were expected to cover beyond the frame (with cfl).
@@ -41,6 +48,9 @@ pub struct Stepper {
     iterations: (u32, u32),
 }
 
+/// Iterations a solve records beyond the most any step of the last finished frame used.
+pub const SPARE_ITERATIONS: u32 = 2;
+
 impl Stepper {
     pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
         let f = &st.fluid;
@@ -54,6 +64,9 @@ impl Stepper {
             health: Health::new(ctx, slots)?,
             errors: errors.take(),
             pending: vec![(0, [0; 2]); slots],
+            recorded: vec![Vec::new(); slots],
+            commands: CommandStats::default(),
+            last_bounded_frame: None,
             bound: [0; 2],
             extra: vec![0.0; slots],
             dt_seen: 0.0,
@@ -118,8 +131,10 @@ impl Stepper {
         if st.fluid.cfl.is_some() {
             self.extra[slot] = steps as f64 * dt as f64 - self.frame_time;
         }
+        self.recorded[slot].clear();
         for k in 0..steps {
             solver.record_hooked_step(ctx, cmd, prof, st, hooks)?;
+            self.recorded[slot].push(st.commands);
             prof.begin(ctx, cmd, StepErrors::NAME);
             self.errors.record(ctx, cmd, st, slot, k)?;
             prof.end(ctx, cmd);
@@ -131,6 +146,13 @@ impl Stepper {
         self.health.record(ctx, cmd, st, slot);
         prof.end(ctx, cmd);
         Ok(())
+    }
+
+    /// Record at most `bound` iterations per solve (density, divergence) from the next
+    /// frame on, as if the last frame had set it (tests force a short bound to see it
+    /// caught).
+    pub fn force_bound(&mut self, bound: [u32; 2]) {
+        self.bound = bound;
     }
 
     /// The run's density error statistics, with the state's neighbour list overflows
@@ -146,13 +168,13 @@ impl Stepper {
     /// iterations the next frame records.
     ///
     /// Iterations past convergence cost empty indirect dispatches, which are not free
-    /// (on lavapipe about 0.2 ms each, against 5 to 20 ms for a real one; on an H200
-    /// about 0.01 against 0.15 at 1M). So a frame records twice the most iterations the
-    /// last finished frame took, plus 4, up to max_iter (with half again, the 1M dam
-    /// break's DFSPH hit the bound in 7% of its steps and flung a particle at 1.3 s; with
-    /// a quarter, the 64K one's in a quarter of its steps); a step that used every
-    /// iteration recorded (it may have stopped above its target) is counted in
-    /// `bounded_steps`, and the next frame records twice as many.
+    /// (on lavapipe about 0.2 ms each, against 5 to 20 ms for a real one; on an H100
+    /// about 9 us each with its barrier, which made up half of a 64K DFSPH step when a
+    /// frame recorded twice the most iterations used plus 4). So a frame records the most
+    /// iterations any step of the last finished frame took plus [`SPARE_ITERATIONS`], up
+    /// to max_iter; a step that used every iteration recorded (it may have stopped above
+    /// its target) is counted in `bounded_steps`, and the next frame records twice as
+    /// many.
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
         self.health.check(slot, frame, self.rest_density)?;
         let (steps, recorded) = self.pending[slot];
@@ -161,14 +183,19 @@ impl Stepper {
         let cap = |b: u32| if b == 0 { max_iter } else { b.min(max_iter) };
         let mut most = [0u32; 2];
         let mut hit = false;
+        let recorded_steps = std::mem::take(&mut self.recorded[slot]);
         for (k, e) in self.errors.read(slot, steps).into_iter().enumerate() {
             t += e.dt as f64;
             let used = [e.iterations, e.divergence_iterations];
+            if let Some(c) = recorded_steps.get(k) {
+                self.commands.add(c, used);
+            }
             for d in 0..2 {
                 most[d] = most[d].max(used[d]);
                 if used[d] > 0 && used[d] >= cap(recorded[d]) && cap(recorded[d]) < max_iter {
                     hit = true;
                     self.density_error.bounded_steps += 1;
+                    self.last_bounded_frame = Some(frame);
                 }
             }
             self.density_error.add(&e);
@@ -183,7 +210,7 @@ impl Stepper {
         self.retired_frames += 1;
         self.bound = match hit {
             true => recorded.map(|r| (2 * cap(r)).min(max_iter)),
-            false => most.map(|m| (2 * m + 4).min(max_iter)),
+            false => most.map(|m| (m + SPARE_ITERATIONS).min(max_iter)),
         };
         Ok(())
     }
