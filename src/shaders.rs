@@ -1,7 +1,7 @@
 //! Every shader with the defines the code compiles it with: its interface's bindings and
 //! each set of feature defines a pass uses. One registration line per pass; the shader
 //! test compiles every entry and fails on a GLSL file registered nowhere.
-use crate::config::{DensityFn, ListKind, Material, Neighbors, SortAlgo};
+use crate::config::{Counters, DensityFn, Lanes, ListKind, Material, Neighbors, SortAlgo};
 use crate::gpu::Interface;
 use crate::render::metaball::MetaballSettings;
 
@@ -203,7 +203,16 @@ fn metaballs(v: &mut Vec<Variant>) {
                     for march in crate::kinds::MarchKind::all() {
                         let mut d = d.clone();
                         d.extend(MetaballSettings::march_defines(*march));
-                        v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                        // Counters and lanes per list on the default look only: they
+                        // change nothing the look's code reads.
+                        let plain = material == Material::Phong
+                            && *density == DensityFn::Wyvill
+                            && *march == crate::kinds::MarchKind::Fixed;
+                        for (counters, lanes) in lane_variants(list, plain) {
+                            let mut d = d.clone();
+                            d.extend(MetaballSettings::lane_defines(counters, lanes));
+                            v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                        }
                     }
                     if list == ListKind::Tiles {
                         continue;
@@ -234,6 +243,22 @@ fn metaballs(v: &mut Vec<Variant>) {
         d.push(kv("PASS", pass));
         v.push(with::<MetaballIo>("render/metaball/tile_pairs.comp", &d));
         v.push(with::<MetaballIo>("render/metaball/pixel_lists.comp", &d));
+    }
+}
+
+/// The march's counter modes and lane layouts to compile: every pair that can run where
+/// `all`, else the defaults' (tiles march blocks only).
+fn lane_variants(list: ListKind, all: bool) -> Vec<(Counters, Lanes)> {
+    let lanes: &[Lanes] = match list {
+        ListKind::Tiles => &[Lanes::Blocks],
+        _ => Lanes::all(),
+    };
+    match all {
+        true => Counters::all()
+            .iter()
+            .flat_map(|c| lanes.iter().map(move |l| (*c, *l)))
+            .collect(),
+        false => vec![(Counters::Workgroup, Lanes::Blocks)],
     }
 }
 

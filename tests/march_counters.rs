@@ -2,7 +2,7 @@
 //! CPU reference marcher and against what each list holds; `--march lipschitz` against the
 //! fixed march: the same hits and pictures from fewer samples.
 mod common;
-use fluidform::config::{ListKind, MarchKind, Material, Switches};
+use fluidform::config::{Counters, Lanes, ListKind, MarchKind, Material, Switches};
 use fluidform::render::metaball::reference::{march_counted, ray_box, MarchParams};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, FrameStats, MetaballSettings};
 use glam::Vec3;
@@ -190,4 +190,71 @@ fn march_is_refused_with_the_other_surfaces() {
         err.contains("--march belongs to the metaball surface"),
         "{err}"
     );
+}
+
+/// Every counter mode and lane layout against the defaults (counters summed per workgroup,
+/// 8 x 8 blocks), per list for Phong, and for glass on the S-buffer (secondary rays read
+/// other pixels' lists; off-screen samples), on a
+/// frame whose sides are no multiple of 8 (blocks past its edge): the same pixels and hits
+/// bit for bit, and the same counts (off: none, the longest list included).
+#[test]
+fn counter_modes_and_lane_layouts_give_the_same_frames_and_counts() {
+    let ctx = common::ctx();
+    for list in [
+        ListKind::None,
+        ListKind::Abuffer,
+        ListKind::Sbuffer,
+        ListKind::Tiles,
+    ] {
+        for material in [Material::Phong, Material::Glass] {
+            if material == Material::Glass && list != ListKind::Sbuffer {
+                continue;
+            }
+            let mut base = settings(list);
+            (base.material, base.width, base.height) = (material, 90, 70);
+            base.build = match list {
+                ListKind::Tiles => fluidform::config::BuildKind::Compute,
+                _ => base.build,
+            };
+            let (st0, px0, dbg0) = render(&ctx, &base);
+            assert!(st0.march.rays > 0 && (list == ListKind::None || st0.longest > 0));
+            for &counters in Counters::all() {
+                for &lanes in Lanes::all() {
+                    if list == ListKind::Tiles && lanes == Lanes::Rows {
+                        continue;
+                    }
+                    let s = MetaballSettings {
+                        counters,
+                        lanes,
+                        ..base.clone()
+                    };
+                    let what = format!("{list:?} {material:?} {counters:?} {lanes:?}");
+                    let (st, px, dbg) = render(&ctx, &s);
+                    assert!(px == px0, "{what}: pixels differ");
+                    assert!(dbg == dbg0, "{what}: hits differ");
+                    match counters {
+                        Counters::Off => {
+                            assert_eq!(st.march, Default::default(), "{what}");
+                            assert_eq!((st.longest, st.offscreen_samples), (0, 0), "{what}");
+                        }
+                        _ => {
+                            assert_eq!(st.march, st0.march, "{what}: counts differ");
+                            assert_eq!(st.longest, st0.longest, "{what}");
+                            assert_eq!(st.offscreen_samples, st0.offscreen_samples, "{what}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let bad = MetaballSettings {
+        lanes: Lanes::Rows,
+        build: fluidform::config::BuildKind::Compute,
+        ..settings(ListKind::Tiles)
+    };
+    let e = FluidRenderer::new(&ctx, bad)
+        .err()
+        .expect("tiles with rows refused");
+    assert!(e.to_string().contains("--lanes rows"), "{e}");
+    common::finish(&ctx);
 }

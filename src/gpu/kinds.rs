@@ -182,3 +182,24 @@ switch_enum!(
         Lipschitz
     }
 );
+
+switch_enum!(
+    /// How the march counts its rays, samples, terms and candidates (the frame's
+    /// statistics): summed per workgroup and added once per workgroup, added per subgroup
+    /// with atomics (one cache line met by every subgroup of the frame), or not at all (to
+    /// measure what counting costs; the frame then reports no counts).
+    Counters {
+        Workgroup,
+        Subgroup,
+        Off
+    }
+);
+
+switch_enum!(
+    /// How the march lays pixels on a workgroup's 64 invocations: 8 x 8 blocks (neighbouring
+    /// rays diverge together at silhouettes and read neighbouring lists) or rows of 64.
+    Lanes {
+        Blocks,
+        Rows
+    }
+);

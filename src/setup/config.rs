@@ -189,6 +189,13 @@ pub struct MetaballArgs {
     /// lipschitz: samples the field's Lipschitz bound proves outside are skipped (same hits)
     #[arg(long, value_parser = choice::<MarchKind>())]
     pub march: Option<MarchKind>,
+    /// How the march counts rays, samples and terms: summed per workgroup (default), per
+    /// subgroup with atomics, or off (no counts: to measure what counting costs)
+    #[arg(long, value_parser = choice::<Counters>())]
+    pub counters: Option<Counters>,
+    /// How the march lays pixels on invocations: 8 x 8 blocks (default) or rows of 64
+    #[arg(long, value_parser = choice::<Lanes>())]
+    pub lanes: Option<Lanes>,
     /// How the S-buffer's per-pixel lists are built: rasterising the billboards (the
     /// thesis's, default) or compute from the per-tile lists (already in depth order)
     #[arg(long, value_parser = choice::<BuildKind>())]

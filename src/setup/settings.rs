@@ -21,6 +21,11 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
         step: radius / 8.0,
         max_steps: 2048,
         march: sw.metaball.march.unwrap_or(MarchKind::Fixed),
+        counters: sw
+            .metaball
+            .counters
+            .unwrap_or(crate::kinds::Counters::Workgroup),
+        lanes: sw.metaball.lanes.unwrap_or(crate::kinds::Lanes::Blocks),
         build: sw.metaball.build.unwrap_or(BuildKind::Raster),
         tile: sw.metaball.tile.unwrap_or(16),
         offscreen_end: sw
@@ -58,6 +63,8 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
             ("--offscreen", m.offscreen.is_some()),
             ("--list-sort", m.list_sort.is_some()),
             ("--march", m.march.is_some()),
+            ("--counters", m.counters.is_some()),
+            ("--lanes", m.lanes.is_some()),
             ("--build", m.build.is_some()),
             ("--tile", m.tile.is_some()),
         ];

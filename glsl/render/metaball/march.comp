@@ -14,7 +14,8 @@
 const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
 uint longest = 0u;
-// Per-ray counters (summed over the subgroup, then added to stats as 64-bit totals).
+// Per-ray counters (summed per subgroup and workgroup, then added to stats as 64-bit
+// totals: add_counters).
 uint n_rays = 0u, n_steps = 0u, n_evals = 0u, n_candidates = 0u;
 // llvmpipe stops a batch's loops after about 65535 iterations in total (hang protection);
 // every later loop then exits at once. Each loop below checks on exit that it ended by
@@ -336,39 +337,100 @@ vec3 normal_at(vec3 x, uint pixel) {
 
 #include "render/shading.glsl"
 
-// v added to the 64-bit (lo, hi) total at stats member M, exactly: the subgroup sums v's
-// low and high 16 bits apart (each sum fits 32 bits) and one lane adds them with carries.
-#define ADD64(M, V) { \
-    uint v_ = (V); \
-    uint lo_ = subgroupAdd(v_ & 0xFFFFu), hi_ = subgroupAdd(v_ >> 16); \
-    if (subgroupElect()) { \
-        uint a_ = lo_ + (hi_ << 16), c_ = (hi_ >> 16) + (a_ < lo_ ? 1u : 0u); \
-        uint o_ = atomicAdd(stats.M.x, a_); \
-        c_ += o_ + a_ < o_ ? 1u : 0u; \
-        if (c_ > 0u) atomicAdd(stats.M.y, c_); } }
+// The frame's counters (COUNTERS): rays, samples, terms and candidates, with the longest
+// list and the off-screen samples. WORKGROUP: each subgroup's sums meet in shared memory
+// and one invocation per workgroup adds them to stats; SUBGROUP: each subgroup adds its
+// own (and each pixel its longest list), every one on stats' one cache line; OFF: nothing
+// counted (the increments above are then dead code), to measure what counting costs.
+// 64-bit totals stay exact: the low and high 16 bits of each count are summed apart (each
+// sum fits 32 bits) and ADD64 adds them to the (lo, hi) total with its carries.
+#define ADD64(M, LO, HI) { \
+    uint lo_ = (LO), hi_ = (HI); \
+    uint a_ = lo_ + (hi_ << 16), c_ = (hi_ >> 16) + (a_ < lo_ ? 1u : 0u); \
+    uint o_ = atomicAdd(stats.M.x, a_); \
+    c_ += o_ + a_ < o_ ? 1u : 0u; \
+    if (c_ > 0u) atomicAdd(stats.M.y, c_); }
 
+#if COUNTERS == COUNTERS_WORKGROUP
+// rays, then (lo, hi) of steps, evals, candidates, then the longest list and off-screen
+// samples.
+shared uint c_sum[9];
 void add_counters() {
+    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
+    if (gl_LocalInvocationIndex == 0u) {
+        [[unroll]] for (uint k = 0u; k < 9u; ++k) c_sum[k] = 0u;
+    }
+    barrier();
+    uint rays = subgroupAdd(n_rays), lg = subgroupMax(longest);
+    uint off = subgroupAdd(offscreen_samples);
+    uint lo[3], hi[3];
+    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
+        hi[k] = subgroupAdd(counts[k] >> 16);
+    }
+    if (subgroupElect()) {
+        atomicAdd(c_sum[0], rays);
+        [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+            atomicAdd(c_sum[1u + 2u * k], lo[k]);
+            atomicAdd(c_sum[2u + 2u * k], hi[k]);
+        }
+        atomicMax(c_sum[7], lg);
+        atomicAdd(c_sum[8], off);
+    }
+    barrier();
+    if (gl_LocalInvocationIndex != 0u) return;
+    if (c_sum[0] > 0u) atomicAdd(stats.rays, c_sum[0]);
+    ADD64(steps, c_sum[1], c_sum[2])
+    ADD64(evals, c_sum[3], c_sum[4])
+    ADD64(candidates, c_sum[5], c_sum[6])
+    if (c_sum[7] > 0u) atomicMax(stats.longest, c_sum[7]);
+    if (c_sum[8] > 0u) atomicAdd(stats.offscreen_samples, c_sum[8]);
+}
+#elif COUNTERS == COUNTERS_SUBGROUP
+void add_counters() {
+    if (longest > 0u) atomicMax(stats.longest, longest);
+    if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);
     uint rays = subgroupAdd(n_rays);
     if (subgroupElect()) atomicAdd(stats.rays, rays);
-    ADD64(steps, n_steps)
-    ADD64(evals, n_evals)
-    ADD64(candidates, n_candidates)
+    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
+    uint lo[3], hi[3];
+    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
+        hi[k] = subgroupAdd(counts[k] >> 16);
+    }
+    if (subgroupElect()) {
+        ADD64(steps, lo[0], hi[0])
+        ADD64(evals, lo[1], hi[1])
+        ADD64(candidates, lo[2], hi[2])
+    }
 }
+#elif COUNTERS == COUNTERS_OFF
+void add_counters() {}
+#else
+#error "COUNTERS names no counter mode"
+#endif
 
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; vec2 cone; };
 
 const int STACK = 8;
 
-void main() {
-#if LIST == LIST_TILES
-    // One workgroup per 8 x 8 block; pixels past the frame join its barriers, then leave.
+// One pixel's colour (and depth, debug output); invocations past the frame return at
+// once, except that tiles' join the barriers of their block's staging first.
+void march_pixel() {
+#if LIST == LIST_TILES || LANES == LANES_BLOCKS
+    // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
     uvec2 pix = block_pixel();
     bool valid = pix.x < P.width && pix.y < P.height;
     uint id = valid ? pixel_index(pix) : 0u;
-#else
+#elif LANES == LANES_ROWS
     uint id = global_id();
-    if (id >= P.width * P.height) return;
+    bool valid = id < P.width * P.height;
     uvec2 pix = uvec2(id % P.width, id / P.width);
+#else
+#error "LANES names no lane layout"
+#endif
+#if LIST != LIST_TILES
+    if (!valid) return;
 #endif
     vec2 ndc = (vec2(pix) + 0.5) / vec2(P.width, P.height) * 2.0 - 1.0;
     vec4 a = P.inv_view_proj * vec4(ndc, 0.0, 1.0);
@@ -472,8 +534,11 @@ void main() {
         scene_depth[id] = z;
     }
     if (P.debug != 0u) debug_out[id] = dbg;
-    if (longest > 0u) atomicMax(stats.longest, longest);
-    if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);
+    // Not a counter: a cut-short pixel makes a wrong frame, reported in every mode.
     if (cut) atomicAdd(stats.budget_pixels, 1u);
-    add_counters();
+}
+
+void main() {
+    march_pixel();
+    add_counters();  // every invocation: WORKGROUP's barriers
 }

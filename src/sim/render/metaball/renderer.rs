@@ -15,7 +15,7 @@ use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
     Scopes,
 };
-use crate::kinds::{BuildKind, ListKind};
+use crate::kinds::{BuildKind, Lanes, ListKind};
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::render::surface::{Frame, Surface};
@@ -364,10 +364,10 @@ impl FluidRenderer {
             scopes.end(ctx, cmd);
         }
         scopes.begin(ctx, cmd, "march");
-        // Tiles: one workgroup per 8 x 8 block (march.comp stages the block's tile).
-        let march_groups = match s.list {
-            ListKind::Tiles => blocks(s),
-            _ => groups,
+        // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
+        let march_groups = match (s.list, s.lanes) {
+            (ListKind::Tiles, _) | (_, Lanes::Blocks) => blocks(s),
+            (_, Lanes::Rows) => groups,
         };
         march.dispatch_groups(ctx, cmd, &bufs, &(), march_groups);
         scopes.end(ctx, cmd);

@@ -2,7 +2,9 @@
 //! defaults, and their GPU mirror.
 use super::density::Density;
 use crate::error::{Error, Result};
-use crate::kinds::{BuildKind, DensityFn, ListKind, MarchKind, Material, SurfaceKind};
+use crate::kinds::{
+    BuildKind, Counters, DensityFn, Lanes, ListKind, MarchKind, Material, SurfaceKind,
+};
 use crate::render::surface::SurfaceFluid;
 use crate::render::Camera;
 use bytemuck::{Pod, Zeroable};
@@ -27,6 +29,12 @@ pub struct MetaballSettings {
     /// The primary rays' march: the fixed grid, or skipping what the Lipschitz bound proves.
     #[serde(default = "fixed")]
     pub march: MarchKind,
+    /// How the march counts rays, samples and terms (off: no counts, to measure their cost).
+    #[serde(default = "workgroup")]
+    pub counters: Counters,
+    /// How the march lays pixels on invocations.
+    #[serde(default = "blocks")]
+    pub lanes: Lanes,
     /// How the S-buffer's lists are built: rasterised billboards, or compute from the
     /// per-tile lists (each range then in depth order, no sort pass). Tiles: compute.
     #[serde(default = "raster")]
@@ -79,6 +87,14 @@ fn half() -> f32 {
 
 fn fixed() -> MarchKind {
     MarchKind::Fixed
+}
+
+fn workgroup() -> Counters {
+    Counters::Workgroup
+}
+
+fn blocks() -> Lanes {
+    Lanes::Blocks
 }
 
 fn raster() -> BuildKind {
@@ -211,6 +227,12 @@ impl MetaballSettings {
             }
             _ => {}
         }
+        if (self.list, self.lanes) == (ListKind::Tiles, Lanes::Rows) {
+            return Err(Error::Param(
+                "--list tiles marches 8 x 8 blocks (its tile is staged per block): not --lanes rows"
+                    .into(),
+            ));
+        }
         if self.depth > MAX_DEPTH {
             return Err(Error::Param(format!(
                 "--depth must be at most {MAX_DEPTH}, got {}",
@@ -236,6 +258,19 @@ impl MetaballSettings {
     pub fn shader_defines(&self) -> Vec<(String, String)> {
         let mut d = Self::defines_for(self.list, self.density, self.material, self.sorts_lists());
         d.extend(Self::march_defines(self.march));
+        d.extend(Self::lane_defines(self.counters, self.lanes));
+        d
+    }
+
+    /// The march.comp defines of its counters and lane layout (COUNTERS, LANES and their
+    /// named values).
+    pub fn lane_defines(counters: Counters, lanes: Lanes) -> Vec<(String, String)> {
+        let mut d = vec![
+            ("COUNTERS".to_string(), (counters as u32).to_string()),
+            ("LANES".to_string(), (lanes as u32).to_string()),
+        ];
+        d.extend(Counters::defines("COUNTERS"));
+        d.extend(Lanes::defines("LANES"));
         d
     }
 
