@@ -116,6 +116,18 @@ pub enum BenchWhat {
         #[command(flatten)]
         camera: CameraArgs,
     },
+    /// The march's own costs on the resting blob: counters (workgroup, subgroup, off) and
+    /// lanes (blocks, rows), each switched alone, per list (or --list)
+    March {
+        #[command(flatten)]
+        common: CommonArgs,
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        metaball: MetaballArgs,
+        #[command(flatten)]
+        camera: CameraArgs,
+    },
 }
 
 /// The switches of the SPH benchmarks.
@@ -248,6 +260,21 @@ impl BenchWhat {
                 camera,
             } => (
                 Bench::Render,
+                Switches {
+                    common,
+                    frame,
+                    metaball,
+                    camera,
+                    ..d()
+                },
+            ),
+            BenchWhat::March {
+                common,
+                frame,
+                metaball,
+                camera,
+            } => (
+                Bench::March,
                 Switches {
                     common,
                     frame,

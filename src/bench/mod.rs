@@ -6,6 +6,7 @@ pub mod control;
 pub mod emission;
 pub mod floor;
 pub mod interval;
+pub mod march;
 pub mod particles;
 pub mod picture;
 pub mod plot;
@@ -33,6 +34,7 @@ fluidform_gpu::switch_enum!(
         Stability,
         Solvers,
         Render,
+        March,
         Skin,
         Control,
         Emission,
@@ -201,6 +203,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         Bench::Render => {
             sw.reject_unused("bench render", &[Group::Metaball, Group::Camera])?;
             render::render(&ctx, opts)?
+        }
+        Bench::March => {
+            sw.reject_unused("bench march", &[Group::Metaball, Group::Camera])?;
+            march::march(&ctx, opts)?
         }
         Bench::Skin => {
             sw.reject_unused("bench skin", &[Group::Character])?;

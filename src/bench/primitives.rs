@@ -315,6 +315,7 @@ pub fn notes(what: super::Bench, rows: &[Row]) -> Vec<String> {
         Bench::Neighbors => neighbors_notes(rows),
         Bench::Sph => sph_notes(rows),
         Bench::Render => render_notes(rows),
+        Bench::March => super::march::notes(rows),
         Bench::Scan => scan_notes(rows),
         Bench::Stability | Bench::Skin | Bench::Control => Vec::new(),
     }

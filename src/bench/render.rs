@@ -14,6 +14,30 @@ use crate::sph::FluidParams;
 use serde_json::json;
 
 pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let other = opts
+        .switches
+        .metaball
+        .surface
+        .filter(|&k| k != SurfaceKind::Metaballs);
+    let mut rows = Vec::new();
+    for (list, sorted, build) in rows_of(&opts.switches)? {
+        let mut settings = crate::settings::metaball_settings(&opts.switches)?;
+        (settings.list, settings.sorted, settings.build) = (list, sorted, build);
+        let name = match other {
+            Some(k) => k.as_str(),
+            None => settings.list_name(),
+        };
+        rows.push((settings, name));
+    }
+    time_rows(ctx, opts, rows)
+}
+
+/// Time the blob with each (settings, row name) together under the protocol.
+pub fn time_rows(
+    ctx: &Context,
+    opts: &BenchOptions,
+    rows: Vec<(crate::render::metaball::MetaballSettings, String)>,
+) -> Result<Vec<Row>> {
     let sw = &opts.switches;
     let n = sw.common.particles.unwrap_or(2048) as usize;
     let spacing = FluidParams::default().spacing();
@@ -23,23 +47,15 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         ctx.storage_buffer("metaball centers", (n * 16) as u64)?,
     );
     ctx.upload(&mut centers, 0, &pts)?;
-    let lists = rows_of(sw)?;
     // The floor's rates, measured in this run (metaball rows only).
     let floor = match sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs) {
         None => Some(Floor::measure(ctx, opts)?),
         Some(_) => None,
     };
-    let other = sw.metaball.surface.filter(|&k| k != SurfaceKind::Metaballs);
     // Every row's renderer and buffers first, its lists sized (and redos counted).
     let mut sets = Vec::new();
-    for (list, sorted, build) in lists {
-        let mut settings = crate::settings::metaball_settings(sw)?;
-        (settings.list, settings.sorted, settings.build) = (list, sorted, build);
+    for (mut settings, name) in rows {
         settings.fluid = Some(blob_fluid(&pts, spacing));
-        let name = match other {
-            Some(k) => k.as_str(),
-            None => settings.list_name(),
-        };
         let cam = crate::run::common::camera_with_switches(
             blob_camera(n, spacing, settings.width as f32 / settings.height as f32),
             sw,
@@ -115,7 +131,7 @@ pub fn render(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
 
 /// The (list, sorted, build) rows: what --list, --list-sort and --build pick, or every
 /// list mode (both S-buffer orders by both builds, and tiles) when --list is unset.
-fn rows_of(sw: &crate::config::Switches) -> Result<Vec<(ListKind, bool, BuildKind)>> {
+pub fn rows_of(sw: &crate::config::Switches) -> Result<Vec<(ListKind, bool, BuildKind)>> {
     let s = crate::settings::metaball_settings(sw)?;
     if sw
         .metaball

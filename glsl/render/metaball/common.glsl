@@ -17,7 +17,11 @@ layout(std430, binding = MB_B_OFFSETS) buffer Offsets { uint offsets[]; };  // S
 layout(std430, binding = MB_B_LIST) buffer List { uint list[]; };  // S ranges
 layout(std430, binding = MB_B_HEADS) buffer Heads { uint heads[]; };  // A heads
 layout(std430, binding = MB_B_NODES) buffer Nodes { uvec2 nodes[]; };  // A (id, next)
-layout(std430, binding = MB_B_STATS) buffer Stats { RenderStats stats; };
+// After the stats, the march's counter slots (march.comp's add_counters): MARCH_SLOTS
+// of MARCH_SLOT_WORDS words, a workgroup adding to slot group % MARCH_SLOTS, so the
+// frame's counter atomics spread over as many cache lines; the host sums them.
+layout(std430, binding = MB_B_STATS) buffer Stats { RenderStats stats; uint march_slots[]; };
+const uint MARCH_SLOTS = 64u, MARCH_SLOT_WORDS = 32u;
 layout(std430, binding = MB_B_PIXELS) writeonly buffer Pixels { uint pixels[]; };  // RGBA8
 layout(std430, binding = MB_B_DEBUG) writeonly buffer Debug { vec4 debug_out[]; };  // t, normal
 layout(std430, binding = MB_B_SKY) readonly buffer Sky { uint sky[]; };  // RGBA8

@@ -36,7 +36,9 @@ uint stage_lo = 0u, stage_hi = 0u;
 vec4 ball(uint s) { return s >= stage_lo && s < stage_hi ? s_balls[s - stage_lo] : tile_balls[s]; }
 #endif
 
-// Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC. Several
+// Sum over the metaballs of pixel p (or ALL) of TERM(d), d = x - centre, into ACC; the
+// terms summed into n_evals, counted from the walk's bounds where it has them (a count per
+// term cost the S-buffer's march 7% on lavapipe, where it is vector arithmetic). Several
 // metaballs per loop iteration (the inner loops unroll away), ALL_UNROLL over every metaball:
 // llvmpipe's loop budget would otherwise cut short rays that take hundreds of samples over
 // lists of hundreds (or, for none, all) metaballs.
@@ -72,23 +74,25 @@ vec4 ball(uint s) { return s >= stage_lo && s < stage_hi ? s_balls[s - stage_lo]
         if (depths[list[m_]] < z_ - r_) lo_ = m_ + 1u; else hi_ = m_; } \
     CUT_UNLESS(!(lo_ < hi_)) \
     bool more_ = true; \
-    uint b_ = lo_; \
+    uint b_ = lo_, end_ = e_; \
     for (; more_ && b_ < e_; b_ += 8u) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             uint s_ = b_ + u_; \
             if (more_ && s_ < e_) { \
                 vec3 c_ = centers[list[s_]].xyz; \
-                if (view_depth(c_) > z_ + r_) more_ = false; \
-                else { vec3 d = x - c_; ACC += TERM; n_evals++; } } } } \
+                if (view_depth(c_) > z_ + r_) { more_ = false; end_ = s_; } \
+                else { vec3 d = x - c_; ACC += TERM; } } } } \
+    n_evals += end_ - lo_; \
     CUT_UNLESS(!(more_ && b_ < e_)) }
 #elif LIST == LIST_SBUFFER
 #define SUM_LIST(x, p, ACC, TERM) { \
     uint e_ = min(offsets[p], P.list_capacity); \
     uint b_ = range_start(p); \
+    n_evals += e_ - min(b_, e_); \
     for (; b_ < e_; b_ += 8u) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             uint s_ = b_ + u_; \
-            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; n_evals++; } } } \
+            if (s_ < e_) { vec3 d = x - centers[list[s_]].xyz; ACC += TERM; } } } \
     CUT_UNLESS(!(b_ < e_)) }
 #elif LIST == LIST_TILES
 // The tile of pixel p holds every metaball whose billboard covers one of its pixels, sorted
@@ -102,14 +106,15 @@ vec4 ball(uint s) { return s >= stage_lo && s < stage_hi ? s_balls[s - stage_lo]
         if (ball(m_).w < z_ - r_) lo_ = m_ + 1u; else hi_ = m_; } \
     CUT_UNLESS(!(lo_ < hi_)) \
     bool more_ = true; \
-    uint b_ = lo_; \
+    uint b_ = lo_, end_ = t_.y; \
     for (; more_ && b_ < t_.y; b_ += 8u) { \
         [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) { \
             uint s_ = b_ + u_; \
             if (more_ && s_ < t_.y) { \
                 vec4 c_ = ball(s_); \
-                if (c_.w > z_ + r_) more_ = false; \
-                else { vec3 d = x - c_.xyz; ACC += TERM; n_evals++; } } } } \
+                if (c_.w > z_ + r_) { more_ = false; end_ = s_; } \
+                else { vec3 d = x - c_.xyz; ACC += TERM; } } } } \
+    n_evals += end_ - lo_; \
     CUT_UNLESS(!(more_ && b_ < t_.y)) }
 #elif LIST == LIST_NONE
 #define SUM_LIST(x, p, ACC, TERM)
@@ -178,9 +183,9 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
         len++;
 #elif LIST == LIST_SBUFFER
     uint s = range_start(p), e = min(offsets[p], P.list_capacity);
+    len = e - min(s, e);
     for (; s < e; ++s) {
         vec3 oc = o - centers[list[s]].xyz;
-        len++;
 #elif LIST == LIST_NONE
     for (uint j = 0u; j < 0u; ++j) {
         vec3 oc = o;
@@ -338,71 +343,81 @@ vec3 normal_at(vec3 x, uint pixel) {
 #include "render/shading.glsl"
 
 // The frame's counters (COUNTERS): rays, samples, terms and candidates, with the longest
-// list and the off-screen samples. WORKGROUP: each subgroup's sums meet in shared memory
-// and one invocation per workgroup adds them to stats; SUBGROUP: each subgroup adds its
-// own (and each pixel its longest list), every one on stats' one cache line; OFF: nothing
-// counted (the increments above are then dead code), to measure what counting costs.
-// 64-bit totals stay exact: the low and high 16 bits of each count are summed apart (each
-// sum fits 32 bits) and ADD64 adds them to the (lo, hi) total with its carries.
-#define ADD64(M, LO, HI) { \
+// list and the off-screen samples, added to the workgroup's counter slot (common.glsl: the
+// frame's atomics spread over MARCH_SLOTS cache lines, summed by the host). WORKGROUP:
+// each subgroup's sums meet in shared memory and one invocation per workgroup adds them;
+// SUBGROUP: each subgroup adds its own; OFF: nothing counted (the increments above are
+// then dead code), to measure what counting costs. (Before: every subgroup's atomics, and
+// every pixel's longest list, met on stats' one cache line.) 64-bit totals stay exact:
+// the low and high 16 bits of each count are summed apart (each sum fits 32 bits) and
+// ADD64 adds them to the slot's (lo, hi) total at word W with its carries.
+#define ADD64(W, LO, HI) { \
     uint lo_ = (LO), hi_ = (HI); \
     uint a_ = lo_ + (hi_ << 16), c_ = (hi_ >> 16) + (a_ < lo_ ? 1u : 0u); \
-    uint o_ = atomicAdd(stats.M.x, a_); \
+    uint o_ = atomicAdd(march_slots[W], a_); \
     c_ += o_ + a_ < o_ ? 1u : 0u; \
-    if (c_ > 0u) atomicAdd(stats.M.y, c_); }
+    if (c_ > 0u) atomicAdd(march_slots[(W) + 1u], c_); }
+
+// Each subgroup's sums (the longest list its max).
+struct Sums { uint rays, longest, offscreen; uint lo[3], hi[3]; };
+Sums subgroup_sums() {
+    Sums s;
+    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
+    s.rays = subgroupAdd(n_rays);
+    s.longest = subgroupMax(longest);
+    s.offscreen = subgroupAdd(offscreen_samples);
+    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        s.lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
+        s.hi[k] = subgroupAdd(counts[k] >> 16);
+    }
+    return s;
+}
+
+// Sums added to the workgroup's slot, each only where it is not zero.
+void add_sums(Sums s) {
+    uint at = (group_id() % MARCH_SLOTS) * MARCH_SLOT_WORDS;
+    if (s.rays > 0u) atomicAdd(march_slots[at], s.rays);
+    if (s.longest > 0u) atomicMax(march_slots[at + 1u], s.longest);
+    if (s.offscreen > 0u) atomicAdd(march_slots[at + 2u], s.offscreen);
+    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        if (s.lo[k] > 0u || s.hi[k] > 0u) ADD64(at + 3u + 2u * k, s.lo[k], s.hi[k])
+    }
+}
 
 #if COUNTERS == COUNTERS_WORKGROUP
-// rays, then (lo, hi) of steps, evals, candidates, then the longest list and off-screen
-// samples.
+// rays, longest, off-screen, then (lo, hi) of steps, evals, candidates.
 shared uint c_sum[9];
 void add_counters() {
-    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
     if (gl_LocalInvocationIndex == 0u) {
         [[unroll]] for (uint k = 0u; k < 9u; ++k) c_sum[k] = 0u;
     }
     barrier();
-    uint rays = subgroupAdd(n_rays), lg = subgroupMax(longest);
-    uint off = subgroupAdd(offscreen_samples);
-    uint lo[3], hi[3];
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-        lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
-        hi[k] = subgroupAdd(counts[k] >> 16);
-    }
+    Sums s = subgroup_sums();
     if (subgroupElect()) {
-        atomicAdd(c_sum[0], rays);
+        atomicAdd(c_sum[0], s.rays);
+        atomicMax(c_sum[1], s.longest);
+        atomicAdd(c_sum[2], s.offscreen);
         [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-            atomicAdd(c_sum[1u + 2u * k], lo[k]);
-            atomicAdd(c_sum[2u + 2u * k], hi[k]);
+            atomicAdd(c_sum[3u + k], s.lo[k]);
+            atomicAdd(c_sum[6u + k], s.hi[k]);
         }
-        atomicMax(c_sum[7], lg);
-        atomicAdd(c_sum[8], off);
     }
     barrier();
     if (gl_LocalInvocationIndex != 0u) return;
-    if (c_sum[0] > 0u) atomicAdd(stats.rays, c_sum[0]);
-    ADD64(steps, c_sum[1], c_sum[2])
-    ADD64(evals, c_sum[3], c_sum[4])
-    ADD64(candidates, c_sum[5], c_sum[6])
-    if (c_sum[7] > 0u) atomicMax(stats.longest, c_sum[7]);
-    if (c_sum[8] > 0u) atomicAdd(stats.offscreen_samples, c_sum[8]);
+    Sums w;
+    w.rays = c_sum[0];
+    w.longest = c_sum[1];
+    w.offscreen = c_sum[2];
+    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        w.lo[k] = c_sum[3u + k];
+        w.hi[k] = c_sum[6u + k];
+    }
+    add_sums(w);
 }
 #elif COUNTERS == COUNTERS_SUBGROUP
 void add_counters() {
-    if (longest > 0u) atomicMax(stats.longest, longest);
-    if (offscreen_samples > 0u) atomicAdd(stats.offscreen_samples, offscreen_samples);
-    uint rays = subgroupAdd(n_rays);
-    if (subgroupElect()) atomicAdd(stats.rays, rays);
-    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
-    uint lo[3], hi[3];
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-        lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
-        hi[k] = subgroupAdd(counts[k] >> 16);
-    }
-    if (subgroupElect()) {
-        ADD64(steps, lo[0], hi[0])
-        ADD64(evals, lo[1], hi[1])
-        ADD64(candidates, lo[2], hi[2])
-    }
+    Sums s = subgroup_sums();
+    if (subgroupElect()) add_sums(s);
 }
 #elif COUNTERS == COUNTERS_OFF
 void add_counters() {}

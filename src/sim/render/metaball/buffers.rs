@@ -161,7 +161,7 @@ impl MetaballBuffers {
         let list = buf("sbuffer list", only(sbuf, list_capacity * 4))?;
         let heads = buf("abuffer heads", only(abuf, px * 4))?;
         let nodes = buf("abuffer nodes", only(abuf, list_capacity * 8))?;
-        let stats = buf("render stats", GpuStats::SIZE)?;
+        let stats = buf("render stats", GpuStats::BUFFER_SIZE)?;
         let pixels = buf("render pixels", px * 4)?;
         let debug_buf = buf("render debug", only(debug, px * 16))?;
         let sky = buf("sky image", sky_px.len() as u64 * 4)?;
@@ -202,7 +202,7 @@ impl MetaballBuffers {
         for _ in 0..slots {
             stats_readback.push(ctx.create_buffer(
                 "render stats readback",
-                GpuStats::SIZE,
+                GpuStats::BUFFER_SIZE,
                 vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )?);

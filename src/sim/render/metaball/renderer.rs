@@ -383,15 +383,21 @@ impl FluidRenderer {
         slot: usize,
     ) {
         let px = self.settings.pixels();
-        ctx.copy(cmd, &b.stats, 0, &b.stats_readback[slot], 0, GpuStats::SIZE);
+        ctx.copy(
+            cmd,
+            &b.stats,
+            0,
+            &b.stats_readback[slot],
+            0,
+            GpuStats::BUFFER_SIZE,
+        );
         ctx.copy(cmd, &b.pixels, 0, &b.pixels_readback[slot], 0, px * 4);
         ctx.host_reads(cmd, &[&b.stats_readback[slot], &b.pixels_readback[slot]]);
     }
 
     /// The statistics of the frame last rendered in `slot` (after its fence).
     pub fn frame_stats(&self, b: &MetaballBuffers, slot: usize) -> FrameStats {
-        let st: GpuStats =
-            bytemuck::pod_read_unaligned(b.stats_readback[slot].mapped().expect("mapped"));
+        let st = GpuStats::read(b.stats_readback[slot].mapped().expect("mapped"));
         let px = self.settings.pixels();
         let pairs = st.pairs as u64;
         let tile_bytes = b.tiles.bytes(pairs, b.tiles.rects.size / 8);

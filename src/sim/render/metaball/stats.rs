@@ -33,8 +33,40 @@ pub fn wide(v: [u32; 2]) -> u64 {
     v[0] as u64 | (v[1] as u64) << 32
 }
 
+/// The march's counter slots after the stats (glsl/render/metaball/common.glsl): each
+/// workgroup adds its counts to slot (group % SLOTS), one cache line each, and the host sums
+/// them: the frame's counter atomics spread over 64 lines instead of meeting on one.
+pub const MARCH_SLOTS: usize = 64;
+pub const MARCH_SLOT_WORDS: usize = 32;
+
 impl GpuStats {
     pub const SIZE: u64 = std::mem::size_of::<GpuStats>() as u64;
+    /// The stats buffer: the stats, then the march's counter slots.
+    pub const BUFFER_SIZE: u64 = Self::SIZE + (MARCH_SLOTS * MARCH_SLOT_WORDS * 4) as u64;
+
+    /// The stats of a read-back stats buffer, the march's slots summed into them.
+    pub fn read(raw: &[u8]) -> Self {
+        let mut st: GpuStats = bytemuck::pod_read_unaligned(&raw[..Self::SIZE as usize]);
+        let (mut steps, mut evals, mut candidates) =
+            (wide(st.steps), wide(st.evals), wide(st.candidates));
+        // A slot's words: rays, longest list, off-screen samples, then the (lo, hi) totals
+        // of steps, evaluations and candidates (march.comp's add_sums).
+        let word = |slot: usize, k: usize| {
+            let at = Self::SIZE as usize + (slot * MARCH_SLOT_WORDS + k) * 4;
+            u32::from_le_bytes([raw[at], raw[at + 1], raw[at + 2], raw[at + 3]])
+        };
+        for k in 0..MARCH_SLOTS {
+            st.rays += word(k, 0);
+            st.longest = st.longest.max(word(k, 1));
+            st.offscreen_samples += word(k, 2);
+            steps += wide([word(k, 3), word(k, 4)]);
+            evals += wide([word(k, 5), word(k, 6)]);
+            candidates += wide([word(k, 7), word(k, 8)]);
+        }
+        let split = |v: u64| [v as u32, (v >> 32) as u32];
+        (st.steps, st.evals, st.candidates) = (split(steps), split(evals), split(candidates));
+        st
+    }
     /// Where the S-buffer's total is copied.
     pub const SBUFFER_FRAGMENTS_OFFSET: u64 =
         std::mem::offset_of!(GpuStats, sbuffer_fragments) as u64;

@@ -1,0 +1,118 @@
+//! `bench march`: what the march's own machinery costs, each suspect switched alone on
+//! `bench render`'s resting blob, timed together under the protocol: the counters (summed
+//! per workgroup, the default; added per subgroup with atomics, the former; off) and the
+//! lanes (8 x 8 blocks, the default; rows of 64), per list mode (or --list). Each row
+//! gives the march scope's ms beside the frame's, and its ratio to the default's row.
+use super::{BenchOptions, Row};
+use crate::config::{Counters, Lanes, ListKind};
+use crate::error::Result;
+use crate::gpu::Context;
+
+/// (counters, lanes) per row: the default first, then each switched alone.
+const SUSPECTS: [(Counters, Lanes); 4] = [
+    (Counters::Workgroup, Lanes::Blocks),
+    (Counters::Subgroup, Lanes::Blocks),
+    (Counters::Off, Lanes::Blocks),
+    (Counters::Workgroup, Lanes::Rows),
+];
+
+pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    for (list, sorted, build) in super::render::rows_of(&opts.switches)? {
+        let mut s = crate::settings::metaball_settings(&opts.switches)?;
+        (s.list, s.sorted, s.build) = (list, sorted, build);
+        for (counters, lanes) in SUSPECTS {
+            if list == ListKind::Tiles && lanes == Lanes::Rows {
+                continue; // tiles stage their tile per block
+            }
+            let name = format!(
+                "{} counters={} lanes={}",
+                s.list_name(),
+                counters.as_str(),
+                lanes.as_str()
+            );
+            rows.push((
+                crate::render::metaball::MetaballSettings {
+                    counters,
+                    lanes,
+                    ..s.clone()
+                },
+                name,
+            ));
+        }
+    }
+    let mut out = super::render::time_rows(ctx, opts, rows)?;
+    // Each list's default row is its first.
+    let mut first = 0;
+    for k in 0..out.len() {
+        if !out[k].variant.contains("counters=workgroup lanes=blocks") && k > 0 {
+            let (m, d) = (march_ms(&out[k]), march_ms(&out[first]));
+            out[k]
+                .extra
+                .insert(0, ("x default march".into(), ratio(m, d)));
+        } else {
+            first = k;
+            out[k]
+                .extra
+                .insert(0, ("x default march".into(), "1.000".into()));
+        }
+        let m = march_ms(&out[k]);
+        out[k].extra.insert(
+            0,
+            (
+                "march ms".into(),
+                m.map_or("-".into(), |m| format!("{m:.3}")),
+            ),
+        );
+    }
+    Ok(out)
+}
+
+/// The march scope's median ms of a row.
+fn march_ms(row: &Row) -> Option<f64> {
+    row.passes
+        .iter()
+        .find(|(k, _)| k == "render/march")
+        .map(|(_, s)| s.median)
+}
+
+fn ratio(a: Option<f64>, b: Option<f64>) -> String {
+    match (a, b) {
+        (Some(a), Some(b)) if b > 0.0 => format!("{:.3}", a / b),
+        _ => "-".into(),
+    }
+}
+
+/// Per list: what the counters cost (the default's march over the one without counters;
+/// target: at most 2% of the march) and what each former choice cost.
+pub fn notes(rows: &[Row]) -> Vec<String> {
+    let mut out = Vec::new();
+    let default = "counters=workgroup lanes=blocks";
+    for d in rows.iter().filter(|r| r.variant.ends_with(default)) {
+        let list = d.variant.trim_end_matches(default).trim_end();
+        let of = |suffix: &str| {
+            rows.iter()
+                .find(|r| r.variant == format!("{list} {suffix}"))
+                .and_then(march_ms)
+        };
+        let (Some(on), Some(off)) = (march_ms(d), of("counters=off lanes=blocks")) else {
+            continue;
+        };
+        let cost = 100.0 * (on / off - 1.0);
+        let verdict = if cost <= 2.0 { "meets" } else { "misses" };
+        let mut line = format!(
+            "{list}: counters cost {cost:+.1}% of the march ({on:.3} against {off:.3} ms off; \
+             {verdict} the 2% target)"
+        );
+        for (what, suffix) in [
+            ("per-subgroup atomics", "counters=subgroup lanes=blocks"),
+            ("rows of 64", "counters=workgroup lanes=rows"),
+        ] {
+            if let Some(m) = of(suffix) {
+                line += &format!("; {what}: {:.3}x", m / on);
+            }
+        }
+        out.push(line);
+    }
+    out
+}
