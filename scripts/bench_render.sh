@@ -2,7 +2,9 @@
 # Regenerate results/<device-slug>/render.md: the thesis's rendering setup (2048 particles
 # in a resting blob, 512x512, Wyvill, T = 0.9, R = 0.04, I = 2) for none, A-buffer and
 # S-buffer (built by raster and by compute, unsorted and sorted) and tiles, with Phong and
-# with glass at recursion depth 3; then Phong with --march lipschitz. Each row has its floor.
+# with glass at recursion depth 3; then Phong with --march lipschitz; then the march's own
+# costs (bench march: counters and lanes switched alone, Phong, S-buffer). Each row has its
+# floor.
 # Usage: scripts/bench_render.sh [--device N|NAME] [--frames N] [--particles N]
 #        [--width W] [--height H] (the last three shrink the setup, e.g. for a quick check)
 # FLUIDFORM_BIN selects a prebuilt binary (e.g. one carried to a GPU machine).
@@ -26,9 +28,12 @@ setup=(--particles "$n" --width "$w" --height "$h" --density wyvill --threshold 
 phong=("$bin" bench render --out out/bench/render-phong "${setup[@]}" --material phong "${dev[@]}" "${args[@]}")
 glass=("$bin" bench render --out out/bench/render-glass "${setup[@]}" --material glass --depth 3 "${dev[@]}" "${args[@]}")
 lip=("$bin" bench render --out out/bench/render-lipschitz "${setup[@]}" --material phong --march lipschitz "${dev[@]}" "${args[@]}")
+march=("$bin" bench march --out out/bench/march "${setup[@]}" --material phong --list sbuffer "${dev[@]}" "${args[@]}")
 "${phong[@]}" > /dev/null
 "${glass[@]}" > /dev/null
 "${lip[@]}" > /dev/null
+"${march[@]}" > /dev/null
+cp out/bench/march/sweep.csv "$dir/render-march.csv"
 cp out/bench/render-phong/sweep.csv "$dir/render-phong.csv"
 cp out/bench/render-glass/sweep.csv "$dir/render-glass.csv"
 cp out/bench/render-phong/sweep.png "$dir/render-phong.png"
@@ -45,6 +50,7 @@ md=$dir/render.md
   echo "    fluidform ${phong[*]:1}"
   echo "    fluidform ${glass[*]:1}"
   echo "    fluidform ${lip[*]:1}"
+  echo "    fluidform ${march[*]:1}"
   echo
   echo "The thesis (GTX 1080 Ti, 2048 particles shaped like a character, 512x512): Phong"
   echo "none 11 / A-buffer 87 / S-buffer 98 fps, 8.7 / 5.8 MB; transparent at depth 3:"
@@ -68,5 +74,12 @@ md=$dir/render.md
   echo "hits); compare steps/px and render/march with the Phong table above."
   echo
   cat out/bench/render-lipschitz/sweep.md
+  echo
+  echo "## The march's own costs (Phong, S-buffer)"
+  echo
+  echo "Each suspect switched alone against the default (counters summed per workgroup into"
+  echo "64 slots, 8 x 8 blocks): per-subgroup counters, no counters, rows of 64 lanes."
+  echo
+  cat out/bench/march/sweep.md
 } > "$md"
 echo "wrote $md"

@@ -139,6 +139,13 @@ step bench-primitives "$(until_pct "${ends[0]}")" bash scripts/bench_primitives.
 step bench-sph "$(until_pct "${ends[1]}")" bash scripts/bench_sph.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}" "${sph[@]}"
 step bench-render "$(until_pct "${ends[2]}")" bash scripts/bench_render.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${render[@]}"
 step bench-solvers "$(until_pct "${ends[3]}")" bash scripts/bench_solvers.sh "${dev[@]}" "${val[@]}" "${solvers[@]}"
+# SPlisHSPlasH 2.19's DFSPH on this machine's cores beside ours, on the same dam break at
+# 0.1% (issue 59), from carried wheels: the device machine reaches no package index.
+if [ $quick = 0 ] && ls out/wheels/pysplishsplash-2.19.0-*.whl > /dev/null 2>&1; then
+  step peer "$(until_pct $(( ends[3] + (ends[4] - ends[3]) / 4 )))" bash scripts/peer_splishsplash.sh "${dev[@]}" --wheels out/wheels
+else
+  say "SPlisHSPlasH peer skipped: no pysplishsplash-2.19.0 wheel in out/wheels (pip download it and numpy's where there is a network, and carry out/wheels)"
+fi
 
 # 3. The experiments in one process, sharing pipelines, SPIR-V and the thesis scene; each
 #    notes its span (FLUIDFORM_SPANS) for its row in gpu.md and the device state on its page.

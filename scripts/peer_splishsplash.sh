@@ -6,7 +6,9 @@
 # after the other on this machine, SPlisHSPlasH on --threads threads (default: the
 # machine's cores). Appends the comparison to results/<device>/solvers.md.
 # Usage: scripts/peer_splishsplash.sh [--device N|NAME] [--particles N] [--seconds S]
-#        [--error PCT] [--threads T]
+#        [--error PCT] [--threads T] [--wheels DIR]
+# --wheels DIR installs pysplishsplash and numpy from wheels in DIR (pip download them
+# where there is a network; a GPU machine has none) instead of from the index.
 # FLUIDFORM_BIN selects a prebuilt binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,6 +16,7 @@ particles=65536
 seconds=0.4
 error=0.1
 threads=$(nproc)
+wheels=
 pass=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -21,6 +24,7 @@ while [ $# -gt 0 ]; do
     --seconds) seconds=$2; shift 2 ;;
     --error) error=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
+    --wheels) wheels=$2; shift 2 ;;
     *) pass+=("$1"); shift ;;
   esac
 done
@@ -30,7 +34,11 @@ venv=out/peer-venv
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
-"$venv/bin/pip" install --quiet "pysplishsplash==2.19.0" "numpy<2"
+if [ -n "$wheels" ]; then
+  "$venv/bin/pip" install --quiet --no-index --find-links "$wheels" "pysplishsplash==2.19.0" "numpy<2"
+else
+  "$venv/bin/pip" install --quiet "pysplishsplash==2.19.0" "numpy<2"
+fi
 # The wheel's own libGLdispatch clashes with the system's libGLX at import (a segfault):
 # the system's is loaded first.
 glx=$(ldconfig -p | awk '/libGLdispatch\.so\.0 /{print $NF; exit}')
