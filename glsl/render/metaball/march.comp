@@ -428,6 +428,17 @@ void add_counters() {}
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; vec2 cone; };
 
 const int STACK = 8;
+// Glass and tinted branch into two paths per hit and keep the ones waiting on a stack;
+// Phong (the primary ray alone) and the metals (each reflection replaces its path) follow
+// one path at a time: no array indexed at run time, which a GPU compiler puts in local
+// memory even when only one entry is ever used.
+#if MATERIAL == MATERIAL_GLASS || MATERIAL == MATERIAL_TINTED
+#define STACKED 1
+#elif MATERIAL == MATERIAL_PHONG || MATERIAL == MATERIAL_METAL
+#define STACKED 0
+#else
+#error "MATERIAL names no material"
+#endif
 
 // One pixel's colour (and depth, debug output); invocations past the frame return at
 // once, except that tiles' join the barriers of their block's staging first.
@@ -471,11 +482,18 @@ void march_pixel() {
     iv.y = min(iv.y, t_opaque);
     vec3 color = vec3(0.0);
     vec4 dbg = vec4(-1.0, 0.0, 0.0, 0.0);
+#if STACKED
     Path stack[STACK];
     int sp = 0;
     stack[sp++] = Path(o, d, vec3(1.0), 0u, false, cone);
     while (sp > 0) {
         Path r = stack[--sp];
+#else
+    Path r = Path(o, d, vec3(1.0), 0u, false, cone);
+    bool more = true;
+    while (more) {
+        more = false;  // a metal's reflection sets it again
+#endif
         bool primary = r.depth == 0u;
         vec2 span = primary ? iv : ray_box(r.o, r.d, box_lo(), box_hi());
 #if MARCH == MARCH_LIPSCHITZ
@@ -517,8 +535,11 @@ void march_pixel() {
 #if MATERIAL == MATERIAL_METAL
         vec3 F = P.f0.rgb + (1.0 - P.f0.rgb) * pow(1.0 - cos_i, 5.0);
         Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside, cone_bent(hit_cone, P.eye.w, 2.0));
-        if (r.depth + 1u > P.depth || sp >= STACK) color += refl.w * sky_color(rd, refl.cone);
-        else stack[sp++] = refl;
+        if (r.depth + 1u > P.depth) color += refl.w * sky_color(rd, refl.cone);
+        else {
+            r = refl;
+            more = true;
+        }
 #else
         float n1 = r.inside ? P.absorb.w : 1.0, n2 = r.inside ? 1.0 : P.absorb.w;
         vec3 td = refract(r.d, nn, n1 / n2);
@@ -535,7 +556,11 @@ void march_pixel() {
 #error "MATERIAL names no material"
 #endif
     }
+#if STACKED
     CUT_UNLESS(!(sp > 0))
+#else
+    CUT_UNLESS(!more)
+#endif
     color = with_tank(color, o, d, min(dbg.x >= 0.0 ? dbg.x : 1e30, t_opaque));
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
