@@ -258,7 +258,7 @@ fn lane_variants(list: ListKind, all: bool) -> Vec<(Counters, Lanes)> {
             .iter()
             .flat_map(|c| lanes.iter().map(move |l| (*c, *l)))
             .collect(),
-        false => vec![(Counters::Workgroup, Lanes::Blocks)],
+        false => vec![(Counters::Subgroup, Lanes::Blocks)],
     }
 }
 

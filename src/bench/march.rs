@@ -1,6 +1,6 @@
 //! `bench march`: what the march's own machinery costs, each suspect switched alone on
-//! `bench render`'s resting blob, timed together under the protocol: the counters (summed
-//! per workgroup, the default; added per subgroup with atomics, the former; off) and the
+//! `bench render`'s resting blob, timed together under the protocol: the counters (added
+//! per subgroup into 64 slots, the default; summed per workgroup first; off) and the
 //! lanes (8 x 8 blocks, the default; rows of 64), per list mode (or --list). Each row
 //! gives the march scope's ms beside the frame's, and its ratio to the default's row.
 use super::{BenchOptions, Row};
@@ -10,11 +10,12 @@ use crate::gpu::Context;
 
 /// (counters, lanes) per row: the default first, then each switched alone.
 const SUSPECTS: [(Counters, Lanes); 4] = [
-    (Counters::Workgroup, Lanes::Blocks),
     (Counters::Subgroup, Lanes::Blocks),
+    (Counters::Workgroup, Lanes::Blocks),
     (Counters::Off, Lanes::Blocks),
-    (Counters::Workgroup, Lanes::Rows),
+    (Counters::Subgroup, Lanes::Rows),
 ];
+const DEFAULT: &str = "counters=subgroup lanes=blocks";
 
 pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
@@ -45,7 +46,7 @@ pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     // Each list's default row is its first.
     let mut first = 0;
     for k in 0..out.len() {
-        if !out[k].variant.contains("counters=workgroup lanes=blocks") && k > 0 {
+        if !out[k].variant.ends_with(DEFAULT) && k > 0 {
             let (m, d) = (march_ms(&out[k]), march_ms(&out[first]));
             out[k]
                 .extra
@@ -87,9 +88,8 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> String {
 /// target: at most 2% of the march) and what each former choice cost.
 pub fn notes(rows: &[Row]) -> Vec<String> {
     let mut out = Vec::new();
-    let default = "counters=workgroup lanes=blocks";
-    for d in rows.iter().filter(|r| r.variant.ends_with(default)) {
-        let list = d.variant.trim_end_matches(default).trim_end();
+    for d in rows.iter().filter(|r| r.variant.ends_with(DEFAULT)) {
+        let list = d.variant.trim_end_matches(DEFAULT).trim_end();
         let of = |suffix: &str| {
             rows.iter()
                 .find(|r| r.variant == format!("{list} {suffix}"))
@@ -105,8 +105,8 @@ pub fn notes(rows: &[Row]) -> Vec<String> {
              {verdict} the 2% target)"
         );
         for (what, suffix) in [
-            ("per-subgroup atomics", "counters=subgroup lanes=blocks"),
-            ("rows of 64", "counters=workgroup lanes=rows"),
+            ("summed per workgroup", "counters=workgroup lanes=blocks"),
+            ("rows of 64", "counters=subgroup lanes=rows"),
         ] {
             if let Some(m) = of(suffix) {
                 line += &format!("; {what}: {:.3}x", m / on);

@@ -9,6 +9,7 @@ pub mod findings;
 pub mod lists;
 pub mod measure;
 pub mod shots;
+pub mod solves;
 pub mod surfaces;
 pub mod surge;
 pub mod sweeps;
@@ -42,7 +43,8 @@ fluidform_gpu::switch_enum!(
         Fidelity,
         Surfaces,
         Lists,
-        Surge
+        Surge,
+        Solves
     }
 );
 
@@ -406,6 +408,7 @@ fn run_all(ctx: &Context, env: &mut Env, names: &[Experiment]) -> Result<Vec<Pat
             Experiment::Surfaces => surfaces::surfaces(env)?,
             Experiment::Lists => lists::lists(ctx, env)?,
             Experiment::Surge => surge::surge(ctx, env)?,
+            Experiment::Solves => solves::solves(ctx, env)?,
             Experiment::Table2
             | Experiment::Table3
             | Experiment::Table4

@@ -185,12 +185,12 @@ switch_enum!(
 
 switch_enum!(
     /// How the march counts its rays, samples, terms and candidates (the frame's
-    /// statistics): summed per workgroup and added once per workgroup, added per subgroup
-    /// with atomics (one cache line met by every subgroup of the frame), or not at all (to
+    /// statistics), into 64 slots a workgroup picks by its index: added per subgroup, summed
+    /// per workgroup first (two barriers) and added once per workgroup, or not at all (to
     /// measure what counting costs; the frame then reports no counts).
     Counters {
-        Workgroup,
         Subgroup,
+        Workgroup,
         Off
     }
 );

@@ -189,8 +189,8 @@ pub struct MetaballArgs {
     /// lipschitz: samples the field's Lipschitz bound proves outside are skipped (same hits)
     #[arg(long, value_parser = choice::<MarchKind>())]
     pub march: Option<MarchKind>,
-    /// How the march counts rays, samples and terms: summed per workgroup (default), per
-    /// subgroup with atomics, or off (no counts: to measure what counting costs)
+    /// How the march counts rays, samples and terms into 64 slots: per subgroup (default),
+    /// summed per workgroup first, or off (no counts: to measure what counting costs)
     #[arg(long, value_parser = choice::<Counters>())]
     pub counters: Option<Counters>,
     /// How the march lays pixels on invocations: 8 x 8 blocks (default) or rows of 64

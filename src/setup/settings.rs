@@ -24,7 +24,7 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
         counters: sw
             .metaball
             .counters
-            .unwrap_or(crate::kinds::Counters::Workgroup),
+            .unwrap_or(crate::kinds::Counters::Subgroup),
         lanes: sw.metaball.lanes.unwrap_or(crate::kinds::Lanes::Blocks),
         build: sw.metaball.build.unwrap_or(BuildKind::Raster),
         tile: sw.metaball.tile.unwrap_or(16),

@@ -30,7 +30,7 @@ pub struct MetaballSettings {
     #[serde(default = "fixed")]
     pub march: MarchKind,
     /// How the march counts rays, samples and terms (off: no counts, to measure their cost).
-    #[serde(default = "workgroup")]
+    #[serde(default = "subgroup")]
     pub counters: Counters,
     /// How the march lays pixels on invocations.
     #[serde(default = "blocks")]
@@ -89,8 +89,8 @@ fn fixed() -> MarchKind {
     MarchKind::Fixed
 }
 
-fn workgroup() -> Counters {
-    Counters::Workgroup
+fn subgroup() -> Counters {
+    Counters::Subgroup
 }
 
 fn blocks() -> Lanes {
