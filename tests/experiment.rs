@@ -206,6 +206,8 @@ fn quick_experiments_write_every_file_and_column() {
         fluidform::experiment::lists::BEST_PHONG,
         fluidform::experiment::lists::BEST_GLASS,
         fluidform::experiment::lists::DEMO_FASTER,
+        findings::SIXFOLD_K2,
+        fluidform::experiment::solves::CLAIM,
         "cost rises with the radius R",
         "cost rises with the refinement steps I",
         "cost rises with the recursion depth",

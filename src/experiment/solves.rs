@@ -83,7 +83,7 @@ pub fn solves(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding
          ---|---|---|---|---|\n",
         opts.warmup, opts.frames
     );
-    for ((solver, i), o) in SOLVERS.iter().zip(&est).zip(outs) {
+    for ((solver, i), o) in SOLVERS.iter().zip(&est).zip(&outs) {
         let e = &o.errors;
         let c = &o.commands.median;
         let dt = o.simulated_s / o.steps.max(1) as f64 * 1000.0;
@@ -120,8 +120,26 @@ pub fn solves(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding
     }
     let p_csv = env.out.join("solves.csv");
     write(&p_csv, &csv)?;
+    let png = env.out.join("solves.png");
+    let labels: Vec<String> = ["ms per step", "dispatches", "barriers", "empty dispatches"]
+        .map(String::from)
+        .to_vec();
+    let series: Vec<(String, Vec<Option<f64>>)> = SOLVERS
+        .iter()
+        .zip(&est)
+        .zip(&outs)
+        .map(|((solver, i), o)| {
+            let c = &o.commands.median;
+            let v = [i.median, c[0] as f64, c[1] as f64, c[4] as f64];
+            (solver.as_str(), v.map(|x| (x > 0.0).then_some(x)).to_vec())
+        })
+        .collect();
+    let title = format!("dam break at {n}: a step");
+    let sub = format!("{}, {}", env.meta.device, crate::bench::plot::today());
+    crate::bench::plot::grouped_bars(&png, &title, &sub, &labels, &series, "per step")?;
+    md.push_str("\n![a step's time and commands per solver](solves.png)\n");
     let p_md = super::finish_md(env, Experiment::Solves, md, &found)?;
-    Ok((vec![p_csv, p_md], found))
+    Ok((vec![p_csv, p_md, png], found))
 }
 
 /// DFSPH's step over WCSPH's at most RATIO beyond the intervals: confirmed where even the
