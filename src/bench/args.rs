@@ -106,28 +106,35 @@ pub enum BenchWhat {
         particle: ParticleArgs,
     },
     /// The metaball renderer on a resting blob, per list (or --list)
-    Render {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        frame: FrameArgs,
-        #[command(flatten)]
-        metaball: MetaballArgs,
-        #[command(flatten)]
-        camera: CameraArgs,
-    },
-    /// The march's own costs on the resting blob: counters (workgroup, subgroup, off) and
+    Render(RenderBench),
+    /// The march's own costs on the resting blob: counters (subgroup, workgroup, off) and
     /// lanes (blocks, rows), each switched alone, per list (or --list)
-    March {
-        #[command(flatten)]
-        common: CommonArgs,
-        #[command(flatten)]
-        frame: FrameArgs,
-        #[command(flatten)]
-        metaball: MetaballArgs,
-        #[command(flatten)]
-        camera: CameraArgs,
-    },
+    March(RenderBench),
+}
+
+/// The switches of the rendering benchmarks.
+#[derive(clap::Args)]
+pub struct RenderBench {
+    #[command(flatten)]
+    common: CommonArgs,
+    #[command(flatten)]
+    frame: FrameArgs,
+    #[command(flatten)]
+    metaball: MetaballArgs,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+impl RenderBench {
+    fn switches(self) -> Switches {
+        Switches {
+            common: self.common,
+            frame: self.frame,
+            metaball: self.metaball,
+            camera: self.camera,
+            ..Switches::default()
+        }
+    }
 }
 
 /// The switches of the SPH benchmarks.
@@ -253,36 +260,8 @@ impl BenchWhat {
                     ..d()
                 },
             ),
-            BenchWhat::Render {
-                common,
-                frame,
-                metaball,
-                camera,
-            } => (
-                Bench::Render,
-                Switches {
-                    common,
-                    frame,
-                    metaball,
-                    camera,
-                    ..d()
-                },
-            ),
-            BenchWhat::March {
-                common,
-                frame,
-                metaball,
-                camera,
-            } => (
-                Bench::March,
-                Switches {
-                    common,
-                    frame,
-                    metaball,
-                    camera,
-                    ..d()
-                },
-            ),
+            BenchWhat::Render(r) => (Bench::Render, r.switches()),
+            BenchWhat::March(r) => (Bench::March, r.switches()),
         };
         (what, sw, None, None, Vec::new())
     }

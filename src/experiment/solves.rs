@@ -85,38 +85,20 @@ pub fn solves(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding
     );
     for ((solver, i), o) in SOLVERS.iter().zip(&est).zip(&outs) {
         let e = &o.errors;
-        let c = &o.commands.median;
         let dt = o.simulated_s / o.steps.max(1) as f64 * 1000.0;
-        md += &format!(
-            "| {} | {} | {} | {dt:.3} | {:.2} | {:.2} | {} | {} | {} | {} | {} | {:.3} |\n",
-            solver.as_str(),
-            i.text(),
-            o.steps,
-            e.iterations_mean,
-            e.divergence_iterations_mean,
-            c[0],
-            c[1],
-            c[2],
-            c[3],
-            c[4],
-            e.mean * 100.0
-        );
-        csv += &format!(
-            "{},{n},{:.6},{:.6},{:.6},{},{dt:.6},{:.4},{:.4},{},{},{},{},{},{:.5}\n",
-            solver.as_str(),
-            i.median,
-            i.lo,
-            i.hi,
-            o.steps,
-            e.iterations_mean,
-            e.divergence_iterations_mean,
-            c[0],
-            c[1],
-            c[2],
-            c[3],
-            c[4],
-            e.mean * 100.0
-        );
+        // The columns after the time, the same in both tables.
+        let mut rest = vec![
+            o.steps.to_string(),
+            format!("{dt:.3}"),
+            format!("{:.2}", e.iterations_mean),
+            format!("{:.2}", e.divergence_iterations_mean),
+        ];
+        rest.extend(o.commands.median.iter().map(|c| c.to_string()));
+        rest.push(format!("{:.3}", e.mean * 100.0));
+        let name = solver.as_str();
+        md += &format!("| {name} | {} | {} |\n", i.text(), rest.join(" | "));
+        let times = format!("{:.6},{:.6},{:.6}", i.median, i.lo, i.hi);
+        csv += &format!("{name},{n},{times},{}\n", rest.join(","));
     }
     let p_csv = env.out.join("solves.csv");
     write(&p_csv, &csv)?;
