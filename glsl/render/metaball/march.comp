@@ -258,7 +258,6 @@ float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
     float T = threshold();
     uint k = 0u;
     for (; k < P.refine; ++k) {
-        n_steps++;
         float m = 0.5 * (a + b);
         vec3 xm = o + d * m;
         uint pm = pixel == NIL ? project(xm) : pixel;
@@ -266,6 +265,7 @@ float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
         if ((field(xm, pm) >= T) != inside) b = m; else a = m;
     }
     CUT_UNLESS(!(k < P.refine))
+    n_steps += k;  // the samples taken, counted once (not per sample)
     return b;
 }
 
@@ -280,23 +280,30 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float prev = max(t - step, 0.0);
     uint i = 0u;
     n_rays++;
+    // The samples are counted once at each exit (i + 1 where sample i ends the march).
     for (; i < P.max_steps && t <= t1; ++i) {
-        n_steps++;
         vec3 x = o + d * t;
         uint p = pixel;
         if (pixel == NIL) {
             p = project(x);
             if (p == NIL) {
                 offscreen_samples++;
-                if (P.offscreen_end != 0u) return -2.0;
+                if (P.offscreen_end != 0u) {
+                    n_steps += i + 1u;
+                    return -2.0;
+                }
                 p = ALL;
             }
         }
-        if ((field(x, p) >= T) != inside) return bisect(o, d, prev, t, inside, pixel);
+        if ((field(x, p) >= T) != inside) {
+            n_steps += i + 1u;
+            return bisect(o, d, prev, t, inside, pixel);
+        }
         prev = t;
         t += step;
     }
     CUT_UNLESS(!(i < P.max_steps && t <= t1))
+    n_steps += i;
     return -1.0;
 }
 
@@ -316,16 +323,19 @@ float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixe
     n_rays++;
     uint i = 0u;
     for (; i < P.max_steps && k < float(P.max_steps) && t <= t1; ++i) {
-        n_steps++;
         vec3 x = o + d * t;
         vec2 fm = field_reach(x, pixel, reach);
-        if ((fm.x >= T) != inside) return bisect(o, d, max(t - step, 0.0), t, inside, pixel);
+        if ((fm.x >= T) != inside) {
+            n_steps += i + 1u;
+            return bisect(o, d, max(t - step, 0.0), t, inside, pixel);
+        }
         float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
         // Samples strictly closer than `safe` (and within `reach`) are skipped.
         k += max(ceil(min(safe, reach) / step - 1e-4), 1.0);
         t = (k0 + k) * step;
     }
     CUT_UNLESS(!(i < P.max_steps && k < float(P.max_steps) && t <= t1))
+    n_steps += i;
     return -1.0;
 }
 #elif MARCH != MARCH_FIXED
