@@ -220,60 +220,11 @@ fn verdicts(def: &TableDef, m: &Measured) -> Vec<Finding> {
         ),
     ));
     found.push(memory_finding(m, s, a));
-    found.push(k2_finding(def, m));
+    found.push(findings::sixfold_k2(def, m));
     for (claim, groups) in &def.rises {
         found.push(rise_finding(def, m, claim, groups));
     }
     found
-}
-
-/// Every cell with a GTX 1080 Ti (K2) frame rate in the thesis at least K2_FACTOR times it
-/// here, beyond the cell's interval: confirmed where even its slowest bound is fast enough,
-/// refuted where even its fastest is not, inconclusive between or where flagged.
-fn k2_finding(def: &TableDef, m: &Measured) -> Finding {
-    let (mut verdicts, mut ratios, mut short) = (Vec::new(), Vec::new(), Vec::new());
-    for (r, row) in def.rows.iter().enumerate() {
-        for (k, col) in def.cols.iter().enumerate() {
-            let Some(k2) = row.thesis.get(k).and_then(|t| value(t.k2)) else {
-                continue;
-            };
-            let c = &m.cells[r][k];
-            let need_ms = 1000.0 / (findings::K2_FACTOR * k2);
-            let i = &c.est.interval;
-            let v = match (c.est.flagged, i.hi <= need_ms, i.lo > need_ms) {
-                (true, _, _) => Verdict::Inconclusive,
-                (false, true, _) => Verdict::Confirmed,
-                (false, _, true) => Verdict::Refuted,
-                _ => Verdict::Inconclusive,
-            };
-            let ratio = c.fps / k2;
-            ratios.push(ratio);
-            if v != Verdict::Confirmed {
-                short.push(format!(
-                    "{} {} {:.1} fps = {ratio:.2}x its {k2}",
-                    m.labels[r], col.name, c.fps
-                ));
-            }
-            verdicts.push(v);
-        }
-    }
-    let n = verdicts.len();
-    Finding::new(
-        findings::SIXFOLD_K2,
-        Verdict::all(verdicts),
-        format!(
-            "{} of {n} cells at least {}x beyond their intervals; fps over the thesis's \
-             GTX 1080 Ti {:.2}x to {:.2}x{}",
-            n - short.len(),
-            findings::K2_FACTOR,
-            ratios.iter().cloned().fold(f64::INFINITY, f64::min),
-            ratios.iter().cloned().fold(0.0, f64::max),
-            match short.is_empty() {
-                true => String::new(),
-                false => format!(" (not: {})", short.join("; ")),
-            }
-        ),
-    )
 }
 
 /// The S-buffer's lists smaller than the A-buffer's in every row.
