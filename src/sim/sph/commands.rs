@@ -51,45 +51,47 @@ pub struct CommandStats {
     pub empty_dispatches: f64,
     pub last: StepCommands,
     pub last_empty: u32,
+    /// Every step's commands and empty dispatches: the means and medians are taken from
+    /// them in `finished`.
     #[serde(skip)]
-    counts: Vec<StepCounts>,
+    seen: Vec<(StepCommands, u32)>,
 }
 
 impl CommandStats {
     /// One more step, with the iterations its solves used.
     pub fn add(&mut self, c: &StepCommands, used: [u32; 2]) {
-        let k = self.steps as f64;
-        let avg = |m: f64, x: u32| (m * k + x as f64) / (k + 1.0);
         let empty = c.empty(used);
-        self.dispatches = avg(self.dispatches, c.step.dispatches);
-        self.barriers = avg(self.barriers, c.step.barriers);
-        self.transfers = avg(self.transfers, c.step.transfers);
-        self.solver_dispatches = avg(self.solver_dispatches, c.solver.dispatches);
-        self.solver_barriers = avg(self.solver_barriers, c.solver.barriers);
-        self.empty_dispatches = avg(self.empty_dispatches, empty);
-        self.last = *c;
-        self.last_empty = empty;
+        (self.last, self.last_empty) = (*c, empty);
         self.steps += 1;
-        self.counts.push([
-            c.step.dispatches,
-            c.step.barriers,
-            c.solver.dispatches,
-            c.solver.barriers,
-            empty,
-        ]);
+        self.seen.push((*c, empty));
     }
 
-    /// With the medians over the steps so far.
+    /// With the means and medians over the steps so far.
     pub fn finished(&self) -> Self {
-        let median = match self.counts.len() {
+        let counts: Vec<StepCounts> = (self.seen.iter())
+            .map(|(c, e)| {
+                let (s, v) = (c.step, c.solver);
+                [s.dispatches, s.barriers, v.dispatches, v.barriers, *e]
+            })
+            .collect();
+        let n = counts.len();
+        let median = match n {
             0 => [0; 5],
             n => std::array::from_fn(|k| {
-                let mut v: Vec<u32> = self.counts.iter().map(|c| c[k]).collect();
+                let mut v: Vec<u32> = counts.iter().map(|c| c[k]).collect();
                 *v.select_nth_unstable(n / 2).1
             }),
         };
+        let mean =
+            |f: &dyn Fn(usize) -> u32| (0..n).map(|i| f(i) as f64).sum::<f64>() / n.max(1) as f64;
         Self {
             median,
+            dispatches: mean(&|i| counts[i][0]),
+            barriers: mean(&|i| counts[i][1]),
+            transfers: mean(&|i| self.seen[i].0.step.transfers),
+            solver_dispatches: mean(&|i| counts[i][2]),
+            solver_barriers: mean(&|i| counts[i][3]),
+            empty_dispatches: mean(&|i| counts[i][4]),
             ..self.clone()
         }
     }

@@ -109,6 +109,10 @@ impl PressureSolver for Pcisph {
         (CHECKED.len() + REST.len()) as u32
     }
 
+    fn solves(&self) -> [bool; 2] {
+        [true, false]
+    }
+
     /// acc = the non-pressure acceleration; the density pass left every pressure at 0.
     fn record_solve(
         &self,

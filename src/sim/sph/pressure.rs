@@ -156,6 +156,11 @@ pub trait PressureSolver {
         0
     }
 
+    /// The iterative solves a step records: (density, divergence).
+    fn solves(&self) -> [bool; 2] {
+        [false; 2]
+    }
+
     /// Whether its states need [`PressureBuffers`].
     fn buffers(&self) -> bool {
         true

@@ -525,13 +525,11 @@ impl SphSolver {
         p.record_solve(self, ctx, cmd, scopes, st)?;
         let end = ctx.recorded(cmd);
         scopes.end(ctx, cmd);
-        let iterations = match p.iteration_dispatches() {
-            0 => [0; 2],
-            _ => [false, true].map(|d| match d && solver != Solver::Dfsph {
-                true => 0,
-                false => st.recorded_iterations(d),
-            }),
-        };
+        let solves = p.solves();
+        let iterations = [false, true].map(|d| match solves[d as usize] {
+            true => st.recorded_iterations(d),
+            false => 0,
+        });
         st.commands = super::commands::StepCommands {
             step: end - start,
             solver: (hooked - forces) + (end - solve),

@@ -276,14 +276,8 @@ impl MetaballSettings {
 
     /// The march.comp defines of a march kind (MARCH and its named values).
     pub fn march_defines(march: MarchKind) -> Vec<(String, String)> {
-        let index = |m: MarchKind| MarchKind::all().iter().position(|v| *v == m);
-        let values: Vec<(String, u32)> = MarchKind::all()
-            .iter()
-            .map(|m| (m.as_str(), index(*m).unwrap_or(0) as u32))
-            .collect();
-        let refs: Vec<(&str, u32)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        let mut d = vec![("MARCH".to_string(), index(march).unwrap_or(0).to_string())];
-        d.extend(crate::gpu::interface::enum_defines("MARCH", &refs));
+        let mut d = vec![("MARCH".to_string(), (march as u32).to_string())];
+        d.extend(MarchKind::defines("MARCH"));
         d
     }
 
