@@ -425,7 +425,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         (
             "sph/cfl.comp",
             "Push",
-            fields!(fluidform::sph::cfl::CflPush; n, mode, cfl, dt_max, speed, dt_prev),
+            fields!(fluidform::sph::cfl::CflPush; n, parts, cfl, dt_max, speed, dt_prev),
         ),
         (
             "sph/constant_force.comp",

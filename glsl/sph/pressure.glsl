@@ -25,6 +25,11 @@ layout(std430, binding = SPH_B_SOLVE) coherent buffer Solve { SolveState S; };
 // the grid search's order, so a list visit sums exactly as the search would.
 layout(std430, binding = SPH_B_NB_LIST) buffer NbList { uint nb_list[]; };
 layout(std430, binding = SPH_B_OVERFLOW) buffer Overflow { uint list_overflows; };
+// The CFL clock, and the parameters again, writable: euler.comp sets the next step's dt
+// once every workgroup has read this step's (cfl.glsl).
+#define CFL_CLOCK SPH_B_CLOCK
+#include "cfl.glsl"
+layout(std430, binding = SPH_B_PARAMS_OUT) buffer ParamsOut { SphParams PO; };
 
 // VISIT(j) for every neighbour j of particle I at XI: from its list when it has one that
 // holds them all, else by the grid search (VISIT then filters j != I, r < h itself).

@@ -19,7 +19,8 @@ const ITEMS: u32 = 8;
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct CflPush {
     pub n: u32,
-    pub mode: u32,
+    /// Workgroups of the dispatch (the last to arrive sets dt).
+    pub parts: u32,
     pub cfl: f32,
     pub dt_max: f32,
     pub speed: f32,
@@ -32,9 +33,9 @@ crate::gpu_interface! {
     pub CflIo / CflBufs: "CFL", push CflPush { params = 0, pos = 1, vel = 2, clock = 3 }
 }
 
-/// Bytes of `ClockState` in glsl/sph/cfl.comp: the largest |v|^2's bits, the last dt, the
-/// simulated time, the steps.
-const CLOCK_BYTES: u64 = 16;
+/// Bytes of `ClockState` in glsl/sph/cfl.glsl: the largest |v|^2's bits, the next step's
+/// dt and its previous step's, whether a step's end set them, the arrivals, padding.
+const CLOCK_BYTES: u64 = 32;
 
 /// The bytes of SphGpuParams up to and including `h` (cfl.comp's SphParamsHead).
 const HEAD: usize = std::mem::offset_of!(SphGpuParams, h) + 4;
@@ -65,9 +66,10 @@ impl CflPass {
     pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &SphState) {
         let f = &st.fluid;
         let Some(cfl) = f.cfl else { return };
-        let mut push = CflPush {
+        let groups = (st.n as u64).div_ceil((WG * ITEMS) as u64).max(1);
+        let push = CflPush {
             n: st.n,
-            mode: 0,
+            parts: groups as u32,
             cfl,
             dt_max: f.dt_max.unwrap_or(f.dt),
             speed: f.sound(),
@@ -79,11 +81,8 @@ impl CflPass {
             vel: st.vel(),
             clock: &st.clock,
         };
-        let groups = (st.n as u64).div_ceil((WG * ITEMS) as u64).max(1);
         self.pipeline
             .dispatch_groups(ctx, cmd, &bufs, &push, groups);
-        push.mode = 1;
-        self.pipeline.dispatch_groups(ctx, cmd, &bufs, &push, 1);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -233,6 +233,10 @@ impl PressureSolver for Dfsph {
         [true, true]
     }
 
+    fn sets_next_dt(&self) -> bool {
+        true
+    }
+
     /// In place of the density and forces passes: densities, factors and the step's
     /// neighbour lists, the divergence-free solve, the non-pressure forces (from the lists).
     fn record_forces(

@@ -113,6 +113,10 @@ impl PressureSolver for Pcisph {
         [true, false]
     }
 
+    fn sets_next_dt(&self) -> bool {
+        true
+    }
+
     /// acc = the non-pressure acceleration; the density pass left every pressure at 0.
     fn record_solve(
         &self,

@@ -20,6 +20,7 @@ crate::gpu_interface! {
         params = 0, nb_keys = 1, nb_start = 2, nb_end = 3, nb_box = 4,
         pos = 5, vel = 6, rho_p = 7, acc = 8, vhalf = 9, colliders = 10,
         aux = 11, aux2 = 12, partials = 13, solve = 14, nb_list = 15, overflow = 16,
+        clock = 17, params_out = 18,
     }
 }
 
@@ -159,6 +160,12 @@ pub trait PressureSolver {
     /// The iterative solves a step records: (density, divergence).
     fn solves(&self) -> [bool; 2] {
         [false; 2]
+    }
+
+    /// Whether its step ends with euler.comp, which takes the next step's dt when the
+    /// fluid sets a CFL number (so the next step in the same recording records no cfl pass).
+    fn sets_next_dt(&self) -> bool {
+        false
     }
 
     /// Whether its states need [`PressureBuffers`].
@@ -483,6 +490,8 @@ impl SphState {
             solve: &p.solve,
             nb_list: &p.nb_list,
             overflow: &p.overflow,
+            clock: &self.clock,
+            params_out: b.params,
         })
     }
 }

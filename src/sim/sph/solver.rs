@@ -123,6 +123,9 @@ pub struct SphState {
     /// (`Context::recording`) they were uploaded in: a step that would upload the same
     /// in the same recording uploads nothing.
     uploaded: Option<(u64, Vec<u8>)>,
+    /// The recording whose last step ended by setting the next step's dt (euler.comp):
+    /// a step that follows it there, with its parameters not uploaded again, has its dt.
+    next_dt: Option<u64>,
     /// `fluid`'s rest-lattice sums, once (recomputed by `gpu_params` if `fluid` changed).
     lattice: LatticeTerms,
 }
@@ -380,6 +383,7 @@ impl SphSolver {
             iteration_bound: [0; 2],
             commands: Default::default(),
             uploaded: None,
+            next_dt: None,
             lattice: LatticeTerms::of(f),
         })
     }
@@ -393,14 +397,22 @@ impl SphSolver {
 
     /// [`record_params`](Self::record_params) unless this recording has uploaded the same
     /// already: the steps of a frame share their parameters (dt is the frame's estimate).
-    fn record_changed_params(&self, ctx: &Context, cmd: vk::CommandBuffer, st: &mut SphState) {
+    /// Whether it uploaded.
+    fn record_changed_params(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        st: &mut SphState,
+    ) -> bool {
         let mut bytes = bytemuck::bytes_of(&st.gpu_params()).to_vec();
         bytes.extend_from_slice(bytemuck::cast_slice(&st.collider_list));
         let now = (ctx.recording(cmd), bytes);
-        if st.uploaded.as_ref() != Some(&now) {
-            self.record_params(ctx, cmd, st);
-            st.uploaded = Some(now);
+        if st.uploaded.as_ref() == Some(&now) {
+            return false;
         }
+        self.record_params(ctx, cmd, st);
+        st.uploaded = Some(now);
+        true
     }
 
     /// Neighbour structure and every reordered attribute in sorted order.
@@ -511,10 +523,14 @@ impl SphSolver {
         }
         let start = ctx.recorded(cmd);
         scopes.begin(ctx, cmd, super::SCOPE.name());
-        self.record_changed_params(ctx, cmd, st);
-        scopes.begin(ctx, cmd, super::cfl::CflPass::NAME);
-        self.cfl.record(ctx, cmd, st);
-        scopes.end(ctx, cmd);
+        let uploaded = self.record_changed_params(ctx, cmd, st);
+        let recording = ctx.recording(cmd);
+        if uploaded || st.next_dt != Some(recording) {
+            scopes.begin(ctx, cmd, super::cfl::CflPass::NAME);
+            self.cfl.record(ctx, cmd, st);
+            scopes.end(ctx, cmd);
+        }
+        st.next_dt = None;
         Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
         self.record_arrange(ctx, cmd, scopes, st)?;
         let forces = ctx.recorded(cmd);
@@ -523,6 +539,9 @@ impl SphSolver {
         Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
         let solve = ctx.recorded(cmd);
         p.record_solve(self, ctx, cmd, scopes, st)?;
+        if p.sets_next_dt() && st.fluid.cfl.is_some() {
+            st.next_dt = Some(recording);
+        }
         let end = ctx.recorded(cmd);
         scopes.end(ctx, cmd);
         let solves = p.solves();
