@@ -58,11 +58,18 @@ pub fn variants() -> Vec<Variant> {
             .map(|(k, v)| (k.to_string(), v))
             .collect();
         for file in [
-            "primitives/scan_chunk_reduce.comp",
             "primitives/scan_chunk_down.comp",
             "primitives/scan_block.comp",
         ] {
             v.push(with::<scan::ScanIo>(file, &d));
+        }
+        for top in ["0", "1"] {
+            let mut d = d.clone();
+            d.push(("TOP".into(), top.into()));
+            v.push(with::<scan::ScanIo>(
+                "primitives/scan_chunk_reduce.comp",
+                &d,
+            ));
         }
     }
     searches_sph_and_control(&mut v);

@@ -16,7 +16,7 @@ layout(std430, binding = SCAN_B_IN4) readonly buffer In4 { uvec4 in4[]; };  // i
 layout(std430, binding = SCAN_B_IN1) readonly buffer In1 { uint in1[]; };  // input as uint
 layout(std430, binding = SCAN_B_OUT4) writeonly buffer Out4 { uvec4 out4[]; };  // output as uvec4
 layout(std430, binding = SCAN_B_OUT1) writeonly buffer Out1 { uint out1[]; };  // output as uint
-layout(std430, binding = SCAN_B_SUMS) buffer Sums { uint sums[]; };  // chunk sums / offsets
+layout(std430, binding = SCAN_B_SUMS) coherent buffer Sums { uint sums[]; };  // chunk sums / offsets
 
 // Sum of elements [first, first + count) (count a multiple of 4).
 uint run_sum(uint first, uint count) {

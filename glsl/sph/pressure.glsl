@@ -96,15 +96,22 @@ void finish_iteration(uint parts) {
 #if DIVERGENCE
     float target = P.divergence_target;
     uint least = P.div_min_iter;
-    S.divergence_iters = it;
-    S.divergence_err = mean;
 #else
     float target = P.density_target;
     uint least = P.min_iter;
-    S.density_iters = it;
+#endif
+    bool stop = (it >= least && mean <= target) || it >= P.max_iter;
+    // The count's top bit: the solve stopped here, so one whose recorded iterations ran
+    // out before it stopped is told from one that stopped at the last (src/sim/sph/errors.rs).
+    uint count = it | (stop ? 0x80000000u : 0u);
+#if DIVERGENCE
+    S.divergence_iters = count;
+    S.divergence_err = mean;
+#else
+    S.density_iters = count;
     S.density_err = mean;
 #endif
-    if ((it >= least && mean <= target) || it >= P.max_iter) {
+    if (stop) {
         S.done = 1u;
         S.gz = 0u;
     }

@@ -33,9 +33,22 @@ crate::gpu_interface! {
     pub OrderIo / OrderBufs: "ORDER", push CountPush { counts = 0, starts = 1, sorted_vals = 2 }
 }
 
+/// Attributes one gather dispatch moves.
+pub const GATHER_SLOTS: usize = 4;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GatherPush {
+    pub n: u32,
+    /// Slots in use (1..=GATHER_SLOTS).
+    pub count: u32,
+}
+
 crate::gpu_interface! {
-    /// glsl/primitives/gather.comp; push: n.
-    pub GatherIo / GatherBufs: "GATHER", push u32 { perm = 0, src = 1, dst = 2 }
+    /// glsl/primitives/gather.comp
+    pub GatherIo / GatherBufs: "GATHER", push GatherPush {
+        perm = 0, src0 = 1, src1 = 2, src2 = 3, src3 = 4, dst0 = 5, dst1 = 6, dst2 = 7, dst3 = 8,
+    }
 }
 
 pub struct CountingSort {
@@ -134,6 +147,34 @@ impl CountingSort {
             rank: &b.rank,
         };
         self.count.dispatch(ctx, cmd, &bufs, &push, n);
+        self.record_counted(ctx, cmd, scan, b, keys, vals, sorted_keys, sorted_vals, n)
+    }
+
+    /// The sort after its first pass, where another pass has counted the keys into
+    /// `b.counts` and `b.rank` as count.comp does (nb_keys.comp with NB_CELL_COUNTS).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_counted(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scan: &ScanPass,
+        b: &CountingBuffers,
+        keys: &Buffer,
+        vals: &Buffer,
+        sorted_keys: &Buffer,
+        sorted_vals: &Buffer,
+        n: u64,
+    ) -> Result<()> {
+        if n > b.capacity {
+            return Err(Error::Param(format!(
+                "counting sort of {n} elements exceeds capacity {}",
+                b.capacity
+            )));
+        }
+        let push = CountPush {
+            n: n as u32,
+            cells: b.cells,
+        };
         scan.record(
             ctx,
             cmd,
@@ -168,7 +209,7 @@ impl CountingSort {
     }
 }
 
-/// `dst[i] = src[perm[i]]` for vec4 attributes.
+/// `dst[i] = src[perm[i]]` for vec4 attributes, up to [`GATHER_SLOTS`] per dispatch.
 pub struct GatherPass {
     pipeline: ComputePipeline<GatherIo>,
 }
@@ -192,8 +233,38 @@ impl GatherPass {
         dst: &Buffer,
         n: u32,
     ) {
-        self.pipeline
-            .dispatch(ctx, cmd, &GatherBufs { perm, src, dst }, &n, n as u64);
+        self.record_many(ctx, cmd, perm, &[(src, dst)], n);
+    }
+
+    /// Every (src, dst) pair reordered by `perm`, [`GATHER_SLOTS`] to a dispatch.
+    pub fn record_many(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        perm: &Buffer,
+        pairs: &[(&Buffer, &Buffer)],
+        n: u32,
+    ) {
+        for chunk in pairs.chunks(GATHER_SLOTS) {
+            // Slots past the chunk repeat its first pair (bound, never written).
+            let at = |k: usize| chunk.get(k).unwrap_or(&chunk[0]);
+            let bufs = GatherBufs {
+                perm,
+                src0: at(0).0,
+                src1: at(1).0,
+                src2: at(2).0,
+                src3: at(3).0,
+                dst0: at(0).1,
+                dst1: at(1).1,
+                dst2: at(2).1,
+                dst3: at(3).1,
+            };
+            let push = GatherPush {
+                n,
+                count: chunk.len() as u32,
+            };
+            self.pipeline.dispatch(ctx, cmd, &bufs, &push, n as u64);
+        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

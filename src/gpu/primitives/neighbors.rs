@@ -94,7 +94,9 @@ const _: () = assert!(std::mem::size_of::<NeighborPush>() == 48);
 
 crate::gpu_interface! {
     /// glsl/primitives/nb_keys.comp
-    pub NbKeysIo / NbKeysBufs: "NBK", push NeighborPush { pos = 0, keys = 1, vals = 2 }
+    pub NbKeysIo / NbKeysBufs: "NBK", push NeighborPush {
+        pos = 0, keys = 1, vals = 2, counts = 3, rank = 4,
+    }
 }
 
 crate::gpu_interface! {
@@ -415,10 +417,21 @@ impl NeighborSearch {
             bounds.record(ctx, cmd, pos, n as u64, bb)?;
             morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
         } else if let Some(keys) = &self.keys {
+            // With the counting sort the keys pass counts too (NB_CELL_COUNTS); a network
+            // sort's keys pass binds the keys again in their place, unused.
+            let (counts, rank) = match &b.counting {
+                Some(cb) if counting => {
+                    ctx.fill(cmd, &cb.counts, 0);
+                    (&cb.counts, &cb.rank)
+                }
+                _ => (kd, vd),
+            };
             let bufs = NbKeysBufs {
                 pos,
                 keys: kd,
                 vals: vd,
+                counts,
+                rank,
             };
             keys.dispatch(ctx, cmd, &bufs, &push, n as u64);
         }
@@ -427,7 +440,7 @@ impl NeighborSearch {
         match &self.sorter {
             Sorter::Counting(c) => {
                 let cb = b.counting.as_ref().expect("counting buffers");
-                c.record(
+                c.record_counted(
                     ctx,
                     cmd,
                     &self.scan,

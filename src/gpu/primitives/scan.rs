@@ -3,7 +3,9 @@
 //!   loads, no barriers); the chunk sums are the next level, scanned recursively;
 //! - level pass 2: each invocation scans its chunk serially from its offset;
 //! - the top level (at most WG * IPT elements) is one workgroup: a workgroup scan with
-//!   subgroup arithmetic where the device has it, shared memory where it has not.
+//!   subgroup arithmetic where the device has it, shared memory where it has not. Where a
+//!   level's chunk sums are the top, the last workgroup of its pass 1 scans them (TOP):
+//!   such a scan is two dispatches.
 //!
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
@@ -100,6 +102,8 @@ impl Interface for ScanIo {
 /// Pipelines (size-independent).
 pub struct ScanPass {
     chunk_reduce: ComputePipeline<ScanIo>,
+    /// The level pass 1 whose last workgroup also scans the chunk sums (at most BLOCK).
+    chunk_reduce_top: ComputePipeline<ScanIo>,
     chunk_down: ComputePipeline<ScanIo>,
     top: ComputePipeline<ScanIo>,
     pub uses_subgroups: bool,
@@ -150,10 +154,14 @@ impl ScanPass {
         let pipeline = |name, shader| {
             ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, WG))
         };
-        let chunk_reduce = Guard::new(
-            ctx,
-            pipeline("scan chunk sums", "primitives/scan_chunk_reduce.comp")?,
-        );
+        let reduce = |name, top: bool| {
+            let mut d = defines.to_vec();
+            d.push(("TOP", (top as u32).to_string()));
+            let desc = ComputeDesc::plain(name, "primitives/scan_chunk_reduce.comp", &d, WG);
+            ComputePipeline::new(ctx, &desc).map(|p| Guard::new(ctx, p))
+        };
+        let chunk_reduce = reduce("scan chunk sums", false)?;
+        let chunk_reduce_top = reduce("scan chunk sums and top", true)?;
         let chunk_down = Guard::new(
             ctx,
             pipeline("scan chunks", "primitives/scan_chunk_down.comp")?,
@@ -161,6 +169,7 @@ impl ScanPass {
         let top = pipeline("scan top", "primitives/scan_block.comp")?;
         Ok(Self {
             chunk_reduce: chunk_reduce.take(),
+            chunk_reduce_top: chunk_reduce_top.take(),
             chunk_down: chunk_down.take(),
             top,
             uses_subgroups: subgroup,
@@ -182,7 +191,11 @@ impl ScanPass {
         while n > BLOCK {
             n = n.div_ceil(CHUNK as u64);
             let name = format!("scan chunk sums {}", levels.len());
-            levels.push(ctx.storage_buffer(&name, n * 4)?);
+            // One element past the sums: the fused top's arrival counter, kept at 0.
+            levels.push(ctx.storage_buffer(&name, n * 4 + 4)?);
+        }
+        if !levels.is_empty() {
+            ctx.one_shot(|cmd| levels.iter().for_each(|b| ctx.fill(cmd, b, 0)))?;
         }
         Ok(ScanScratch {
             levels: levels.take(),
@@ -288,9 +301,16 @@ impl ScanPass {
                 p.dispatch_groups(ctx, cmd, &bufs, &push, groups);
             }
         };
-        dispatch(&self.chunk_reduce, 0);
         let next = scratch.levels[level].raw;
         let chunks = n.div_ceil(chunk);
+        if chunks <= BLOCK && n <= seg {
+            // One segment whose chunk sums one workgroup scans: that workgroup is the
+            // last of the sums pass to finish.
+            dispatch(&self.chunk_reduce_top, 0);
+            dispatch(&self.chunk_down, inclusive);
+            return;
+        }
+        dispatch(&self.chunk_reduce, 0);
         self.level(
             ctx,
             cmd,
@@ -306,6 +326,7 @@ impl ScanPass {
 
     pub fn destroy(&mut self, ctx: &Context) {
         self.chunk_reduce.destroy(ctx);
+        self.chunk_reduce_top.destroy(ctx);
         self.chunk_down.destroy(ctx);
         self.top.destroy(ctx);
     }

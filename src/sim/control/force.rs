@@ -563,9 +563,8 @@ impl SphHook for ControlForce {
         if !refresh {
             // The last step's stored sums, gathered into this step's particle order.
             scopes.begin(ctx, cmd, "control-force-stored");
-            for (src, dst) in cache.gathers() {
-                g.gather.record(ctx, cmd, &st.nb.perm, src, dst, st.n);
-            }
+            g.gather
+                .record_many(ctx, cmd, &st.nb.perm, &cache.gathers(), st.n);
             g.apply.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
             scopes.end(ctx, cmd);
             return Ok(());

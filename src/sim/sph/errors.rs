@@ -29,6 +29,9 @@ crate::gpu_interface! {
     }
 }
 
+/// The top bit of a solve's iteration count (glsl/sph/pressure.glsl): the solve stopped.
+const STOPPED: u32 = 1 << 31;
+
 /// One step's density error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepError {
@@ -40,6 +43,9 @@ pub struct StepError {
     /// Iterations of the pressure solve (0 for wcsph) and of DFSPH's divergence solve.
     pub iterations: u32,
     pub divergence_iterations: u32,
+    /// Whether each solve (density, divergence) stopped by its own rule (its target, or
+    /// max_iterations) rather than running out of the iterations its frame recorded.
+    pub stopped: [bool; 2],
     /// DFSPH: the divergence solve's mean compression rate times dt at its end.
     pub divergence_error: f32,
     /// The pressure solve's own estimate of the mean density error at its last iteration.
@@ -68,8 +74,9 @@ pub struct DensityErrorStats {
     pub divergence_iterations_mean: f64,
     #[serde(default)]
     pub divergence_error_mean: f64,
-    /// Solves that used every iteration their frame recorded, fewer than max_iterations
-    /// (they may end above their target; see `Stepper::retire_slot`).
+    /// Solves that ran out of the iterations their frame recorded, fewer than
+    /// max_iterations, before they stopped: they ended above their target (see
+    /// `Stepper::retire_slot`).
     #[serde(default)]
     pub bounded_steps: u64,
     /// DFSPH: particle-steps with more neighbours than `fluid.neighbor_list`, searched in
@@ -207,8 +214,9 @@ impl StepErrors {
                 max: r[1],
                 particles: r[2] as u32,
                 dt: r[3],
-                iterations: s[0].to_bits(),
-                divergence_iterations: s[1].to_bits(),
+                iterations: s[0].to_bits() & !STOPPED,
+                divergence_iterations: s[1].to_bits() & !STOPPED,
+                stopped: [s[0].to_bits() & STOPPED != 0, s[1].to_bits() & STOPPED != 0],
                 solver_error: s[2],
                 divergence_error: s[3],
             })

@@ -9,6 +9,7 @@ use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Context, Profiler};
+use crate::kinds::Solver;
 use serde::{Deserialize, Serialize};
 
 /// Chooses steps per frame and watches the state's health. With `cfl`, each step's dt is
@@ -46,10 +47,26 @@ pub struct Stepper {
     rest_density: f32,
     /// The fluid's (min, max) iterations.
     iterations: (u32, u32),
+    /// Spare iterations recorded: the solver's [`spare_iterations`], raised by each frame
+    /// in which a solve ran out.
+    spare: u32,
 }
 
-/// Iterations a solve records beyond the most any step of the last finished frame used.
-pub const SPARE_ITERATIONS: u32 = 2;
+/// Iterations a solve records beyond the most any step of the last finished frame used, at
+/// first: each costs its passes' empty dispatches per solve and step once the solve has
+/// stopped. A frame in which a solve ran out of them raises the run's spare by one (up to
+/// [`MOST_SPARE`]). On the dam break at 64K over a second (lavapipe, 2026-11-28), DFSPH
+/// ran out of none at 1; PCISPH ran out 10 times at 1 and twice at 2; PBF, whose counts
+/// jump from 4 to 48, 19 and 14 times.
+pub fn spare_iterations(solver: Solver) -> u32 {
+    match solver {
+        Solver::Wcsph | Solver::Dfsph => 1,
+        Solver::Pcisph | Solver::Pbf => 2,
+    }
+}
+
+/// The most a run's spare iterations grow to.
+pub const MOST_SPARE: u32 = 8;
 
 impl Stepper {
     pub fn new(ctx: &Context, st: &SphState, slots: usize) -> Result<Self> {
@@ -78,6 +95,7 @@ impl Stepper {
             steps_taken: 0,
             sim_time: 0.0,
             rest_density: st.fluid.rest_density,
+            spare: spare_iterations(st.fluid.solver),
             iterations: {
                 let c = st.fluid.convergence();
                 (c.min_iterations, c.max_iterations)
@@ -171,10 +189,10 @@ impl Stepper {
     /// (on lavapipe about 0.2 ms each, against 5 to 20 ms for a real one; on an H100
     /// about 9 us each with its barrier, which made up half of a 64K DFSPH step when a
     /// frame recorded twice the most iterations used plus 4). So a frame records the most
-    /// iterations any step of the last finished frame took plus [`SPARE_ITERATIONS`], up
-    /// to max_iter; a step that used every iteration recorded (it may have stopped above
-    /// its target) is counted in `bounded_steps`, and the next frame records twice as
-    /// many.
+    /// iterations any step of the last finished frame took plus its [`spare_iterations`], up
+    /// to max_iter; a solve that ran out of them before it stopped (it ended above its
+    /// target) is counted in `bounded_steps`, the next frame records twice as many, and
+    /// the spare grows by one.
     pub fn retire_slot(&mut self, slot: usize, frame: u64) -> Result<()> {
         self.health.check(slot, frame, self.rest_density)?;
         let (steps, recorded) = self.pending[slot];
@@ -192,7 +210,8 @@ impl Stepper {
             }
             for d in 0..2 {
                 most[d] = most[d].max(used[d]);
-                if used[d] > 0 && used[d] >= cap(recorded[d]) && cap(recorded[d]) < max_iter {
+                let ran_out = used[d] >= cap(recorded[d]) && !e.stopped[d];
+                if used[d] > 0 && ran_out && cap(recorded[d]) < max_iter {
                     hit = true;
                     self.density_error.bounded_steps += 1;
                     self.last_bounded_frame = Some(frame);
@@ -208,9 +227,12 @@ impl Stepper {
         self.extra[slot] = 0.0;
         self.retired_time = t;
         self.retired_frames += 1;
+        if hit {
+            self.spare = (self.spare + 1).min(MOST_SPARE);
+        }
         self.bound = match hit {
             true => recorded.map(|r| (2 * cap(r)).min(max_iter)),
-            false => most.map(|m| (m + SPARE_ITERATIONS).min(max_iter)),
+            false => most.map(|m| (m + self.spare).min(max_iter)),
         };
         Ok(())
     }

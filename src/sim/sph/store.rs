@@ -209,9 +209,10 @@ impl ParticleStore {
     ) {
         scopes.begin(ctx, cmd, "reorder");
         let (a, b) = (self.cur, 1 - self.cur);
-        for attr in self.attrs.iter().filter(|x| x.decl.reorder) {
-            gather.record(ctx, cmd, perm, &attr.bufs[a], &attr.bufs[b], self.live);
-        }
+        let pairs: Vec<_> = (self.attrs.iter().filter(|x| x.decl.reorder))
+            .map(|x| (&x.bufs[a], &x.bufs[b]))
+            .collect();
+        gather.record_many(ctx, cmd, perm, &pairs, self.live);
         scopes.end(ctx, cmd);
         self.cur = b;
     }
