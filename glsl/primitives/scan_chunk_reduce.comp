@@ -1,9 +1,10 @@
 #version 450
 // Scan level pass 1: each invocation sums one chunk of CHUNK contiguous elements.
 // No barriers: the chunk sums form the next level of the scan.
-// TOP: the chunk sums fit one workgroup's scan (scan_block.comp's), and the last workgroup
-// to write its sums scans them in place (exclusive), so the level needs no pass of its
-// own; the arrival counter is the sums buffer's last element, 0 between scans.
+// TOP: the chunk sums are few enough for one workgroup (src/gpu/primitives/scan.rs,
+// TOP_MOST), and the last workgroup to write its sums scans them in place (exclusive), so
+// the next level needs no pass of its own; the arrival counter is the sums buffer's last
+// element, 0 between scans.
 #include "common/index.glsl"
 #if TOP
 #include "workgroup.glsl"
@@ -23,12 +24,14 @@ void main() {
     barrier();
     if (!s_last) return;
     memoryBarrierBuffer();
-    uint first = gl_LocalInvocationIndex * IPT;
+    // Each invocation scans a run of `per` sums (at most 64: TOP_MOST).
+    uint per = (chunks + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;
+    uint first = gl_LocalInvocationIndex * per;
     uint s = 0u;
-    for (uint k = 0u; k < IPT; ++k) s += first + k < chunks ? sums[first + k] : 0u;
+    for (uint k = 0u; k < per; ++k) s += first + k < chunks ? sums[first + k] : 0u;
     uint total;
     uint pre = wg_exclusive_scan(s, total);
-    for (uint k = 0u; k < IPT; ++k) {
+    for (uint k = 0u; k < per; ++k) {
         if (first + k < chunks) {
             uint x = sums[first + k];
             sums[first + k] = pre;

@@ -4,8 +4,8 @@
 //! - level pass 2: each invocation scans its chunk serially from its offset;
 //! - the top level (at most WG * IPT elements) is one workgroup: a workgroup scan with
 //!   subgroup arithmetic where the device has it, shared memory where it has not. Where a
-//!   level's chunk sums are the top, the last workgroup of its pass 1 scans them (TOP):
-//!   such a scan is two dispatches.
+//!   level has at most TOP_MOST chunks, the last workgroup of its pass 1 scans their sums
+//!   (TOP): such a scan is two dispatches.
 //!
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
@@ -21,6 +21,10 @@ pub const CHUNK: u32 = 64;
 pub const IPT: u32 = 16;
 /// Most elements the top level scans in one workgroup.
 pub const BLOCK: u64 = (WG * IPT) as u64;
+/// Most chunk sums the last workgroup of a level's first pass scans itself (64 per
+/// invocation): a scan of up to CHUNK * TOP_MOST elements (4M) is two dispatches. (A
+/// 512 x 512 S-buffer's counts and their total, 2^18 + 1, are 4097 chunks: one past BLOCK.)
+pub const TOP_MOST: u64 = WG as u64 * 64;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScanKind {
@@ -303,7 +307,7 @@ impl ScanPass {
         };
         let next = scratch.levels[level].raw;
         let chunks = n.div_ceil(chunk);
-        if chunks <= BLOCK && n <= seg {
+        if chunks <= TOP_MOST && n <= seg {
             // One segment whose chunk sums one workgroup scans: that workgroup is the
             // last of the sums pass to finish.
             dispatch(&self.chunk_reduce_top, 0);
