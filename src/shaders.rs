@@ -218,7 +218,19 @@ fn metaballs(v: &mut Vec<Variant>) {
                         for (counters, lanes) in lane_variants(list, plain) {
                             let mut d = d.clone();
                             d.extend(MetaballSettings::lane_defines(counters, lanes));
-                            v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                            // Every stack size (depth 0..=6) on one list and look; the
+                            // default depth's elsewhere.
+                            let deep = material == Material::Glass
+                                && *density == DensityFn::Wyvill
+                                && *march == crate::kinds::MarchKind::Fixed
+                                && list == ListKind::Sbuffer
+                                && (counters, lanes) == (Counters::Subgroup, Lanes::Blocks);
+                            let depths = if deep { 0..=6 } else { 1..=1 };
+                            for depth in depths {
+                                let mut d = d.clone();
+                                d.extend(MetaballSettings::stack_defines(depth));
+                                v.push(with::<MetaballIo>("render/metaball/march.comp", &d));
+                            }
                         }
                     }
                     if list == ListKind::Tiles {

@@ -352,98 +352,19 @@ vec3 normal_at(vec3 x, uint pixel) {
 
 #include "render/shading.glsl"
 
-// The frame's counters (COUNTERS): rays, samples, terms and candidates, with the longest
-// list and the off-screen samples, added to the workgroup's counter slot (common.glsl: the
-// frame's atomics spread over MARCH_SLOTS cache lines, summed by the host). WORKGROUP:
-// each subgroup's sums meet in shared memory and one invocation per workgroup adds them;
-// SUBGROUP: each subgroup adds its own; OFF: nothing counted (the increments above are
-// then dead code), to measure what counting costs. (Before: every subgroup's atomics, and
-// every pixel's longest list, met on stats' one cache line.) 64-bit totals stay exact:
-// the low and high 16 bits of each count are summed apart (each sum fits 32 bits) and
-// ADD64 adds them to the slot's (lo, hi) total at word W with its carries.
-#define ADD64(W, LO, HI) { \
-    uint lo_ = (LO), hi_ = (HI); \
-    uint a_ = lo_ + (hi_ << 16), c_ = (hi_ >> 16) + (a_ < lo_ ? 1u : 0u); \
-    uint o_ = atomicAdd(march_slots[W], a_); \
-    c_ += o_ + a_ < o_ ? 1u : 0u; \
-    if (c_ > 0u) atomicAdd(march_slots[(W) + 1u], c_); }
-
-// Each subgroup's sums (the longest list its max).
-struct Sums { uint rays, longest, offscreen; uint lo[3], hi[3]; };
-Sums subgroup_sums() {
-    Sums s;
-    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
-    s.rays = subgroupAdd(n_rays);
-    s.longest = subgroupMax(longest);
-    s.offscreen = subgroupAdd(offscreen_samples);
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-        s.lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
-        s.hi[k] = subgroupAdd(counts[k] >> 16);
-    }
-    return s;
-}
-
-// Sums added to the workgroup's slot, each only where it is not zero.
-void add_sums(Sums s) {
-    uint at = (group_id() % MARCH_SLOTS) * MARCH_SLOT_WORDS;
-    if (s.rays > 0u) atomicAdd(march_slots[at], s.rays);
-    if (s.longest > 0u) atomicMax(march_slots[at + 1u], s.longest);
-    if (s.offscreen > 0u) atomicAdd(march_slots[at + 2u], s.offscreen);
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-        if (s.lo[k] > 0u || s.hi[k] > 0u) ADD64(at + 3u + 2u * k, s.lo[k], s.hi[k])
-    }
-}
-
-#if COUNTERS == COUNTERS_WORKGROUP
-// rays, longest, off-screen, then (lo, hi) of steps, evals, candidates.
-shared uint c_sum[9];
-void add_counters() {
-    if (gl_LocalInvocationIndex == 0u) {
-        [[unroll]] for (uint k = 0u; k < 9u; ++k) c_sum[k] = 0u;
-    }
-    barrier();
-    Sums s = subgroup_sums();
-    if (subgroupElect()) {
-        atomicAdd(c_sum[0], s.rays);
-        atomicMax(c_sum[1], s.longest);
-        atomicAdd(c_sum[2], s.offscreen);
-        [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-            atomicAdd(c_sum[3u + k], s.lo[k]);
-            atomicAdd(c_sum[6u + k], s.hi[k]);
-        }
-    }
-    barrier();
-    if (gl_LocalInvocationIndex != 0u) return;
-    Sums w;
-    w.rays = c_sum[0];
-    w.longest = c_sum[1];
-    w.offscreen = c_sum[2];
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
-        w.lo[k] = c_sum[3u + k];
-        w.hi[k] = c_sum[6u + k];
-    }
-    add_sums(w);
-}
-#elif COUNTERS == COUNTERS_SUBGROUP
-void add_counters() {
-    Sums s = subgroup_sums();
-    if (subgroupElect()) add_sums(s);
-}
-#elif COUNTERS == COUNTERS_OFF
-void add_counters() {}
-#else
-#error "COUNTERS names no counter mode"
-#endif
+#include "march_counters.glsl"
 
 struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; vec2 cone; };
 
-const int STACK = 8;
 // Glass and tinted branch into two paths per hit and keep the ones waiting on a stack;
 // Phong (the primary ray alone) and the metals (each reflection replaces its path) follow
-// one path at a time: no array indexed at run time, which a GPU compiler puts in local
-// memory even when only one entry is ever used.
+// one path at a time. The stack is STACK named slots, not an array indexed at run time
+// (which a GPU compiler puts in local memory even when one entry is used): STACK is the
+// recursion depth + 1, the most a depth-first walk holds (a waiting sibling per level
+// and a hit's two paths), so it never overflows.
 #if MATERIAL == MATERIAL_GLASS || MATERIAL == MATERIAL_TINTED
 #define STACKED 1
+#include "march_stack.glsl"
 #elif MATERIAL == MATERIAL_PHONG || MATERIAL == MATERIAL_METAL
 #define STACKED 0
 #else
@@ -493,11 +414,9 @@ void march_pixel() {
     vec3 color = vec3(0.0);
     vec4 dbg = vec4(-1.0, 0.0, 0.0, 0.0);
 #if STACKED
-    Path stack[STACK];
-    int sp = 0;
-    stack[sp++] = Path(o, d, vec3(1.0), 0u, false, cone);
+    push(Path(o, d, vec3(1.0), 0u, false, cone));
     while (sp > 0) {
-        Path r = stack[--sp];
+        Path r = pop();
 #else
     Path r = Path(o, d, vec3(1.0), 0u, false, cone);
     bool more = true;
@@ -557,9 +476,9 @@ void march_pixel() {
         Path refl = Path(x + nn * eps, rd, w * F, r.depth + 1u, r.inside, cone_bent(hit_cone, P.eye.w, 2.0));
         Path refr = Path(x - nn * eps, normalize(td), w * (1.0 - F), r.depth + 1u, !r.inside, cone_bent(hit_cone, P.eye.w, 1.0));
         bool deep = r.depth + 1u > P.depth;
-        if (deep || sp >= STACK) color += refl.w * sky_color(rd, refl.cone); else stack[sp++] = refl;
+        if (deep || sp >= STACK) color += refl.w * sky_color(rd, refl.cone); else push(refl);
         if (F < 1.0) {
-            if (deep || sp >= STACK) color += refr.w * sky_color(refr.d, refr.cone); else stack[sp++] = refr;
+            if (deep || sp >= STACK) color += refr.w * sky_color(refr.d, refr.cone); else push(refr);
         }
 #endif
 #else

@@ -259,7 +259,14 @@ impl MetaballSettings {
         let mut d = Self::defines_for(self.list, self.density, self.material, self.sorts_lists());
         d.extend(Self::march_defines(self.march));
         d.extend(Self::lane_defines(self.counters, self.lanes));
+        d.extend(Self::stack_defines(self.depth));
         d
+    }
+
+    /// march.comp's path stack for recursion depth `depth`: STACK, its slots (depth + 1,
+    /// the most a depth-first walk of glass and tinted holds).
+    pub fn stack_defines(depth: u32) -> Vec<(String, String)> {
+        vec![("STACK".to_string(), (depth + 1).to_string())]
     }
 
     /// The march.comp defines of its counters and lane layout (COUNTERS, LANES and their
