@@ -244,3 +244,45 @@ fn switches_that_do_not_apply_are_refused() {
         (BuildKind::Compute, 32, "tiles-32")
     );
 }
+
+/// `run`'s default S-buffer (built in compute, sorted) draws the thesis's (raster,
+/// unsorted) pictures, and is taken only where no switch asks for the thesis's build.
+#[test]
+fn runs_default_sbuffer_draws_the_thesis_pictures() {
+    let ctx = common::ctx();
+    let run = |args: &[&str]| fluidform::settings::run_metaball_settings(&switches(args), N as u32);
+    let s = run(&[]).unwrap();
+    assert_eq!((s.build, s.sorted), (BuildKind::Compute, true));
+    let s = run(&["--build", "raster"]).unwrap();
+    assert_eq!((s.build, s.sorted), (BuildKind::Raster, false));
+    let s = run(&["--list-sort", "off"]).unwrap();
+    assert_eq!((s.build, s.sorted), (BuildKind::Raster, false));
+    assert_eq!(
+        run(&["--list", "abuffer"]).unwrap().build,
+        BuildKind::Raster
+    );
+    for (material, depth) in [
+        (Material::Phong, 1),
+        (Material::Tinted, 2),
+        (Material::Gold, 1),
+    ] {
+        let mut thesis = settings(97, 71, ListKind::Sbuffer, BuildKind::Raster, false);
+        (thesis.material, thesis.depth) = (material, depth);
+        let mut fast = run(&[]).unwrap();
+        (fast.width, fast.height, fast.material, fast.depth) = (97, 71, material, depth);
+        let (a, b) = (render(&ctx, thesis, None), render(&ctx, fast, None));
+        let exact = agreement(&a.pixels, &b.pixels, 0);
+        let near = agreement(&a.pixels, &b.pixels, 2);
+        eprintln!(
+            "{material:?}: {:.3}% exact, {:.3}% within 2/255",
+            exact * 100.0,
+            near * 100.0
+        );
+        assert!(
+            near >= 0.999,
+            "{material:?}: {:.2}% within 2/255",
+            near * 100.0
+        );
+    }
+    common::finish(&ctx);
+}

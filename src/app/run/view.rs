@@ -248,7 +248,7 @@ impl MetaballViewer {
         show: ShowMesh,
         overlay: bool,
     ) -> Result<Self> {
-        let mut settings = crate::settings::metaball_settings(sw)?;
+        let mut settings = crate::settings::run_metaball_settings(sw, n)?;
         settings.tank = tank;
         settings.fluid = Some(fluid);
         settings.opaque = show != ShowMesh::Off || overlay;
