@@ -2,6 +2,9 @@
 //! set, a step starts with the largest speed of its particles and takes
 //! dt = min(dt_max, cfl h / max(v_max, c)) (c: wcsph's speed of sound, else 0), written
 //! into the parameters every pass reads, the previous step's dt kept for the warm starts.
+//! One dispatch: its last workgroup sets dt (glsl/sph/cfl.glsl). PCISPH's and DFSPH's
+//! Euler pass does the same for the next step from the velocities it leaves, so a step
+//! that follows in the same recording with its parameters not uploaded again records none.
 //! The host records a frame's steps from the last finished frame's dt and how far the
 //! simulated time trails the frames (`stepper::Stepper`): no step is snapped to the frame
 //! grid, and the time a frame leaves over carries into the next.

@@ -6,7 +6,7 @@
 //! the predicted velocities, both warm-started with last step's stiffness, then symplectic
 //! Euler (glsl/sph/dfsph.comp, euler.comp). The divergence solve's warm start is part of
 //! the factor pass, the prediction part of the density solve's first passes, and each
-//! iteration's source pass ends the iteration: a step at 2 + 1 iterations runs 15
+//! iteration's source pass ends the iteration: a step at 2 + 1 iterations runs 14
 //! dispatches from factor to Euler, and each spare iteration recorded 2 empty ones.
 use super::pressure::{
     check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
