@@ -67,7 +67,8 @@ fn bad_scene_input_is_refused_quickly() {
 }
 
 /// BYTES_PER_PARTICLE, used to refuse scenes that cannot fit, bounds what a run allocates
-/// per particle (every buffer but the pixel-sized ones).
+/// per particle (every buffer but the pixel-sized ones and those sized by the metaballs'
+/// screen coverage, which grow on overflow: the lists, and the compute build's tile pairs).
 #[test]
 fn bytes_per_particle_bounds_the_allocation() {
     let dir = tempfile::tempdir().unwrap();
@@ -79,7 +80,16 @@ fn bytes_per_particle_bounds_the_allocation() {
     );
     let n = s["stats"]["particles"].as_u64().unwrap();
     let pixel_sized = [
-        "render", "sbuffer", "abuffer", "sky", "frame", "color", "depth",
+        "render",
+        "sbuffer",
+        "abuffer",
+        "sky",
+        "frame",
+        "color",
+        "depth",
+        "tile ranges",
+        "tile pair",
+        "tile metaballs",
     ];
     let per_particle: u64 = s["memory_bytes"]
         .as_object()
