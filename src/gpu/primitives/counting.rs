@@ -51,6 +51,22 @@ crate::gpu_interface! {
     }
 }
 
+impl CountPush {
+    /// The push constants of a sort of `n` elements, which `b` must hold.
+    fn checked(b: &CountingBuffers, n: u64) -> Result<Self> {
+        if n > b.capacity {
+            return Err(Error::Param(format!(
+                "counting sort of {n} elements exceeds capacity {}",
+                b.capacity
+            )));
+        }
+        Ok(Self {
+            n: n as u32,
+            cells: b.cells,
+        })
+    }
+}
+
 pub struct CountingSort {
     count: ComputePipeline<CountIo>,
     scatter: ComputePipeline<ScatterIo>,
@@ -130,16 +146,7 @@ impl CountingSort {
         sorted_vals: &Buffer,
         n: u64,
     ) -> Result<()> {
-        if n > b.capacity {
-            return Err(Error::Param(format!(
-                "counting sort of {n} elements exceeds capacity {}",
-                b.capacity
-            )));
-        }
-        let push = CountPush {
-            n: n as u32,
-            cells: b.cells,
-        };
+        let push = CountPush::checked(b, n)?;
         ctx.fill(cmd, &b.counts, 0);
         let bufs = CountBufs {
             keys,
@@ -165,16 +172,7 @@ impl CountingSort {
         sorted_vals: &Buffer,
         n: u64,
     ) -> Result<()> {
-        if n > b.capacity {
-            return Err(Error::Param(format!(
-                "counting sort of {n} elements exceeds capacity {}",
-                b.capacity
-            )));
-        }
-        let push = CountPush {
-            n: n as u32,
-            cells: b.cells,
-        };
+        let push = CountPush::checked(b, n)?;
         scan.record(
             ctx,
             cmd,
