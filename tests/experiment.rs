@@ -2,7 +2,7 @@
 //! thesis scene, renderer reuse against fresh renderers, and refusals.
 mod common;
 use common::{ctx, finish, fluidform, text};
-use fluidform::config::{ListKind, Switches};
+use fluidform::config::ListKind;
 use fluidform::control::inside::InsideTest;
 use fluidform::experiment::thesis::Body;
 use fluidform::experiment::{findings, tables, Experiment};
@@ -292,7 +292,7 @@ fn a_retuned_renderer_draws_what_a_new_one_draws() {
     let cam = blob_camera(n, spacing, 1.0);
     let mut centers = ctx.storage_buffer("centers", (n * 16) as u64).unwrap();
     ctx.upload(&mut centers, 0, &pts).unwrap();
-    let mut base = fluidform::settings::metaball_settings(&Switches::default()).unwrap();
+    let mut base = fluidform::render::metaball::MetaballSettings::thesis();
     base.width = w;
     base.height = w;
     base.list = ListKind::Sbuffer;

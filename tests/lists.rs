@@ -23,7 +23,7 @@ fn switches(args: &[&str]) -> Switches {
 }
 
 fn settings(w: u32, h: u32, list: ListKind, build: BuildKind, sorted: bool) -> MetaballSettings {
-    let mut s = fluidform::settings::metaball_settings(&switches(&[])).unwrap();
+    let mut s = MetaballSettings::thesis();
     (s.width, s.height, s.list, s.build, s.sorted) = (w, h, list, build, sorted);
     s
 }
@@ -285,4 +285,13 @@ fn runs_default_sbuffer_draws_the_thesis_pictures() {
         );
     }
     common::finish(&ctx);
+}
+
+/// No switch set gives the thesis's renderer, named once (`MetaballSettings::thesis`).
+#[test]
+fn no_switch_gives_the_thesis_settings() {
+    let s = fluidform::settings::metaball_settings(&switches(&[])).unwrap();
+    assert_eq!(s, MetaballSettings::thesis());
+    let tiles = fluidform::settings::metaball_settings(&switches(&["--list", "tiles"])).unwrap();
+    assert_eq!(tiles.build, BuildKind::Compute);
 }

@@ -2,7 +2,7 @@
 //! CPU reference marcher and against what each list holds; `--march lipschitz` against the
 //! fixed march: the same hits and pictures from fewer samples.
 mod common;
-use fluidform::config::{Counters, Lanes, ListKind, MarchKind, Material, Switches};
+use fluidform::config::{Counters, Lanes, ListKind, MarchKind, Material};
 use fluidform::render::metaball::reference::{march_counted, ray_box, MarchParams};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, FrameStats, MetaballSettings};
 use glam::Vec3;
@@ -14,7 +14,7 @@ const SPACING: f32 = 0.0271;
 
 /// The blob's Phong settings with `list`.
 fn settings(list: ListKind) -> MetaballSettings {
-    let mut s = fluidform::settings::metaball_settings(&Switches::default()).unwrap();
+    let mut s = fluidform::render::metaball::MetaballSettings::thesis();
     s.list = list;
     s.material = Material::Phong;
     s.width = W;

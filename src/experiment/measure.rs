@@ -49,10 +49,11 @@ fn slug(s: &str) -> String {
 
 /// The thesis defaults (Wyvill, T 0.9, R 0.04, I 2, Phong, depth 1) at the table's size.
 pub fn base(width: u32, height: u32) -> Result<MetaballSettings> {
-    let mut s = crate::settings::metaball_settings(&crate::config::Switches::default())?;
-    s.width = width;
-    s.height = height;
-    Ok(s)
+    Ok(MetaballSettings {
+        width,
+        height,
+        ..MetaballSettings::thesis()
+    })
 }
 
 pub fn table(ctx: &Context, env: &mut Env, def: TableDef) -> Result<(Vec<PathBuf>, Vec<Finding>)> {

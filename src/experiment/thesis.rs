@@ -143,7 +143,7 @@ impl ThesisScene {
             list: ListKind::Sbuffer,
             width,
             height,
-            ..crate::settings::metaball_settings(&crate::config::Switches::default())?
+            ..MetaballSettings::thesis()
         };
         let aspect = width as f32 / height as f32;
         let mut distance = 3.0 * body.height;

@@ -3,55 +3,44 @@
 use crate::config::Switches;
 use crate::control::target::ControlDesc;
 use crate::error::{Error, Result};
-use crate::kinds::{BuildKind, DensityFn, ListKind, MarchKind, Material, SurfaceKind};
+use crate::kinds::{BuildKind, ListKind, Material, SurfaceKind};
 use crate::render::metaball::MetaballSettings;
 
-/// The metaball settings: the thesis's defaults (Wyvill, T = 0.9, R = 0.04, I = 2, Phong, S-buffer),
-/// overridden by the switches that are set.
+/// The metaball settings: the thesis's (`MetaballSettings::thesis`), overridden by the
+/// switches that are set.
 pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
-    let radius = sw.metaball.radius.unwrap_or(0.04);
+    let t = MetaballSettings::thesis();
+    let m = &sw.metaball;
+    let radius = m.radius.unwrap_or(t.radius);
     let mut s = MetaballSettings {
-        list: sw.metaball.list.unwrap_or(ListKind::Sbuffer),
-        density: sw.metaball.density.unwrap_or(DensityFn::Wyvill),
-        material: sw.metaball.material.unwrap_or(Material::Phong),
-        threshold: sw.metaball.threshold.unwrap_or(0.9),
+        list: m.list.unwrap_or(t.list),
+        density: m.density.unwrap_or(t.density),
+        material: m.material.unwrap_or(t.material),
+        threshold: m.threshold.unwrap_or(t.threshold),
         radius,
-        refine: sw.metaball.refine.unwrap_or(2),
-        depth: sw.metaball.depth.unwrap_or(1),
+        refine: m.refine.unwrap_or(t.refine),
+        depth: m.depth.unwrap_or(t.depth),
         step: radius / 8.0,
-        max_steps: 2048,
-        march: sw.metaball.march.unwrap_or(MarchKind::Fixed),
-        counters: sw
-            .metaball
-            .counters
-            .unwrap_or(crate::kinds::Counters::Subgroup),
-        lanes: sw.metaball.lanes.unwrap_or(crate::kinds::Lanes::Blocks),
-        build: sw.metaball.build.unwrap_or(BuildKind::Raster),
-        tile: sw.metaball.tile.unwrap_or(16),
-        offscreen_end: sw
-            .metaball
+        march: m.march.unwrap_or(t.march),
+        counters: m.counters.unwrap_or(t.counters),
+        lanes: m.lanes.unwrap_or(t.lanes),
+        build: m.build.unwrap_or(t.build),
+        tile: m.tile.unwrap_or(t.tile),
+        offscreen_end: m
             .offscreen
             .map(|o| o == crate::kinds::Offscreen::End)
-            .unwrap_or(false),
+            .unwrap_or(t.offscreen_end),
         // Sorting pays where rays read the lists many times: inside glass and tinted.
-        sorted: match sw.metaball.list_sort {
+        sorted: match m.list_sort {
             Some(o) => o == crate::kinds::OnOff::On,
-            None => matches!(
-                sw.metaball.material,
-                Some(Material::Glass) | Some(Material::Tinted)
-            ),
+            None => matches!(m.material, Some(Material::Glass) | Some(Material::Tinted)),
         },
         width: sw.frame.width(),
         height: sw.frame.height(),
-        ior: 1.33,
-        absorb: [6.0, 2.0, 0.8],
-        base: [0.08, 0.06, 0.05],
-        tank: None,
-        sky: sw.metaball.sky.clone(),
-        opaque: false,
-        surface: sw.metaball.surface.unwrap_or(SurfaceKind::Metaballs),
-        mesh_cell: sw.metaball.mesh_cell.unwrap_or(0.5),
-        fluid: None,
+        sky: m.sky.clone(),
+        surface: m.surface.unwrap_or(t.surface),
+        mesh_cell: m.mesh_cell.unwrap_or(t.mesh_cell),
+        ..t
     };
     if s.surface != SurfaceKind::Metaballs {
         let m = &sw.metaball;
@@ -80,16 +69,9 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
     } else if sw.metaball.mesh_cell.is_some() {
         return Err(Error::Param("--mesh-cell belongs to --surface mesh".into()));
     }
-    match (s.list, sw.metaball.build) {
-        (ListKind::Tiles, Some(BuildKind::Raster)) => {
-            return Err(Error::Param(
-                "--list tiles is built in compute (its pairs are sorted by tile and depth); \
-                 --build raster applies to the S-buffer"
-                    .into(),
-            ))
-        }
-        (ListKind::Tiles, _) => s.build = BuildKind::Compute,
-        _ => {}
+    // Tiles are built in compute; an explicit --build raster is refused by `validate`.
+    if s.list == ListKind::Tiles && sw.metaball.build.is_none() {
+        s.build = BuildKind::Compute;
     }
     if sw.metaball.tile.is_some() && s.build != BuildKind::Compute {
         return Err(Error::Param(format!(

@@ -77,6 +77,45 @@ pub struct MetaballSettings {
     pub fluid: Option<SurfaceFluid>,
 }
 
+impl MetaballSettings {
+    /// The thesis's renderer: Wyvill's density at T = 0.9, R = 0.04, march step R / 8 (at
+    /// most 2048), I = 2 bisection steps, Phong, the S-buffer built by raster and unsorted,
+    /// recursion depth 1 for the materials that branch, 512 x 512; water's index of
+    /// refraction and tint. What every switch left unset gives (`settings::metaball_settings`).
+    pub fn thesis() -> Self {
+        let radius = 0.04;
+        Self {
+            list: ListKind::Sbuffer,
+            density: DensityFn::Wyvill,
+            material: Material::Phong,
+            threshold: 0.9,
+            radius,
+            refine: 2,
+            depth: 1,
+            step: radius / 8.0,
+            max_steps: 2048,
+            march: MarchKind::Fixed,
+            counters: Counters::Subgroup,
+            lanes: Lanes::Blocks,
+            build: BuildKind::Raster,
+            tile: 16,
+            offscreen_end: false,
+            sorted: false,
+            width: 512,
+            height: 512,
+            ior: 1.33,
+            absorb: [6.0, 2.0, 0.8],
+            base: [0.08, 0.06, 0.05],
+            tank: None,
+            sky: None,
+            opaque: false,
+            surface: SurfaceKind::Metaballs,
+            mesh_cell: 0.5,
+            fluid: None,
+        }
+    }
+}
+
 fn metaballs() -> SurfaceKind {
     SurfaceKind::Metaballs
 }
@@ -217,7 +256,11 @@ impl MetaballSettings {
         }
         match (self.list, self.build) {
             (ListKind::Tiles, BuildKind::Raster) => {
-                return Err(Error::Param("--list tiles is built in compute".into()))
+                return Err(Error::Param(
+                    "--list tiles is built in compute (its pairs are sorted by tile and \
+                     depth); --build raster applies to the S-buffer"
+                        .into(),
+                ))
             }
             (ListKind::None | ListKind::Abuffer, BuildKind::Compute) => {
                 return Err(Error::Param(format!(
