@@ -42,19 +42,19 @@ fluidform_gpu::switch_enum!(
     }
 );
 
-/// Who measures through the benchmarks' machinery: a benchmark, or an experiment (whose
-/// name then labels the outputs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Who measures through the benchmarks' machinery: a benchmark, or an experiment, by its
+/// name, which then labels the outputs (the benchmarks know no experiment).
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Measurer {
     Bench(Bench),
-    Experiment(crate::experiment::Experiment),
+    Experiment(String),
 }
 
 impl std::fmt::Display for Measurer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Measurer::Bench(b) => b.fmt(f),
-            Measurer::Experiment(e) => e.fmt(f),
+            Measurer::Experiment(e) => f.write_str(e),
         }
     }
 }
@@ -163,7 +163,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         validation: sw.common.validation,
         present: None,
     })?;
-    let Measurer::Bench(bench) = opts.what else {
+    let Measurer::Bench(bench) = opts.what.clone() else {
         return Err(Error::Bug(format!(
             "bench::run runs benchmarks; {} measures through bench::measure",
             opts.what

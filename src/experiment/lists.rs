@@ -125,7 +125,10 @@ fn thesis_frame(
     let centers = env.scene(ctx)?.centers.clone();
     let cam = env.scene(ctx)?.camera;
     let n = centers.len();
-    let opts = env.bench_options(Measurer::Experiment(Experiment::Lists), Experiment::Lists);
+    let opts = env.bench_options(
+        Measurer::Experiment(Experiment::Lists.as_str()),
+        Experiment::Lists,
+    );
     let floor = Floor::measure(ctx, &opts)?;
     let mut buf = Guard::new(ctx, ctx.storage_buffer("thesis centers", (n * 16) as u64)?);
     ctx.upload(&mut buf, 0, &centers)?;

@@ -68,7 +68,7 @@ fn run(ctx: &Context, env: &mut Env, def: &TableDef) -> Result<Measured> {
     let seed = env.switches.common.seed;
     let base_centers = env.scene(ctx)?.centers.clone();
     let cam = env.scene(ctx)?.camera;
-    let opts = env.bench_options(Measurer::Experiment(def.name), def.name);
+    let opts = env.bench_options(Measurer::Experiment(def.name.as_str()), def.name);
     let (width, height) = (env.width, env.height);
     let mut steps = Steps::new(
         &def.name.as_str(),
@@ -434,7 +434,9 @@ fn setup_text(env: &Env, def: &TableDef, m: &Measured) -> Result<String> {
         scene.target_fragments,
         scene.fragments,
         scene.fragments as f64 / scene.centers.len() as f64,
-        crate::bench::protocol_text(&env.bench_options(Measurer::Experiment(def.name), def.name)),
+        crate::bench::protocol_text(
+            &env.bench_options(Measurer::Experiment(def.name.as_str()), def.name)
+        ),
     ));
     Ok(md)
 }

@@ -28,7 +28,10 @@ pub fn solves(ctx: &Context, env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding
     let mut base = Scene::built_in("dam-break")?.with_particles(n);
     // Frames of 4 WCSPH steps (1.6 ms): a DFSPH frame takes one or two of its own.
     base.fluid.substeps = 4;
-    let mut opts = env.bench_options(Measurer::Experiment(Experiment::Solves), Experiment::Solves);
+    let mut opts = env.bench_options(
+        Measurer::Experiment(Experiment::Solves.as_str()),
+        Experiment::Solves,
+    );
     (opts.warmup, opts.frames) = (8, env.frames.clamp(2, 10));
     let mut sph = Guard::new(
         ctx,
