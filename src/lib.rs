@@ -1,11 +1,12 @@
 //! fluidform: a Rust + Vulkan research testbed for liquid characters. This crate is the top:
-//! the benchmarks, the experiments and their tables, the shader registry, and the binary.
+//! the benchmarks, the experiments and their tables, `inspect`, the shader registry, and the binary.
 //! The layers below are crates of their own: the runs and the window (`fluidform-app`,
 //! src/app), the switches, scenes and outputs (`fluidform-setup`, src/setup), the simulation and rendering
 //! (`fluidform-sim`, src/sim) and the GPU layer (`fluidform-gpu`, src/gpu), all re-exported
 //! here under their module names. See README.md and docs/.
 pub mod bench;
 pub mod experiment;
+pub mod inspect;
 pub mod provenance;
 pub mod shaders;
 

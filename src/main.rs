@@ -255,7 +255,7 @@ fn real_main() -> Result<()> {
             up,
             picture,
         } => {
-            use fluidform::bench::picture::inspect;
+            use fluidform::inspect::inspect;
             print!("{}", inspect(&file, up, picture.as_deref(), json)?);
             Ok(())
         }

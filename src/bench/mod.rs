@@ -8,7 +8,6 @@ pub mod floor;
 pub mod interval;
 pub mod march;
 pub mod particles;
-pub mod picture;
 pub mod plot;
 pub mod primitives;
 pub mod protocol;

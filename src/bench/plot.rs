@@ -13,7 +13,7 @@ const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 /// GPU machine gets only the binary.
 const EMBEDDED: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/font.ttf"));
 
-pub(super) fn err(path: &Path, e: impl std::fmt::Display) -> Error {
+pub(crate) fn err(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Image {
         path: path.display().to_string(),
         message: e.to_string(),
@@ -21,7 +21,7 @@ pub(super) fn err(path: &Path, e: impl std::fmt::Display) -> Error {
 }
 
 /// Register the font once; plotters draws text with it.
-pub(super) fn font() -> Result<()> {
+pub(crate) fn font() -> Result<()> {
     static DONE: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
     DONE.get_or_init(|| {
         let bytes: &'static [u8] = match EMBEDDED.is_empty() {

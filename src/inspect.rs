@@ -1,6 +1,6 @@
-//! `inspect FILE --picture PNG`: the character's rest pose from the front and the side
-//! (character::picture) with the views and the up axis named on it.
-use super::plot::{err, font};
+//! `fluidform inspect FILE`: the character's report, and with `--picture PNG` its rest pose
+//! from the front and the side (character::picture), the views and the up axis named on it.
+use crate::bench::plot::{err, font};
 use crate::character::{anim::Up, picture, Character};
 use crate::error::Result;
 use plotters::prelude::*;
