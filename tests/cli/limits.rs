@@ -249,7 +249,7 @@ fn run_pass_times_agree_with_bench() {
         let ran = run["pass_ms"][pass]["median"].as_f64().unwrap() / steps_per_frame;
         let ratio = ran / bench;
         // Within 3x: two separate runs on a shared CPU differ by up to 1.5x (measured),
-        // 2.08x with another build beside them (2026-11-28); the misattribution this
+        // 2.08x with other work on the machine (2026-11-28); the misattribution this
         // guards against was 100x (0.02 against 3 ms).
         assert!(
             (1.0 / 3.0..=3.0).contains(&ratio),
