@@ -94,8 +94,7 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
 /// that where neither `--build` nor `--list-sort` is given, the S-buffer is built in compute
 /// and sorted by depth, its fastest form on every device measured (H200 Phong thesis frame
 /// 0.86 ms against the thesis's raster build's 12.6; lavapipe 601 against 813 ms sorted):
-/// each pixel holds the same metaballs (tests/lists.rs) and the pictures agree
-/// (tests/render.rs). Bench and experiment keep the thesis's build. A frame whose tile pair
+/// each pixel holds the same metaballs and the pictures agree (tests/lists.rs). Bench and experiment keep the thesis's build. A frame whose tile pair
 /// keys would not fit 32 bits keeps the raster build, and says so in one line.
 pub fn run_metaball_settings(sw: &Switches, n: u32) -> Result<MetaballSettings> {
     let mut s = metaball_settings(sw)?;

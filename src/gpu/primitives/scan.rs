@@ -106,7 +106,7 @@ impl Interface for ScanIo {
 /// Pipelines (size-independent).
 pub struct ScanPass {
     chunk_reduce: ComputePipeline<ScanIo>,
-    /// The level pass 1 whose last workgroup also scans the chunk sums (at most BLOCK).
+    /// The level pass 1 whose last workgroup also scans the chunk sums (at most TOP_MOST).
     chunk_reduce_top: ComputePipeline<ScanIo>,
     chunk_down: ComputePipeline<ScanIo>,
     top: ComputePipeline<ScanIo>,

@@ -229,14 +229,6 @@ impl PressureSolver for Dfsph {
         DENSITY.iteration.len() as u32
     }
 
-    fn solves(&self) -> [bool; 2] {
-        [true, true]
-    }
-
-    fn sets_next_dt(&self) -> bool {
-        true
-    }
-
     /// In place of the density and forces passes: densities, factors and the step's
     /// neighbour lists, the divergence-free solve, the non-pressure forces (from the lists).
     fn record_forces(

@@ -154,10 +154,6 @@ impl PressureSolver for Pbf {
         (CHECKED.len() + REST.len()) as u32
     }
 
-    fn solves(&self) -> [bool; 2] {
-        [true, false]
-    }
-
     /// After the forces pass (no viscous force: XSPH replaces it) and the force hooks.
     fn record_solve(
         &self,

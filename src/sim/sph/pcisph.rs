@@ -109,14 +109,6 @@ impl PressureSolver for Pcisph {
         (CHECKED.len() + REST.len()) as u32
     }
 
-    fn solves(&self) -> [bool; 2] {
-        [true, false]
-    }
-
-    fn sets_next_dt(&self) -> bool {
-        true
-    }
-
     /// acc = the non-pressure acceleration; the density pass left every pressure at 0.
     fn record_solve(
         &self,

@@ -157,15 +157,18 @@ pub trait PressureSolver {
         0
     }
 
-    /// The iterative solves a step records: (density, divergence).
+    /// The iterative solves a step records, (density, divergence): those its pass table
+    /// checks.
     fn solves(&self) -> [bool; 2] {
-        [false; 2]
+        let passes = registered(self.kind()).0;
+        [false, true].map(|div| passes.iter().any(|d| d.check && d.divergence == div))
     }
 
-    /// Whether its step ends with euler.comp, which takes the next step's dt when the
-    /// fluid sets a CFL number (so the next step in the same recording records no cfl pass).
+    /// Whether its step ends with euler.comp (its pass table holds it), which takes the
+    /// next step's dt when the fluid sets a CFL number (so the next step in the same
+    /// recording records no cfl pass).
     fn sets_next_dt(&self) -> bool {
-        false
+        registered(self.kind()).0.contains(&EULER)
     }
 
     /// Whether its states need [`PressureBuffers`].

@@ -27,20 +27,20 @@ pub struct MetaballSettings {
     pub step: f32,
     pub max_steps: u32,
     /// The primary rays' march: the fixed grid, or skipping what the Lipschitz bound proves.
-    #[serde(default = "fixed")]
+    #[serde(default = "thesis_march")]
     pub march: MarchKind,
     /// How the march counts rays, samples and terms (off: no counts, to measure their cost).
-    #[serde(default = "subgroup")]
+    #[serde(default = "thesis_counters")]
     pub counters: Counters,
     /// How the march lays pixels on invocations.
-    #[serde(default = "blocks")]
+    #[serde(default = "thesis_lanes")]
     pub lanes: Lanes,
     /// How the S-buffer's lists are built: rasterised billboards, or compute from the
     /// per-tile lists (each range then in depth order, no sort pass). Tiles: compute.
-    #[serde(default = "raster")]
+    #[serde(default = "thesis_build")]
     pub build: BuildKind,
     /// Tile size in pixels of the per-tile lists (tiles, and compute-built S-buffers).
-    #[serde(default = "tile16")]
+    #[serde(default = "thesis_tile")]
     pub tile: u32,
     /// Secondary samples that leave the screen end the path (else: every metaball).
     pub offscreen_end: bool,
@@ -67,10 +67,10 @@ pub struct MetaballSettings {
     pub opaque: bool,
     /// The surface drawn: the metaballs, or screen-space fluid or a marching-cubes mesh
     /// (which need `fluid`), shaded with the same materials.
-    #[serde(default = "metaballs")]
+    #[serde(default = "thesis_surface")]
     pub surface: SurfaceKind,
     /// Marching-cubes cell in rest spacings (`--surface mesh`).
-    #[serde(default = "half")]
+    #[serde(default = "thesis_mesh_cell")]
     pub mesh_cell: f32,
     /// The particles' fluid, for the other surfaces (set by the caller).
     #[serde(default)]
@@ -116,32 +116,33 @@ impl MetaballSettings {
     }
 }
 
-fn metaballs() -> SurfaceKind {
-    SurfaceKind::Metaballs
+// serde's defaults for fields summaries written before them lack: the thesis's.
+fn thesis_surface() -> SurfaceKind {
+    MetaballSettings::thesis().surface
 }
 
-fn half() -> f32 {
-    0.5
+fn thesis_mesh_cell() -> f32 {
+    MetaballSettings::thesis().mesh_cell
 }
 
-fn fixed() -> MarchKind {
-    MarchKind::Fixed
+fn thesis_march() -> MarchKind {
+    MetaballSettings::thesis().march
 }
 
-fn subgroup() -> Counters {
-    Counters::Subgroup
+fn thesis_counters() -> Counters {
+    MetaballSettings::thesis().counters
 }
 
-fn blocks() -> Lanes {
-    Lanes::Blocks
+fn thesis_lanes() -> Lanes {
+    MetaballSettings::thesis().lanes
 }
 
-fn raster() -> BuildKind {
-    BuildKind::Raster
+fn thesis_build() -> BuildKind {
+    MetaballSettings::thesis().build
 }
 
-fn tile16() -> u32 {
-    16
+fn thesis_tile() -> u32 {
+    MetaballSettings::thesis().tile
 }
 
 /// The tile sizes `--tile` takes.
