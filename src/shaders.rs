@@ -1,9 +1,10 @@
 //! Every shader with the defines the code compiles it with: its interface's bindings and
 //! each set of feature defines a pass uses. One registration line per pass; the shader
 //! test compiles every entry and fails on a GLSL file registered nowhere.
-use crate::config::{Counters, DensityFn, Lanes, ListKind, Material, Neighbors, SortAlgo};
 use crate::gpu::Interface;
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::render::metaball::MetaballSettings;
+use crate::render::{Counters, DensityFn, Lanes, ListKind, Material};
 
 /// (file under glsl/, defines).
 pub type Variant = (&'static str, Vec<(String, String)>);
@@ -43,7 +44,10 @@ pub fn variants() -> Vec<Variant> {
     ];
     particle_systems(&mut v);
     use crate::character::skin::{SkinIo, SkinPass};
-    for method in [crate::config::Skinning::Lbs, crate::config::Skinning::Dqs] {
+    for method in [
+        crate::character::Skinning::Lbs,
+        crate::character::Skinning::Dqs,
+    ] {
         for sets in [1, 2] {
             let d: Vec<(String, String)> = SkinPass::defines(method, sets)
                 .into_iter()
@@ -150,8 +154,8 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
             for f in ["sph/density.comp", "sph/forces.comp", "sph/integrate.comp"] {
                 v.push(with::<crate::sph::solver::SphIo>(f, &sph));
             }
-            use crate::config::Solver;
             use crate::sph::pressure::{pass_defines, passes, PressureIo};
+            use crate::sph::Solver;
             for solver in Solver::all() {
                 for p in passes(*solver) {
                     let mut d = sph.clone();
@@ -160,7 +164,7 @@ fn searches_sph_and_control(v: &mut Vec<Variant>) {
                 }
             }
             use crate::control::force::{ControlIo, ControlSettings};
-            for a in crate::config::Adaptive::all() {
+            for a in crate::control::Adaptive::all() {
                 let mut c = sph.clone();
                 c.extend(
                     ControlSettings::defines(*a)
@@ -207,14 +211,14 @@ fn metaballs(v: &mut Vec<Variant>) {
                         continue;
                     }
                     let d = MetaballSettings::defines_for(list, *density, material, sorted);
-                    for march in crate::kinds::MarchKind::all() {
+                    for march in crate::render::MarchKind::all() {
                         let mut d = d.clone();
                         d.extend(MetaballSettings::march_defines(*march));
                         // Counters and lanes per list on the default look only: they
                         // change nothing the look's code reads.
                         let plain = material == Material::Phong
                             && *density == DensityFn::Wyvill
-                            && *march == crate::kinds::MarchKind::Fixed;
+                            && *march == crate::render::MarchKind::Fixed;
                         for (counters, lanes) in lane_variants(list, plain) {
                             let mut d = d.clone();
                             d.extend(MetaballSettings::lane_defines(counters, lanes));
@@ -222,7 +226,7 @@ fn metaballs(v: &mut Vec<Variant>) {
                             // default depth's elsewhere.
                             let deep = material == Material::Glass
                                 && *density == DensityFn::Wyvill
-                                && *march == crate::kinds::MarchKind::Fixed
+                                && *march == crate::render::MarchKind::Fixed
                                 && list == ListKind::Sbuffer
                                 && (counters, lanes) == (Counters::Subgroup, Lanes::Blocks);
                             let depths = if deep { 0..=6 } else { 1..=1 };

@@ -3,8 +3,8 @@
 mod common;
 use common::asset;
 use fluidform::character::anim::{clip_time, slerp};
+use fluidform::character::Skinning;
 use fluidform::character::{self, Channel, Character, Clip, Interp, Property};
-use fluidform::config::Skinning;
 use glam::{Mat4, Quat, Vec3, Vec4};
 
 fn load(name: &str) -> Character {

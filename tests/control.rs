@@ -3,10 +3,10 @@
 mod common;
 use common::asset;
 use fluidform::character::{self, Character};
-use fluidform::config::{BoneWeights, Placement};
 use fluidform::control::binding::{self, pair_weights};
 use fluidform::control::inside::{winding_number, InsideTest};
 use fluidform::control::placement;
+use fluidform::control::{BoneWeights, Placement};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 
@@ -272,7 +272,7 @@ fn the_shape_fill_is_one_inside_and_falls_at_faces_and_corners() {
 #[test]
 fn the_deficit_measure_follows_the_preset_and_placement() {
     use fluidform::control::target::ControlDesc;
-    use fluidform::kinds::{ControlPreset, Deficit, Placement};
+    use fluidform::control::{ControlPreset, Deficit, Placement};
     let d = ControlDesc::default();
     assert_eq!(d.deficit().unwrap(), Deficit::Rest);
     let shape = ControlDesc {

@@ -3,9 +3,11 @@
 //! the deficit attraction and damping of the fidelity preset.
 mod common;
 use fluidform::character::Mesh;
-use fluidform::config::{Adaptive, Neighbors, Skinning};
+use fluidform::character::Skinning;
 use fluidform::control::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
+use fluidform::control::Adaptive;
 use fluidform::gpu::Labels;
+use fluidform::kinds::Neighbors;
 use fluidform::scene::schema::{Ball, Block, Domain, Scene};
 use fluidform::sph::hooks::SphHook;
 use fluidform::sph::{FluidParams, SphSolver};
@@ -335,7 +337,7 @@ fn settings(adaptive: Adaptive, group: u32) -> ControlSettings {
         attraction: 0.0,
         reach: 0.18,
         damping: 0.0,
-        motion: fluidform::config::ControlMotion::Frames,
+        motion: fluidform::control::ControlMotion::Frames,
         group,
         every: 1,
     }
@@ -393,7 +395,7 @@ fn velocity_term_and_damping_with_a_moving_control_set_match_the_f64_reference()
         attraction: 20.0,
         reach: 0.1,
         damping: 3.0,
-        motion: fluidform::config::ControlMotion::Skin,
+        motion: fluidform::control::ControlMotion::Skin,
         ..settings(Adaptive::On, ALL_GROUPS)
     };
     let (err, err_rho) = compare(s, Vec3::new(0.6, -0.3, 0.9));

@@ -5,11 +5,12 @@
 mod common;
 use common::asset;
 use fluidform::character::{self, Character, UvPart};
-use fluidform::config::{EmitterKind, Neighbors, SortAlgo};
 use fluidform::emission::emit::{EmitGpuParams, EmitInput, EmitPass};
 use fluidform::emission::emitter::EmitSource;
 use fluidform::emission::layout::UvLayout;
+use fluidform::emission::EmitterKind;
 use fluidform::gpu::{sync, Buffer, Context, Labels};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::scene::emission::{births_per_triangle, uniformity, BUCKETS};
 use fluidform::sph::SphSolver;
 use glam::Vec3;

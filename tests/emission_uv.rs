@@ -4,8 +4,8 @@
 //! refused. Algorithm 1 on CesiumMan's surface.
 mod common;
 use common::asset;
+use fluidform::character::Skinning;
 use fluidform::character::{self, Animator, Character};
-use fluidform::config::Skinning;
 use fluidform::emission::layout::UvLayout;
 use fluidform::emission::uv::UvSurface;
 use fluidform::gpu::{sync, Context, Labels};

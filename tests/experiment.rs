@@ -2,11 +2,11 @@
 //! thesis scene, renderer reuse against fresh renderers, and refusals.
 mod common;
 use common::{ctx, finish, fluidform, text};
-use fluidform::config::ListKind;
 use fluidform::control::inside::InsideTest;
 use fluidform::experiment::thesis::Body;
 use fluidform::experiment::{findings, tables, Experiment};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer};
+use fluidform::render::ListKind;
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -107,7 +107,7 @@ fn a_given_spacing_stays_and_bad_pools_are_refused() {
 /// the floor the character stands on, and the camera sees the whole of it.
 #[test]
 fn the_domain_and_camera_are_fitted_around_the_motion() {
-    use fluidform::config::Skinning;
+    use fluidform::character::Skinning;
     use fluidform::scene::character::placed_matrices;
     let dir = std::env::temp_dir().join("fluidform-fit-3");
     std::fs::create_dir_all(&dir).unwrap();

@@ -10,10 +10,11 @@
 //! sort's atomics order a cell's particles by chance.
 //! And the fallback: a solve recorded with fewer iterations than it needs is caught.
 mod common;
-use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Guard};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::scene::Scene;
 use fluidform::sph::stepper::Stepper;
+use fluidform::sph::Solver;
 use fluidform::sph::{SphSolver, SphState};
 use serde::{Deserialize, Serialize};
 

@@ -4,9 +4,10 @@
 //! S-buffer's picture for every material and recursion depth, pairs grow on overflow, and
 //! the switches that do not apply are refused.
 mod common;
-use fluidform::config::{BuildKind, ListKind, MarchKind, Material, Switches};
+use fluidform::config::Switches;
 use fluidform::gpu::Context;
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
+use fluidform::render::{BuildKind, ListKind, MarchKind, Material};
 use std::collections::BTreeSet;
 
 const N: usize = 160;

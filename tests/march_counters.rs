@@ -2,9 +2,9 @@
 //! CPU reference marcher and against what each list holds; `--march lipschitz` against the
 //! fixed march: the same hits and pictures from fewer samples.
 mod common;
-use fluidform::config::{Counters, Lanes, ListKind, MarchKind, Material};
 use fluidform::render::metaball::reference::{march_counted, ray_box, MarchParams};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, FrameStats, MetaballSettings};
+use fluidform::render::{Counters, Lanes, ListKind, MarchKind, Material};
 use glam::Vec3;
 
 const W: u32 = 96;
@@ -213,7 +213,7 @@ fn counter_modes_and_lane_layouts_give_the_same_frames_and_counts() {
             let mut base = settings(list);
             (base.material, base.width, base.height) = (material, 90, 70);
             base.build = match list {
-                ListKind::Tiles => fluidform::config::BuildKind::Compute,
+                ListKind::Tiles => fluidform::render::BuildKind::Compute,
                 _ => base.build,
             };
             let (st0, px0, dbg0) = render(&ctx, &base);
@@ -249,7 +249,7 @@ fn counter_modes_and_lane_layouts_give_the_same_frames_and_counts() {
     }
     let bad = MetaballSettings {
         lanes: Lanes::Rows,
-        build: fluidform::config::BuildKind::Compute,
+        build: fluidform::render::BuildKind::Compute,
         ..settings(ListKind::Tiles)
     };
     let e = FluidRenderer::new(&ctx, bad)

@@ -1,7 +1,6 @@
 //! Metaball density functions and the CPU reference ray marcher.
-use fluidform::config::DensityFn;
-use fluidform::render::metaball::density::Density;
 use fluidform::render::metaball::reference::{field, march, MarchParams};
+use fluidform::render::DensityFn;
 use glam::Vec3;
 
 const ALL: [DensityFn; 4] = [

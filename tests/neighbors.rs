@@ -1,7 +1,7 @@
 //! Every neighbour strategy returns exactly the brute-force neighbour set.
 mod common;
-use fluidform::config::{Neighbors, SortAlgo};
 use fluidform::gpu::{Context, Labels};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::primitives::cpu;
 use fluidform::primitives::neighbors::{GridSpec, NeighborSearch};
 use rand::{Rng, SeedableRng};

@@ -272,7 +272,7 @@ fn a_character_outside_its_domain_names_the_key_to_change() {
 #[test]
 fn character_scenes_look_like_water_unless_they_say_otherwise() {
     let (dir, obj) = with_quadruped();
-    use fluidform::config::Material;
+    use fluidform::render::Material;
     let s = load(&five_lines(
         dir.path(),
         &obj.display().to_string(),

@@ -5,11 +5,12 @@
 //! solver misses a bound the issue asked for (README: known gaps), its lists below leave
 //! it out and the run prints what it measured.
 mod common;
-use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::experiment::surge;
 use fluidform::gpu::{Context, Labels};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::scene::schema::Scene;
 use fluidform::sph::solver::StateDump;
+use fluidform::sph::Solver;
 use fluidform::sph::{FluidParams, SphSolver, SphState};
 
 const ALL: [Solver; 4] = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];

@@ -1,11 +1,12 @@
 //! The metaball renderer: every list gives the same image, the GPU's hits match the CPU
 //! reference marcher, billboards are conservative, lists grow on overflow, golden images.
 mod common;
-use fluidform::config::{DensityFn, ListKind, Material, Switches};
+use fluidform::config::Switches;
 use fluidform::gpu::Context;
 use fluidform::render::metaball::reference::{march, MarchParams};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
 use fluidform::render::Camera;
+use fluidform::render::{DensityFn, ListKind, Material};
 use glam::Vec3;
 
 const W: u32 = 96;

@@ -130,7 +130,7 @@ fn fluid_overrides_reach_each_solvers_table() {
 /// [fluid], its table or --fluid wins, each on its own; wcsph keeps the fixed step.
 #[test]
 fn each_solver_takes_its_own_step_unless_told_otherwise() {
-    use fluidform::kinds::Solver;
+    use fluidform::sph::Solver;
     let f = FluidParams::default();
     let o = |args: &[&str], s: Option<Solver>| {
         let a: Vec<String> = args.iter().map(|s| s.to_string()).collect();

@@ -159,7 +159,7 @@ fn constant_force_hook_moves_particles_as_gravity_would() {
     let ctx = common::ctx();
     let extra = [0.0f32, 3.0, 0.0];
     let run = |scene: &Scene, hook: bool| {
-        let mut solver = SphSolver::new(&ctx, fluidform::config::Neighbors::Grid, None).unwrap();
+        let mut solver = SphSolver::new(&ctx, fluidform::kinds::Neighbors::Grid, None).unwrap();
         let mut force = ConstantForce::new(&ctx, extra).unwrap();
         let parts = scene.particles(1);
         let mut st = solver.state(&ctx, scene, &parts).unwrap();
@@ -208,7 +208,7 @@ fn constant_force_hook_moves_particles_as_gravity_would() {
 #[test]
 fn registered_attribute_survives_reorder() {
     let ctx = common::ctx();
-    let mut solver = SphSolver::new(&ctx, fluidform::config::Neighbors::Grid, None).unwrap();
+    let mut solver = SphSolver::new(&ctx, fluidform::kinds::Neighbors::Grid, None).unwrap();
     let scene = block();
     let parts = scene.particles(3);
     let mut st = solver.state(&ctx, &scene, &parts).unwrap();

@@ -4,11 +4,11 @@
 //! ones at a large radius (a near-sphere), per material; and the renderer's own energy,
 //! total internal reflection and absorption, in pictures.
 mod common;
-use fluidform::config::{DensityFn, ListKind, Material};
 use fluidform::gpu::Context;
 use fluidform::render::metaball::{FluidRenderer, MetaballSettings};
 use fluidform::render::trace::{iso_radius, Env, Look, Reference, Sphere};
 use fluidform::render::Camera;
+use fluidform::render::{DensityFn, ListKind, Material};
 use glam::{DVec3, Vec3};
 
 const SIZE: u32 = 64;

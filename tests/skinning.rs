@@ -3,8 +3,8 @@
 mod common;
 use common::asset;
 use fluidform::character::skin::{SkinnedMesh, Skinner};
+use fluidform::character::Skinning;
 use fluidform::character::{self, Animator, Character};
-use fluidform::config::Skinning;
 use fluidform::gpu::{sync, Context};
 use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};

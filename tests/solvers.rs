@@ -2,9 +2,10 @@
 //! momentum without walls, and the control force with groups, each solver (a resting
 //! pool: tests/physics.rs).
 mod common;
-use fluidform::config::{Neighbors, Solver, SortAlgo};
 use fluidform::gpu::{Context, Labels};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::scene::schema::Particles;
+use fluidform::sph::Solver;
 use fluidform::sph::{cpu_pressure, FluidParams, SphSolver, SphState};
 
 const SOLVERS: [Solver; 3] = [Solver::Pcisph, Solver::Dfsph, Solver::Pbf];

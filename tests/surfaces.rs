@@ -2,11 +2,11 @@
 //! grid, the screen-space splats against ray-sphere intersections computed here, and both
 //! surfaces' coverage against the metaballs' (the plain variant).
 mod common;
-use fluidform::config::{ListKind, SurfaceKind};
 use fluidform::gpu::Context;
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, MetaballSettings};
 use fluidform::render::surface::SurfaceFluid;
 use fluidform::render::Camera;
+use fluidform::render::{ListKind, SurfaceKind};
 use glam::Vec3;
 
 fn xyz(v: [f32; 4]) -> Vec3 {

@@ -5,7 +5,7 @@
 //! inside fraction over the last animation cycle, the share of the frame the rays
 //! placement takes (with --placement rays), and the GPU frame time.
 use super::{BenchOptions, Row};
-use crate::config::Adaptive;
+use crate::control::Adaptive;
 use crate::error::{Error, Result};
 use crate::run::{run, RunOptions, RunStats};
 
@@ -70,7 +70,7 @@ fn one_run(
     let mut s = opts.switches.clone();
     s.control.adaptive = Some(mode);
     s.control.control_velocity = Some(k);
-    s.view.render = Some(crate::config::RenderKind::Points);
+    s.view.render = Some(crate::render::RenderKind::Points);
     s.frame.width = Some(64);
     s.frame.height = Some(64);
     s.common.quiet = true;

@@ -5,9 +5,9 @@
 //! alive: every frame skins the walker, renders it into its UV atlas, emits, and steps.
 use super::protocol::{self, Case};
 use super::{BenchOptions, Row};
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::scene::emission::EmissionDesc;
 use crate::scene::schema::Block;
 use crate::scene::targets::SceneTargets;

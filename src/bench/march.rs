@@ -4,9 +4,9 @@
 //! lanes (8 x 8 blocks, the default; rows of 64), per list mode (or --list). Each row
 //! gives the march scope's ms beside the frame's, and its ratio to the default's row.
 use super::{BenchOptions, Row};
-use crate::config::{Counters, Lanes, ListKind};
 use crate::error::Result;
 use crate::gpu::Context;
+use crate::render::{Counters, Lanes, ListKind};
 
 /// (counters, lanes) per row: the default first, then each switched alone.
 const SUSPECTS: [(Counters, Lanes); 4] = [

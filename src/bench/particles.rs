@@ -3,11 +3,12 @@
 //! step, sort and draw per frame at 512 x 512 (or --width, --height).
 use super::protocol::{self, Case};
 use super::{counts, BenchOptions, Row};
-use crate::config::{Integrator, SortAlgo, SpriteMode};
 use crate::error::{Error, Result};
 use crate::gpu::{ColorTarget, Context, Guard};
+use crate::kinds::SortAlgo;
 use crate::psys::frame::{frame_info, record_simulation};
 use crate::psys::spec::{ColliderSpec, ParticleSpec, Shape, SystemSpec, Vary};
+use crate::psys::{Integrator, SpriteMode};
 use crate::psys::{ParticleSystem, Passes};
 use crate::render::Camera;
 use crate::scene::particles::{base_system, emitter};

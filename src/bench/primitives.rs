@@ -1,10 +1,10 @@
 //! Benchmarks of the GPU primitives: scan (against a buffer copy), sorts, neighbours.
 use super::protocol::{self, Case};
 use super::{counts, BenchOptions, Row};
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, Guard, ScopeKey};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
 use crate::primitives::neighbors::{default_sort, GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};

@@ -6,10 +6,10 @@
 use super::floor::Floor;
 use super::protocol::{self, Case};
 use super::{BenchOptions, Row};
-use crate::config::{BuildKind, ListKind, SurfaceKind};
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
 use crate::render::metaball::{blob, blob_camera, FluidRenderer};
+use crate::render::{BuildKind, ListKind, SurfaceKind};
 use crate::sph::FluidParams;
 use serde_json::json;
 

@@ -3,8 +3,8 @@
 //! copies of the walker side by side, skinned by its 13 joints mid-walk.
 use super::protocol::{self, Case};
 use super::{BenchOptions, Row};
+use crate::character::Skinning;
 use crate::character::{self, skin::Skinner, Animator, Character};
-use crate::config::Skinning;
 use crate::error::Result;
 use crate::gpu::{Context, Guard};
 use glam::{Mat4, Vec3};

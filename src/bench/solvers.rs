@@ -5,7 +5,6 @@
 //! A configuration plays `--warmup` frames of 20 ms untimed (the column starts to fall),
 //! then `--frames` frames timed; every step is CFL-limited (`Stepper`).
 use super::{BenchOptions, Row};
-use crate::config::Solver;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
@@ -15,6 +14,7 @@ use crate::sph::errors::DensityErrorStats;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Eos, FluidParams};
 use crate::sph::stepper::Stepper;
+use crate::sph::Solver;
 use crate::sph::{SphSolver, SphState};
 
 pub const SOLVERS: [Solver; 4] = [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf];
@@ -296,8 +296,8 @@ pub fn solvers(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let (strategy, sort) = super::sph::strategies(
         opts,
         &[(
-            crate::config::Neighbors::Grid,
-            crate::config::SortAlgo::Counting,
+            crate::kinds::Neighbors::Grid,
+            crate::kinds::SortAlgo::Counting,
         )],
     )[0];
     let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);

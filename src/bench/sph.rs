@@ -2,9 +2,9 @@
 //! the dam-break stability run (32K particles, 10 simulated seconds, any solver).
 use super::protocol::{self, Case};
 use super::{counts, BenchOptions, Row};
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, FrameLoop, Guard};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::neighbors::default_sort;
 use crate::scene::Scene;
 use crate::sph::errors::DensityErrorStats;
@@ -217,7 +217,7 @@ fn play_checkpoints(
     ctx: &Context,
     frames: &mut FrameLoop,
     work: &mut super::solvers::Play,
-    (scene, solver_kind): (&Scene, crate::config::Solver),
+    (scene, solver_kind): (&Scene, crate::sph::Solver),
     total: u64,
     checkpoints: &mut Vec<Checkpoint>,
 ) -> Result<()> {
@@ -245,7 +245,7 @@ fn play_checkpoints(
 }
 
 /// The dam break with the solver's own stable setup and the switches applied.
-fn stability_scene(opts: &BenchOptions) -> Result<(Scene, crate::config::Solver)> {
+fn stability_scene(opts: &BenchOptions) -> Result<(Scene, crate::sph::Solver)> {
     let mut scene = Scene::built_in("dam-break").expect("built-in");
     let solver_kind = opts
         .switches
@@ -297,7 +297,7 @@ fn stability_row(
     summary: &StabilitySummary,
     timings: &[crate::gpu::FrameTiming],
     last: &crate::sph::stepper::PhysicsStats,
-    solver_kind: crate::config::Solver,
+    solver_kind: crate::sph::Solver,
     ratio: f64,
 ) -> Result<Row> {
     let (simulated, steps) = (summary.simulated_seconds, summary.steps);

@@ -3,7 +3,7 @@
 use super::findings::{self, Finding, Verdict};
 use super::{write, Env, Experiment, Steps};
 use crate::bench::{Bench, Measurer, Row};
-use crate::config::Adaptive;
+use crate::control::Adaptive;
 use crate::error::{Error, Result};
 use std::path::PathBuf;
 

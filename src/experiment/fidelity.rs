@@ -4,9 +4,10 @@
 //! run), the last saved frame of each (same scene time), and fill and IoU over time.
 use super::findings::Finding;
 use super::{write, Env, Experiment, Steps};
-use crate::config::{ControlPreset, RenderKind};
 use crate::control::metrics::ControlRow;
+use crate::control::ControlPreset;
 use crate::error::{Error, Result};
+use crate::render::RenderKind;
 use std::path::{Path, PathBuf};
 
 /// (label, scene, frames with --quick).

@@ -11,10 +11,10 @@ use super::{write, Env, Experiment, Steps};
 use crate::bench::floor::Floor;
 use crate::bench::interval::Estimate;
 use crate::bench::Measurer;
-use crate::config::{BuildKind, ListKind, MarchKind, Material, RenderKind};
 use crate::error::{Error, Result};
 use crate::gpu::Guard;
 use crate::render::metaball::MetaballSettings;
+use crate::render::{BuildKind, ListKind, MarchKind, Material, RenderKind};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 

@@ -6,11 +6,11 @@
 use super::Env;
 use crate::bench::protocol::{self, Case};
 use crate::bench::{BenchOptions, Row};
-use crate::config::ListKind;
 use crate::error::Result;
 use crate::gpu::{Buffer, Context, Guard};
 use crate::render::metaball::{FrameStats, MetaballSettings};
 use crate::render::Camera;
+use crate::render::ListKind;
 use serde_json::Value;
 
 /// One frame to time.

@@ -5,9 +5,9 @@
 //! particles.
 use super::findings::{Finding, Verdict};
 use super::{write, Env, Experiment, Steps};
-use crate::config::{RenderKind, SurfaceKind};
 use crate::error::{Error, Result};
 use crate::render::surface::cubes::{CELLS_SCOPE, DENSITY_SCOPE, RASTER_SCOPE};
+use crate::render::{RenderKind, SurfaceKind};
 use crate::report::pass_median;
 use serde_json::Value;
 use std::path::{Path, PathBuf};

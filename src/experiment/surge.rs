@@ -3,11 +3,11 @@
 //! the solvers to it).
 use super::findings::{Finding, Verdict};
 use super::{write, Env, Experiment, Steps};
-use crate::config::{Neighbors, SortAlgo};
 use crate::error::Result;
 use crate::gpu::{Context, Labels};
-use crate::kinds::Solver;
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::scene::schema::{Block, Scene};
+use crate::sph::Solver;
 use crate::sph::{Eos, FluidParams, SphSolver};
 use std::path::PathBuf;
 

@@ -4,9 +4,10 @@
 use super::findings::{self, Finding, Verdict};
 use super::{write, Env, Experiment, Steps};
 use crate::bench::{Bench, Measurer, Row};
-use crate::config::{ListKind, Neighbors, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::{Context, Guard};
+use crate::kinds::{Neighbors, SortAlgo};
+use crate::render::ListKind;
 use std::path::PathBuf;
 
 fn per_particle_ns(r: &Row) -> f64 {

@@ -1,8 +1,8 @@
 //! Thesis tables 2-8 (seed 000, section 5): the same rows and columns, the thesis's frame
 //! rates (K1 = GTX 1660 Ti laptop, K2 = GTX 1080 Ti desktop) and list memory beside ours.
 use super::Experiment;
-use crate::config::{DensityFn, ListKind, Material};
 use crate::render::metaball::MetaballSettings;
+use crate::render::{DensityFn, ListKind, Material};
 
 /// A column: one metaball list (the S-buffer as the thesis built it, unsorted, or ours
 /// with its ranges sorted by depth).

@@ -3,12 +3,13 @@
 //! camera framed so the lists hold about as many fragments as the thesis's memory column
 //! implies (about 490 per metaball at 512x512).
 use crate::character::Character;
-use crate::config::{ListKind, Skinning};
+use crate::character::Skinning;
 use crate::control::placement;
 use crate::error::{Error, Result};
 use crate::gpu::{Context, Guard};
 use crate::render::metaball::{FluidRenderer, MetaballSettings};
 use crate::render::Camera;
+use crate::render::ListKind;
 use crate::scene::character::CharacterDesc;
 use glam::Vec3;
 use rand::seq::SliceRandom;

@@ -1,6 +1,7 @@
-//! The closed sets of algorithm and look choices (sorts, neighbour searches, solvers,
-//! list modes, materials, ...): plain values every layer may name, below the command line
-//! (the application's `config`), which offers them as switches. Each parses and prints as its switch spells it.
+//! Closed sets of choices (`Kind`, declared with `switch_enum!`): each parses and prints as
+//! its switch spells it, and gives its shader defines. This layer declares only its own
+//! (the primitives' sorts and neighbour searches); each domain declares its choices beside
+//! it (`sph::Solver`, `render::ListKind`, ...), and the command line offers them as switches.
 /// A closed set of choices: every value, and each one's name as its switch spells it
 /// (kebab case). The command line offers them through `Kind`, so no layer below it needs
 /// the command-line parser.
@@ -51,6 +52,13 @@ macro_rules! switch_enum {
             pub fn all() -> &'static [Self] {
                 <Self as $crate::kinds::Kind>::ALL
             }
+            /// A shader's switch on this value: `NAME` = its value, and `NAME_VARIANT` = each
+            /// variant's (what the GLSL compares against; a switch ends in `#error`).
+            pub fn define(self, name: &str) -> Vec<(String, String)> {
+                let mut d = vec![(name.to_string(), (self as u32).to_string())];
+                d.extend(Self::defines(name));
+                d
+            }
             /// `PREFIX_NAME` = value for every variant, for a shader's runtime switch.
             pub fn defines(prefix: &str) -> Vec<(String, String)> {
                 let names: Vec<(String, u32)> = Self::all()
@@ -84,122 +92,5 @@ switch_enum!(SortAlgo {
     Counting,
     None
 });
-switch_enum!(Integrator {
-    Euler,
-    Verlet,
-    Closed
-});
-switch_enum!(SpriteMode {
-    Points,
-    Streaks,
-    Sprites
-});
+
 switch_enum!(Neighbors { Morton, Grid, Hash });
-switch_enum!(
-    /// SPH pressure solver: weakly compressible (the papers'), or the incompressible
-    /// predictive-corrective, divergence-free and position-based ones.
-    Solver {
-        Wcsph,
-        Pcisph,
-        Dfsph,
-        Pbf
-    }
-);
-
-switch_enum!(
-    /// SPH smoothing kernel, one for densities and pressure gradients alike (src/sim/sph/kernel.rs):
-    /// Mueller 2003's poly6 densities with spiky gradients (the thesis's), the cubic
-    /// spline, or Wendland's C2.
-    Kernel {
-        Muller,
-        Cubic,
-        Wendland
-    }
-);
-
-switch_enum!(
-    /// The metaball lists: none, the A-buffer's linked lists, the S-buffer's ranges (the
-    /// thesis's), or per-tile ranges sorted by (tile, depth) after tile-based splatting.
-    ListKind {
-        None,
-        Abuffer,
-        Sbuffer,
-        Tiles
-    }
-);
-switch_enum!(
-    /// How per-pixel lists are built: by rasterising the billboards (the thesis's), or in
-    /// compute from the per-tile lists, each pixel's range already in depth order.
-    BuildKind {
-        Raster,
-        Compute
-    }
-);
-switch_enum!(DensityFn {
-    Blinn,
-    Wyvill,
-    Nishimura,
-    Murakami
-});
-switch_enum!(Material {
-    Phong,
-    Glass,
-    Tinted,
-    Gold,
-    Copper,
-    Aluminium
-});
-switch_enum!(EmitterKind { Uv, Vertices });
-switch_enum!(Placement {
-    Vertices,
-    Random,
-    Rays
-});
-switch_enum!(Skinning { Lbs, Dqs });
-switch_enum!(OnOff { On, Off });
-switch_enum!(Adaptive { Off, On, Smooth });
-switch_enum!(ControlPreset { Thesis, Fidelity });
-switch_enum!(ControlMotion { Frames, Skin });
-switch_enum!(Deficit { Rest, Shape });
-switch_enum!(BoneWeights { Eq8, Eq9, Skin });
-switch_enum!(Offscreen { All, End });
-switch_enum!(RenderKind { Metaballs, Points });
-switch_enum!(
-    /// The fluid's surface under `--render metaballs`: the ray-marched metaballs, screen-space
-    /// fluid (depth splats, bilateral smoothing, normals from depth) or a marching-cubes mesh.
-    SurfaceKind {
-        Metaballs,
-        ScreenSpace,
-        Mesh
-    }
-);
-switch_enum!(ShowMesh { Off, Shaded, Wire });
-switch_enum!(
-    /// The metaball march's step: the thesis's fixed grid, or the same grid with the samples
-    /// skipped that the summed field's Lipschitz bound proves on the ray's side.
-    MarchKind {
-        Fixed,
-        Lipschitz
-    }
-);
-
-switch_enum!(
-    /// How the march counts its rays, samples, terms and candidates (the frame's
-    /// statistics), into 64 slots a workgroup picks by its index: added per subgroup, summed
-    /// per workgroup first (two barriers) and added once per workgroup, or not at all (to
-    /// measure what counting costs; the frame then reports no counts).
-    Counters {
-        Subgroup,
-        Workgroup,
-        Off
-    }
-);
-
-switch_enum!(
-    /// How the march lays pixels on a workgroup's 64 invocations: 8 x 8 blocks (neighbouring
-    /// rays diverge together at silhouettes and read neighbouring lists) or rows of 64.
-    Lanes {
-        Blocks,
-        Rows
-    }
-);

@@ -7,9 +7,24 @@ use crate::error::{Error, Result};
 use clap::Args;
 use serde::Serialize;
 
-pub use crate::kinds::*;
+use crate::character::Skinning;
+use crate::control::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Placement};
+use crate::emission::EmitterKind;
+pub use crate::kinds::Kind;
+use crate::kinds::{Neighbors, SortAlgo};
+use crate::psys::{Integrator, SpriteMode};
+use crate::render::{
+    BuildKind, Counters, DensityFn, Lanes, ListKind, MarchKind, Material, Offscreen, RenderKind,
+    ShowMesh, SurfaceKind,
+};
+use crate::sph::{Kernel, Solver};
 use clap::builder::TypedValueParser;
 use fluidform_gpu::switch_enum;
+
+switch_enum!(
+    /// A switch that is on or off.
+    OnOff { On, Off }
+);
 
 /// The parser of a `Kind` switch: its values listed in --help and in the error for an
 /// unknown one.

@@ -3,8 +3,8 @@
 use crate::config::Switches;
 use crate::control::target::ControlDesc;
 use crate::error::{Error, Result};
-use crate::kinds::{BuildKind, ListKind, Material, SurfaceKind};
 use crate::render::metaball::MetaballSettings;
+use crate::render::{BuildKind, ListKind, Material, SurfaceKind};
 
 /// The metaball settings: the thesis's (`MetaballSettings::thesis`), overridden by the
 /// switches that are set.
@@ -28,11 +28,11 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
         tile: m.tile.unwrap_or(t.tile),
         offscreen_end: m
             .offscreen
-            .map(|o| o == crate::kinds::Offscreen::End)
+            .map(|o| o == crate::render::Offscreen::End)
             .unwrap_or(t.offscreen_end),
         // Sorting pays where rays read the lists many times: inside glass and tinted.
         sorted: match m.list_sort {
-            Some(o) => o == crate::kinds::OnOff::On,
+            Some(o) => o == crate::config::OnOff::On,
             None => matches!(m.material, Some(Material::Glass) | Some(Material::Tinted)),
         },
         width: sw.frame.width(),

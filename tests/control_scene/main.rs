@@ -185,7 +185,7 @@ fn rays_fill_the_capsule_frame_after_frame() {
     let path = scene(dir.path(), "rays", control, 9e-4, 12);
     let r = play(&path, &dir.path().join("out"), 30, &[]);
     let c = control_of(&r);
-    assert_eq!(c.placement, Some(fluidform::config::Placement::Rays));
+    assert_eq!(c.placement, Some(fluidform::control::Placement::Rays));
     // The capsule's lattice: about its volume (0.0061 m^3) over spacing^3, 1800.
     let n = c.control_particles;
     assert!((1500..2100).contains(&n), "{n} control particles");

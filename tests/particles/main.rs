@@ -3,11 +3,12 @@
 #[path = "../common/mod.rs"]
 mod common;
 use common::{finish, fluidform, text};
-use fluidform::config::{Integrator, SortAlgo, SpriteMode};
 use fluidform::gpu::{Context, Labels};
+use fluidform::kinds::SortAlgo;
 use fluidform::psys::cpu::{attractor_potential, closed_pos, partitions};
 use fluidform::psys::spec::*;
 use fluidform::psys::{FrameInfo, ParticleSystem, Passes};
+use fluidform::psys::{Integrator, SpriteMode};
 use fluidform::render::Camera;
 use fluidform::scene::particles::{base_system, emitter, ParticleScene};
 use glam::Vec3;

@@ -5,8 +5,9 @@ use super::*;
 #[test]
 fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     use fluidform::character::capsules;
-    use fluidform::config::{ShowMesh, Skinning};
+    use fluidform::character::Skinning;
     use fluidform::psys::character::CharacterLink;
+    use fluidform::render::ShowMesh;
     use fluidform::scene::character::{CharacterDesc, SceneCharacter};
     let ctx = common::ctx();
     let passes = Passes::new(&ctx).unwrap();

@@ -1,9 +1,10 @@
 //! The kernels of `--kernel` (src/sim/sph/kernel.rs) against numerical integration: each
 //! normalised, its gradient W's derivative, its wall terms the integrals over a solid
 //! half-space, and a rest lattice's density at the kernel's default support.
-use fluidform::config::Solver;
-use fluidform::sph::kernel::{self, Kernel, Smoothing};
+use fluidform::sph::kernel::{self, Smoothing};
 use fluidform::sph::FluidParams;
+use fluidform::sph::Kernel;
+use fluidform::sph::Solver;
 
 const ALL: [Kernel; 3] = [Kernel::Muller, Kernel::Cubic, Kernel::Wendland];
 

@@ -1,8 +1,8 @@
 //! SPH on the GPU against the f64 CPU reference, physics invariants, boundaries, scenes.
 #[path = "../common/mod.rs"]
 mod common;
-use fluidform::config::{Neighbors, SortAlgo};
 use fluidform::gpu::{Context, Labels};
+use fluidform::kinds::{Neighbors, SortAlgo};
 use fluidform::scene::schema::{Ball, Block, Domain, Particles, Scene};
 use fluidform::sph::cpu;
 use fluidform::sph::params::Collider;
@@ -310,7 +310,7 @@ fn assert_sane(d: &fluidform::sph::solver::StateDump, scene: &Scene, what: &str)
 /// colour-field force) and PBF's vorticity confinement do not, so both are off.
 #[test]
 fn every_solver_conserves_momentum_without_walls() {
-    use fluidform::kinds::Solver;
+    use fluidform::sph::Solver;
     let ctx = common::ctx();
     for solver_kind in [Solver::Wcsph, Solver::Pcisph, Solver::Dfsph, Solver::Pbf] {
         let mut fluid = FluidParams {

@@ -1,13 +1,15 @@
 //! `fluidform run`: play a scene for N frames, write PNGs, timings.csv and summary.json.
 //! Every scene kind is a `FrameWork` played by `common::play`.
 use crate::animation::Animation;
+use crate::character::Skinning;
 use crate::config::Switches;
-use crate::config::{Neighbors, RenderKind, ShowMesh, Skinning, SortAlgo};
 use crate::error::{Error, Result};
 use crate::gpu::target::save_rgba;
 use crate::gpu::vk;
 use crate::gpu::{Context, FrameWork, Guard, Profiler};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::render::Camera;
+use crate::render::{RenderKind, ShowMesh};
 use crate::report::{Report, Summary};
 pub use crate::run::common::{camera_with_switches, check_validation, SLOTS};
 use crate::run::common::{open, play};

@@ -1,16 +1,19 @@
 //! `fluidform run` for particle-system scenes: step, sort and draw every system per frame.
+use crate::character::Skinning;
 use crate::config::Group;
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
-use crate::kinds::{Integrator, ShowMesh, Skinning, SortAlgo, SpriteMode};
+use crate::kinds::SortAlgo;
 use crate::psys::character::{CharacterBufs, CharacterLink};
 use crate::psys::frame::{frame_info, record_simulation};
 use crate::psys::gpu::Passes;
 use crate::psys::spec::SystemSpec;
 use crate::psys::system::{FrameInfo, ParticleSystem};
+use crate::psys::{Integrator, SpriteMode};
 use crate::render::mesh::MeshView;
 use crate::render::Camera;
+use crate::render::ShowMesh;
 use crate::run::common::{camera_with_switches, open, play, SLOTS};
 use crate::run::view::Picture;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};

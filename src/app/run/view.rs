@@ -3,13 +3,14 @@
 //! skinned mesh with them, depth-tested, and an overlay (particle systems): its opaque
 //! draws with the mesh, its blended ones over the finished picture, depth-tested against
 //! the fluid and the mesh. Both write one PNG per saved frame.
-use crate::config::{ShowMesh, Switches};
+use crate::config::Switches;
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
 use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FluidRenderer, FrameStats, MetaballBuffers, MetaballSettings};
 use crate::render::surface::SurfaceFluid;
+use crate::render::ShowMesh;
 use crate::render::{points::PointsPush, Camera, PointsView};
 use serde::{Deserialize, Serialize};
 

@@ -5,8 +5,8 @@
 //! tuned for then names only the file, the animation, the height and a pool.
 use super::character::{perimeter, placed_matrices, CharacterDesc};
 use super::schema::{CameraDesc, Domain, Scene};
+use crate::character::Skinning;
 use crate::character::{check::bounds, Animator, Character};
-use crate::config::Skinning;
 use crate::error::{Error, Result};
 use glam::Vec3;
 

@@ -1,11 +1,12 @@
 //! A character in a scene (TOML `[character]`): which file and clip, where it stands, how
 //! fast it plays; skinned every frame on the GPU (`skin` scope) and drawn by the view.
+use crate::character::Skinning;
 use crate::character::{self, anim, anim::Up, skin::Skinner, Animator, Character};
-use crate::config::{ShowMesh, Skinning};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Context, Guard};
 use crate::render::mesh::MeshDraw;
+use crate::render::ShowMesh;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 

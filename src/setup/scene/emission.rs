@@ -5,9 +5,10 @@
 //! surface (the coefficient of variation of births per unit area over buckets of
 //! triangles of equal area).
 use crate::character::Mesh;
-use crate::config::{EmitterKind, Switches};
+use crate::config::Switches;
 use crate::emission::emit::EmitSettings;
 use crate::emission::emitter::Emitter;
+use crate::emission::EmitterKind;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, MemoryLocation};

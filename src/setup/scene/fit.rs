@@ -113,7 +113,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
     // The placed skin at scene time 0 (the path's start included).
     let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
-    let first = ch.skinned_at(&mats, crate::config::Skinning::Lbs)?.0;
+    let first = ch.skinned_at(&mats, crate::character::Skinning::Lbs)?.0;
     inside(scene, &first, height)?;
     // (A mass other than the default's already says the spacing: mass = rho_0 S^3.)
     let default_mass = scene.fluid.mass == crate::sph::FluidParams::default().mass;

@@ -1,8 +1,9 @@
 //! Particle-system scenes: TOML holding `[[system]]` tables and no `[domain]`, built in
 //! (scenes/fountain.toml, smoke, flock, rain: no asset files) or a user's (tests/scenes/).
 use crate::error::{Error, Result};
-use crate::kinds::{Integrator, SortAlgo, SpriteMode};
+use crate::kinds::SortAlgo;
 use crate::psys::spec::*;
+use crate::psys::{Integrator, SpriteMode};
 use crate::scene::character::CharacterDesc;
 use crate::scene::schema::CameraDesc;
 use serde::{Deserialize, Serialize};

@@ -92,22 +92,22 @@ pub struct TargetDesc {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Look {
-    pub material: Option<crate::config::Material>,
+    pub material: Option<crate::render::Material>,
     /// [width, height] in pixels.
     pub size: Option<[u32; 2]>,
     /// Draw the domain as a glass tank (default on; off in a scene with a `[character]` and fluid).
     pub tank: Option<bool>,
     /// Metaballs (default) or points (coloured by particle, as groups need).
-    pub render: Option<crate::config::RenderKind>,
+    pub render: Option<crate::render::RenderKind>,
     /// The fluid's surface under metaballs rendering (`--surface`).
-    pub surface: Option<crate::config::SurfaceKind>,
+    pub surface: Option<crate::render::SurfaceKind>,
 }
 
 impl Look {
     /// The defaults of a scene with a character and fluid: water (tinted, under the
     /// sky) and no tank, for each key its `[look]` leaves out.
     pub fn water(&mut self) {
-        self.material.get_or_insert(crate::config::Material::Tinted);
+        self.material.get_or_insert(crate::render::Material::Tinted);
         self.tank.get_or_insert(false);
     }
 
@@ -118,7 +118,7 @@ impl Look {
             sw.metaball.material = self.material;
         }
         if sw.metaball.surface.is_none()
-            && sw.view.render.or(self.render) != Some(crate::config::RenderKind::Points)
+            && sw.view.render.or(self.render) != Some(crate::render::RenderKind::Points)
         {
             sw.metaball.surface = self.surface;
         }

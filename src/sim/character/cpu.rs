@@ -1,7 +1,7 @@
 //! CPU reference of the skinning pass, in the same f32 operations as
 //! glsl/character/skin.comp, for the tests.
 use super::pose::GpuJoint;
-use crate::kinds::Skinning;
+use crate::character::Skinning;
 use glam::{Mat3, Vec3, Vec4};
 
 fn cofactor(a: Mat3) -> Mat3 {

@@ -1,6 +1,8 @@
 //! Characters: glTF 2.0 and OBJ loading, mesh checks, clip sampling and orientation,
 //! skinning (a GPU pass with linear blend or dual quaternions, and its CPU reference), the
 //! thickness of their parts, and what `inspect` reports and draws.
+mod kinds;
+pub use kinds::Skinning;
 pub mod anim;
 pub mod capsules;
 pub mod check;
@@ -21,7 +23,6 @@ pub use check::MeshCheck;
 pub use model::*;
 
 use crate::error::{Error, Result};
-use crate::kinds::Skinning;
 use glam::{Mat4, Vec3};
 use std::path::Path;
 

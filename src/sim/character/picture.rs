@@ -33,7 +33,7 @@ const VIEWS: [View; 2] = [
 
 /// Draw `ch`'s rest pose turned by `orient` side by side: front, then side.
 pub fn draw(ch: &Character, orient: Mat3) -> Result<RgbImage> {
-    let (pos, nrm) = ch.skinned_at(&ch.rest_matrices(), crate::kinds::Skinning::Lbs)?;
+    let (pos, nrm) = ch.skinned_at(&ch.rest_matrices(), crate::character::Skinning::Lbs)?;
     let pos: Vec<Vec3> = pos.iter().map(|p| orient * *p).collect();
     let nrm: Vec<Vec3> = nrm.iter().map(|n| orient * *n).collect();
     let (lo, hi) = super::check::bounds(&pos);

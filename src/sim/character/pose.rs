@@ -1,8 +1,8 @@
 //! Joint matrices -> what the skinning shader reads: the matrix for linear blending, and
 //! for dual quaternions the polar split M = [R S | t] (Kavan et al. 2008, §4: the
 //! scale/shear S blended linearly first, the rigid part R, t as a unit dual quaternion).
+use crate::character::Skinning;
 use crate::error::{Error, Result};
-use crate::kinds::Skinning;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 

@@ -2,10 +2,10 @@
 //! matrices uploaded each frame. Sized buffers (`SkinnedMesh`) apart from the pipeline.
 use super::model::Mesh;
 use super::pose::GpuJoint;
+use crate::character::Skinning;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
-use crate::kinds::Skinning;
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]

@@ -27,7 +27,7 @@ pub struct Region {
 /// Every region's thickness for the rest pose oriented by `orient` (the placement's
 /// up axis and rotation; only names the static mesh's cells), thinnest first.
 pub fn regions(ch: &Character, orient: Mat3) -> Result<Vec<Region>> {
-    let (pos, nrm) = ch.skinned_at(&ch.rest_matrices(), crate::kinds::Skinning::Lbs)?;
+    let (pos, nrm) = ch.skinned_at(&ch.rest_matrices(), crate::character::Skinning::Lbs)?;
     let t = per_vertex(&pos, &nrm, &ch.mesh.indices);
     let joints = ch.skeleton.joints.len();
     let (keys, names): (Vec<usize>, Vec<String>) = match joints > 1 {

@@ -4,7 +4,7 @@
 //! distance; the thesis's eq. 9 is lost), or `skin`: the skin weights of the nearest
 //! surface vertex (ours, a comparison the thesis did not have).
 use crate::character::{Character, MAX_INFLUENCES};
-use crate::kinds::BoneWeights;
+use crate::control::BoneWeights;
 use glam::{Mat4, Vec3};
 
 /// A joint's bones in the rest pose: segments from it to each child joint (a point for a

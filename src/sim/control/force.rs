@@ -75,7 +75,7 @@ pub struct Pose {
 /// skinning, and each control particle's fill of the shape (`--control-deficit shape`).
 pub type SetKind<'a> = (
     Option<(f32, u32)>,
-    crate::kinds::Skinning,
+    crate::character::Skinning,
     Option<&'a [f32]>,
 );
 

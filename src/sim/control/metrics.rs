@@ -42,7 +42,7 @@ pub struct ControlRow {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ControlStats {
     pub target: String,
-    pub placement: Option<crate::kinds::Placement>,
+    pub placement: Option<crate::control::Placement>,
     pub control_particles: u32,
     pub settings: Option<super::force::ControlSettings>,
     /// First scene time at which `fill` reached 0.9 (None: never).

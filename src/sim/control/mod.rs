@@ -1,6 +1,8 @@
 //! Control particles (seed 000, section 3): placement inside a character's mesh, binding to
 //! its skeleton, the inside tests they need, the control force (an SPH hook), targets and
 //! their timeline, and the fidelity metrics (with the mesh distance they use).
+mod kinds;
+pub use kinds::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Placement};
 pub mod binding;
 pub mod cache;
 pub mod fidelity;

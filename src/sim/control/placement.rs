@@ -4,8 +4,8 @@
 //! the other two are compared against.
 use super::inside::InsideTest;
 use crate::character::{check, Character};
+use crate::control::Placement;
 use crate::error::{Error, Result};
-use crate::kinds::Placement;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 

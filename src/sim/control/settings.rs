@@ -1,7 +1,7 @@
 //! The control switches of a target, resolved (see `target::ControlDesc` for the scene
 //! file's and the presets' defaults), with their checks and shader defines.
+use crate::control::{Adaptive, ControlMotion};
 use crate::error::{Error, Result};
-use crate::kinds::{Adaptive, ControlMotion};
 use serde::{Deserialize, Serialize};
 
 /// The control switches and their defaults.

@@ -4,12 +4,11 @@
 use super::binding;
 use super::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
+use crate::character::Skinning;
 use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
+use crate::control::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Placement};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::kinds::{
-    Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Placement, Skinning,
-};
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 

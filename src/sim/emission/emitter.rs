@@ -7,10 +7,10 @@
 use super::emit::{EmitGpuParams, EmitInput, EmitPass, EmitSettings};
 use super::layout::UvLayout;
 use super::uv::UvSurface;
+use crate::emission::EmitterKind;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, Guard, Scopes};
-use crate::kinds::EmitterKind;
 use crate::sph::hooks::SphHook;
 use crate::sph::params::SphGpuParams;
 use crate::sph::store::{AttrId, AttributeDecl};

@@ -12,11 +12,12 @@ use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
 };
 use crate::kinds::Neighbors;
-use crate::kinds::{Integrator, SortAlgo, SpriteMode};
+use crate::kinds::SortAlgo;
 use crate::primitives::counting::CountingSort;
 use crate::primitives::neighbors::{GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanPass, ScanVariant};
 use crate::primitives::sort::{Network, NetworkSort};
+use crate::psys::{Integrator, SpriteMode};
 use bytemuck::{Pod, Zeroable};
 
 type V4 = [f32; 4];

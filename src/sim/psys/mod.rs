@@ -3,6 +3,8 @@
 //! keep state on the GPU, or the stateless closed form evaluated in the vertex shader;
 //! forces, collisions, death; alive and dead lists compacted on the GPU with indirect
 //! dispatch and draw; points, streaks and sprites sorted back to front.
+mod kinds;
+pub use kinds::{Integrator, SpriteMode};
 pub mod character;
 pub mod codes;
 pub mod cpu;

@@ -1,7 +1,8 @@
 //! A particle system as declared in a scene file's `[[system]]` table (seed 003): the
 //! emitter, every attribute as mean + rand x variance (rand uniform in [-1, 1)),
 //! attributes over life as keyframe curves, forces, colliders and death rules.
-use crate::kinds::{Integrator, SortAlgo, SpriteMode};
+use crate::kinds::SortAlgo;
+use crate::psys::{Integrator, SpriteMode};
 use serde::{Deserialize, Serialize};
 
 mod validate;

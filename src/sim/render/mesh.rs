@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, GraphicsDesc, GraphicsPipeline};
-use crate::kinds::ShowMesh;
+use crate::render::ShowMesh;
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]

@@ -2,6 +2,11 @@
 //! (ray-marched metaballs with per-pixel or per-tile lists, screen-space fluid and GPU
 //! marching cubes, all shaded by one pass), the character mesh, and an independent f64 ray
 //! tracer (`trace`) the shading is checked against.
+mod kinds;
+pub use kinds::{
+    BuildKind, Counters, DensityFn, Lanes, ListKind, MarchKind, Material, Offscreen, RenderKind,
+    ShowMesh, SurfaceKind,
+};
 pub mod camera;
 pub mod mesh;
 pub mod metaball;

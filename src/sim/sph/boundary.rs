@@ -2,8 +2,9 @@
 //! walls and the colliders as solid half-spaces at rest density (their density / rho0 and
 //! sum V grad W in closed form), and common.glsl's collision response.
 use super::collider::{Collider, GpuCollider};
-use super::kernel::{wall_density, wall_push, Kernel};
+use super::kernel::{wall_density, wall_push};
 use super::params::FluidParams;
+use super::Kernel;
 use crate::error::Result;
 
 pub use super::v3::V3;

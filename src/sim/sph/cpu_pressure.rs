@@ -6,7 +6,7 @@
 use super::boundary::{Boundary, Solid};
 use super::params::{Eos, FluidParams};
 use super::v3::{axpy, cross, dot, sub, xyz, Smoothing, V3};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 
 struct K {
     h: f64,

@@ -16,7 +16,7 @@ use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 
 /// DFSPH's neighbour list length: a particle has about 20 neighbours at rest (h = 1.68
 /// spacings), 30 compressed by half.

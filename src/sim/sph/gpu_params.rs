@@ -117,7 +117,7 @@ impl SphGpuParams {
         };
         let h = f.h;
         let k = Kernels::new(h as f64);
-        let incompressible = f.solver != crate::kinds::Solver::Wcsph;
+        let incompressible = f.solver != crate::sph::Solver::Wcsph;
         let c = f.convergence();
         let dq = (f.pbf.scorr_dq * h) as f64;
         let w_dq = super::kernel::Smoothing::of(f).w_r2(dq * dq);
@@ -135,7 +135,7 @@ impl SphGpuParams {
             } else {
                 f.eos_constant()
             },
-            viscosity: if f.solver == crate::kinds::Solver::Pbf {
+            viscosity: if f.solver == crate::sph::Solver::Pbf {
                 0.0
             } else {
                 f.viscosity

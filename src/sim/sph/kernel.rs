@@ -10,7 +10,7 @@
 //! at distance d = u h: A(u) = 2 pi int_d^h W r dr (|sum V grad W|) and I(u) = int_d^h A
 //! (the solid's density / rho0).
 use super::params::FluidParams;
-pub use crate::kinds::Kernel;
+use super::Kernel;
 use std::f64::consts::PI;
 
 /// A kernel's support in rest spacings where the fluid sets none (`fluid.support`): there

@@ -2,6 +2,8 @@
 //! pressure solvers (weakly compressible, the papers'; predictive-corrective,
 //! divergence-free and position-based), switchable kernels and neighbour search,
 //! boundaries and colliders, the stepper that plays a scene, and f64 CPU references.
+mod kinds;
+pub use kinds::{Kernel, Solver};
 pub mod boundary;
 pub mod cfl;
 pub mod collider;

@@ -1,14 +1,15 @@
 //! Fluid parameters (Kelager 2006's water by default) and their GPU mirror.
 use crate::error::{Error, Result};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 use serde::{Deserialize, Serialize};
 
 pub use super::collider::{Collider, GpuCollider, MAX_COLLIDERS};
 pub use super::dfsph::{DfsphParams, DEFAULT_NEIGHBOR_LIST, MAX_NEIGHBOR_LIST};
-pub use super::kernel::{proto_grad2, Kernel, Kernels};
+pub use super::kernel::{proto_grad2, Kernels};
 pub use super::pbf::PbfParams;
 pub use super::pcisph::PcisphParams;
 pub use super::pressure::Convergence;
+use super::Kernel;
 
 /// The CFL number a configuration without a table of its own takes (each pressure solver
 /// has its own: pcisph.rs, dfsph.rs, pbf.rs).
@@ -79,7 +80,7 @@ pub struct FluidParams {
     /// Tangential velocity lost at a wall, 0..1
     pub friction: f32,
     /// The pressure solver (`--solver`).
-    pub solver: crate::kinds::Solver,
+    pub solver: crate::sph::Solver,
     /// With `cfl`: the largest step, s (default: `dt`). The frame time stays dt * substeps.
     pub dt_max: Option<f32>,
     /// `[fluid.pcisph]`, `[fluid.dfsph]`, `[fluid.pbf]`: each solver's own settings.
@@ -120,7 +121,7 @@ impl Default for FluidParams {
             gravity: [0.0, -9.82, 0.0],
             restitution: 0.0,
             friction: 0.0,
-            solver: crate::kinds::Solver::Wcsph,
+            solver: crate::sph::Solver::Wcsph,
             dt_max: None,
             pcisph: PcisphParams::default(),
             dfsph: DfsphParams::default(),
@@ -405,7 +406,7 @@ impl FluidParams {
     /// Speed of sound used by the CFL limit: the equation of state's for wcsph; the
     /// incompressible solvers have none (their CFL limit is the largest speed alone).
     pub fn sound(&self) -> f32 {
-        if self.solver != crate::kinds::Solver::Wcsph {
+        if self.solver != crate::sph::Solver::Wcsph {
             return 0.0;
         }
         match self.eos {

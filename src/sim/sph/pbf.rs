@@ -9,7 +9,7 @@ use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 
 /// `[fluid.pbf]`: the constraint iterations, relaxation, tensile correction, XSPH and
 /// vorticity confinement.

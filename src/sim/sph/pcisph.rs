@@ -9,7 +9,7 @@ use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 
 /// `[fluid.pcisph]`: when the predict-correct loop stops.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

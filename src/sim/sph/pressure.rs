@@ -10,8 +10,8 @@ use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
-use crate::kinds::Solver;
 use crate::primitives::neighbors::NeighborPush;
+use crate::sph::Solver;
 use bytemuck::{Pod, Zeroable};
 
 crate::gpu_interface! {

@@ -10,10 +10,11 @@ use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
-use crate::kinds::{Neighbors, Solver, SortAlgo};
+use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
 use crate::sph::store::{AttrId, AttributeDecl, ParticleStore};
+use crate::sph::Solver;
 
 crate::gpu_interface! {
     /// glsl/sph/common.glsl: every SPH pass declares all of these.

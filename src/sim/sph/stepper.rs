@@ -9,7 +9,7 @@ use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Context, Profiler};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 use serde::{Deserialize, Serialize};
 
 /// Chooses steps per frame and watches the state's health. With `cfl`, each step's dt is

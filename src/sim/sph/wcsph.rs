@@ -6,7 +6,7 @@ use super::solver::{SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
-use crate::kinds::Solver;
+use crate::sph::Solver;
 
 pub struct Wcsph;
 

@@ -5,16 +5,19 @@
 use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
 use super::emission::{EmissionMetrics, EmissionStats, SceneEmission};
 use crate::character::capsules::{self, BoneCapsule};
-use crate::config::{ControlMotion, ShowMesh, Skinning, Switches};
+use crate::character::Skinning;
+use crate::config::Switches;
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
+use crate::control::ControlMotion;
 use crate::emission::emitter::{EmitSource, Emitter};
 use crate::emission::layout::UvLayout;
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
+use crate::render::ShowMesh;
 use crate::scene::schema::MAIN_TARGET;
 use crate::scene::Scene;
 use crate::sph::hooks::Hooks;
@@ -193,7 +196,7 @@ impl SceneTargets {
             )));
         }
         let layout = match kind {
-            crate::config::EmitterKind::Vertices => None,
+            crate::emission::EmitterKind::Vertices => None,
             _ if !ch.mesh.uvs.is_empty() => Some(UvLayout::from_mesh(&ch.mesh, size)?),
             _ => Some(UvLayout::from_capsules(&ch.mesh, &caps, size)?),
         };

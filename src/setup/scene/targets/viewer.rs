@@ -44,7 +44,7 @@ impl SceneTargets {
             if built != *o || desc != *od {
                 return Ok(false);
             }
-            if nd.placement == crate::config::Placement::Rays
+            if nd.placement == crate::control::Placement::Rays
                 && (s.velocity > 0.0 || s.damping > 0.0)
             {
                 return Err(crate::Error::Param(

@@ -6,9 +6,9 @@ use super::stats::GpuStats;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, Context, Guard, MemoryLocation};
-use crate::kinds::ListKind;
 use crate::primitives::bounds::BoundsBuffers;
 use crate::primitives::scan::{ScanPass, ScanScratch};
+use crate::render::ListKind;
 
 /// Sized buffers: lists for width x height, up to `n_capacity` metaballs, per-slot readbacks.
 pub struct MetaballBuffers {

@@ -1,27 +1,16 @@
 //! Finite-support metaball density functions D(r), r <= R (0 beyond), normalised to
 //! D(0) = 1, with their radial derivative for analytic normals. The surface is where the
 //! sum over metaballs equals the threshold T.
-use crate::kinds::DensityFn;
+use crate::render::DensityFn;
 
 /// Blinn's Gaussian b exp(-a r^2) truncated at R, shifted and rescaled so that it reaches
 /// 0 continuously at R (a = BLINN_A / R^2).
 pub const BLINN_A: f32 = 4.0;
 
-/// The density functions' mathematics (the choice itself is a plain `kinds::DensityFn`).
-pub trait Density {
+/// The density functions' mathematics.
+impl DensityFn {
     /// D(r) for support radius `radius`.
-    fn value(self, r: f32, radius: f32) -> f32;
-    /// dD/dr for support radius `radius`.
-    fn derivative(self, r: f32, radius: f32) -> f32;
-    /// max |dD/dq| over q = r / R in [0, 1]: the march's Lipschitz bound.
-    fn slope_max(self) -> f32;
-    /// The shader's DENSITY value.
-    fn index(self) -> u32;
-}
-
-impl Density for DensityFn {
-    /// D(r) for support radius `radius`.
-    fn value(self, r: f32, radius: f32) -> f32 {
+    pub fn value(self, r: f32, radius: f32) -> f32 {
         if r >= radius {
             return 0.0;
         }
@@ -47,7 +36,7 @@ impl Density for DensityFn {
     }
 
     /// dD/dr.
-    fn derivative(self, r: f32, radius: f32) -> f32 {
+    pub fn derivative(self, r: f32, radius: f32) -> f32 {
         if r >= radius {
             return 0.0;
         }
@@ -75,21 +64,11 @@ impl Density for DensityFn {
     /// max |dD/dq| over q = r / R in [0, 1] with a 0.1% margin (sampled at 1e-5 in q; each
     /// slope here is smooth, so the samples miss its peak by far less): one metaball's
     /// field is slope_max / R Lipschitz in x (`--march lipschitz`).
-    fn slope_max(self) -> f32 {
+    pub fn slope_max(self) -> f32 {
         let steps = 100_000;
         let peak = (0..=steps)
             .map(|i| self.derivative(i as f32 / steps as f32, 1.0).abs())
             .fold(0.0f32, f32::max);
         peak * 1.001
-    }
-
-    /// Shader constant selecting this function in glsl/render (0..3).
-    fn index(self) -> u32 {
-        match self {
-            DensityFn::Blinn => 0,
-            DensityFn::Wyvill => 1,
-            DensityFn::Nishimura => 2,
-            DensityFn::Murakami => 3,
-        }
     }
 }

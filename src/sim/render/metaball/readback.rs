@@ -4,7 +4,7 @@ use super::buffers::MetaballBuffers;
 use super::renderer::FluidRenderer;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::kinds::ListKind;
+use crate::render::ListKind;
 
 impl FluidRenderer {
     /// The S-buffer's per-pixel lists of the frame last rendered (tests and debugging).

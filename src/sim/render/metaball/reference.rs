@@ -1,8 +1,7 @@
 //! CPU reference ray marcher: fixed steps on the grid t = k * step through the metaballs'
 //! bounds until the field reaches the threshold, `refine` bisection steps on the hit,
 //! normal = -grad / |grad|.
-use super::density::Density;
-use crate::kinds::DensityFn;
+use crate::render::DensityFn;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]

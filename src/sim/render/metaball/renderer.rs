@@ -15,11 +15,11 @@ use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
     Scopes,
 };
-use crate::kinds::{BuildKind, Lanes, ListKind};
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::render::surface::{Frame, Surface};
 use crate::render::Camera;
+use crate::render::{BuildKind, Lanes, ListKind};
 
 crate::gpu_interface! {
     /// glsl/render/metaball/common.glsl: every metaball pass declares all of these.

@@ -1,12 +1,11 @@
 //! Renderer settings from the command line (or a bench configuration), with the thesis's
 //! defaults, and their GPU mirror.
-use super::density::Density;
 use crate::error::{Error, Result};
-use crate::kinds::{
-    BuildKind, Counters, DensityFn, Lanes, ListKind, MarchKind, Material, SurfaceKind,
-};
 use crate::render::surface::SurfaceFluid;
 use crate::render::Camera;
+use crate::render::{
+    BuildKind, Counters, DensityFn, Lanes, ListKind, MarchKind, Material, SurfaceKind,
+};
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;
 
@@ -162,26 +161,6 @@ pub fn metal_nk(m: Material) -> Option<([f32; 3], [f32; 3])> {
 }
 
 /// Reflectance at normal incidence from a complex index: ((n-1)^2 + k^2) / ((n+1)^2 + k^2).
-/// LIST in the shaders.
-pub fn list_index(l: ListKind) -> u32 {
-    match l {
-        ListKind::None => 0,
-        ListKind::Abuffer => 1,
-        ListKind::Sbuffer => 2,
-        ListKind::Tiles => 3,
-    }
-}
-
-/// MATERIAL in the shaders: the metals share one path.
-pub fn material_index(m: Material) -> u32 {
-    match m {
-        Material::Phong => 0,
-        Material::Glass => 1,
-        Material::Tinted => 2,
-        Material::Gold | Material::Copper | Material::Aluminium => 3,
-    }
-}
-
 pub fn f0_from_nk(n: f32, k: f32) -> f32 {
     ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
 }
@@ -316,20 +295,14 @@ impl MetaballSettings {
     /// The march.comp defines of its counters and lane layout (COUNTERS, LANES and their
     /// named values).
     pub fn lane_defines(counters: Counters, lanes: Lanes) -> Vec<(String, String)> {
-        let mut d = vec![
-            ("COUNTERS".to_string(), (counters as u32).to_string()),
-            ("LANES".to_string(), (lanes as u32).to_string()),
-        ];
-        d.extend(Counters::defines("COUNTERS"));
-        d.extend(Lanes::defines("LANES"));
+        let mut d = counters.define("COUNTERS");
+        d.extend(lanes.define("LANES"));
         d
     }
 
     /// The march.comp defines of a march kind (MARCH and its named values).
     pub fn march_defines(march: MarchKind) -> Vec<(String, String)> {
-        let mut d = vec![("MARCH".to_string(), (march as u32).to_string())];
-        d.extend(MarchKind::defines("MARCH"));
-        d
+        march.define("MARCH")
     }
 
     /// The defines of one configuration (also the shader registry's variants).
@@ -339,48 +312,18 @@ impl MetaballSettings {
         material: Material,
         sorted: bool,
     ) -> Vec<(String, String)> {
-        use crate::gpu::interface::enum_defines;
-        let mut d = vec![
-            ("LIST".to_string(), list_index(list).to_string()),
-            ("DENSITY".to_string(), density.index().to_string()),
-            ("MATERIAL".to_string(), material_index(material).to_string()),
-            (
-                "SORTED".to_string(),
-                ((sorted && list == ListKind::Sbuffer) as u32).to_string(),
-            ),
-            // max |dD/dq| of the density: the march's Lipschitz bound (density.rs).
-            (
-                "SLOPE_MAX".to_string(),
-                format!("{:.6}", density.slope_max()),
-            ),
-        ];
-        // The named values the shaders compare against, from the same index functions.
-        let lists: Vec<(String, u32)> = ListKind::all()
-            .iter()
-            .map(|l| (l.as_str(), list_index(*l)))
-            .collect();
-        let densities: Vec<(String, u32)> = DensityFn::all()
-            .iter()
-            .map(|f| (f.as_str(), f.index()))
-            .collect();
-        // The metals share one shader path, MATERIAL_METAL.
-        let materials: Vec<(String, u32)> = [
-            ("phong", Material::Phong),
-            ("glass", Material::Glass),
-            ("tinted", Material::Tinted),
-            ("metal", Material::Gold),
-        ]
-        .iter()
-        .map(|(n, m)| (n.to_string(), material_index(*m)))
-        .collect();
-        for (prefix, values) in [
-            ("LIST", lists),
-            ("DENSITY", densities),
-            ("MATERIAL", materials),
-        ] {
-            let refs: Vec<(&str, u32)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-            d.extend(enum_defines(prefix, &refs));
-        }
+        let mut d = list.define("LIST");
+        d.extend(density.define("DENSITY"));
+        d.extend(material.define_path());
+        d.push((
+            "SORTED".to_string(),
+            ((sorted && list == ListKind::Sbuffer) as u32).to_string(),
+        ));
+        // max |dD/dq| of the density: the march's Lipschitz bound (density.rs).
+        d.push((
+            "SLOPE_MAX".to_string(),
+            format!("{:.6}", density.slope_max()),
+        ));
         d
     }
 

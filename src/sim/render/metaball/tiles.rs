@@ -52,7 +52,7 @@ impl TileBuffers {
         // Overflow grows it to what a frame needs.
         let pairs = match (used, s.list) {
             (false, _) => 0,
-            (true, crate::kinds::ListKind::Tiles) => capacity.max(1),
+            (true, crate::render::ListKind::Tiles) => capacity.max(1),
             (true, _) => first_pairs(s, n_capacity),
         };
         let only = |bytes: u64| if used { bytes.max(16) } else { 16 };
@@ -162,7 +162,7 @@ impl TilePasses {
         let emit = compute("tile emit", "render/metaball/tile_pairs.comp", Some(1), 64)?;
         let ranges = compute("tile ranges", "render/metaball/tile_ranges.comp", None, 64)?;
         let pixels = match s.list {
-            crate::kinds::ListKind::Sbuffer => {
+            crate::render::ListKind::Sbuffer => {
                 let shader = "render/metaball/pixel_lists.comp";
                 Some((
                     compute("pixel count", shader, Some(0), BLOCK_INVOCATIONS)?,

@@ -5,7 +5,7 @@ use super::{SurfaceFluid, SurfacePush, FILTER_CAP, ISO};
 use crate::error::{Error, Result};
 use crate::gpu::{Buffer, Context, Guard};
 use crate::isosurface::table::{table, EDGES};
-use crate::kinds::SurfaceKind;
+use crate::render::SurfaceKind;
 
 pub struct SurfaceBuffers {
     pub(super) zbits: Buffer,

@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{
     Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
 };
-use crate::kinds::SurfaceKind;
+use crate::render::SurfaceKind;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 

@@ -3,8 +3,8 @@
 //! that would go deeper reads the environment instead). Output: RGBA8, gamma 2.2.
 use super::env::{sun, Env};
 use super::optics::{conductor_f0, fresnel_dielectric, reflect, refract, schlick};
-use crate::kinds::DensityFn;
 use crate::render::Camera;
+use crate::render::DensityFn;
 use glam::DVec3;
 
 #[derive(Clone, Copy, Debug)]

@@ -1,0 +1,5 @@
+//! How a character's skin follows its bones.
+//! Closed sets (`fluidform_gpu::kinds::Kind`): each parses and prints as its switch spells it.
+use fluidform_gpu::switch_enum;
+
+switch_enum!(Skinning { Lbs, Dqs });
