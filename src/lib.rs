@@ -1,5 +1,5 @@
 //! fluidform: a Rust + Vulkan research testbed for liquid characters. This crate is the top:
-//! the benchmarks, the experiments and their tables, `inspect`, the shader registry, and the binary.
+//! the benchmarks, the experiments and their tables, `inspect` and the binary.
 //! The layers below are crates of their own: the runs and the window (`fluidform-app`,
 //! src/app), the switches, scenes and outputs (`fluidform-setup`, src/setup), the simulation and rendering
 //! (`fluidform-sim`, src/sim) and the GPU layer (`fluidform-gpu`, src/gpu), all re-exported
@@ -8,7 +8,6 @@ pub mod bench;
 pub mod experiment;
 pub mod inspect;
 pub mod provenance;
-pub mod shaders;
 
 pub use fluidform_app::{run, window};
 pub use fluidform_gpu as gpu;

@@ -372,7 +372,7 @@ fn shader_error_names_file_and_line() {
 #[test]
 fn every_glsl_file_compiles_with_every_define_set_the_code_uses() {
     let c = shader::ShaderCompiler::new().unwrap();
-    let variants = fluidform::shaders::variants();
+    let variants = fluidform::gpu::pass::compiled_files();
     let mut count = 0;
     for f in shader::glsl_files() {
         if f.ends_with(".glsl") {
@@ -383,7 +383,7 @@ fn every_glsl_file_compiles_with_every_define_set_the_code_uses() {
         if mine.is_empty() {
             assert!(
                 f.starts_with("test/"),
-                "glsl/{f} is in no shaders::variants() entry"
+                "glsl/{f} is in no pass declaration (compute_pass!, graphics_pass!)"
             );
             c.compile(f, &[]).unwrap_or_else(|e| panic!("{e}"));
         }
@@ -405,7 +405,7 @@ fn a_variant_switch_with_an_unknown_value_fails_to_compile() {
     // Every multi-valued GLSL switch ends in #error: an unlisted value must not compile
     // into a default variant.
     let c = shader::ShaderCompiler::new().unwrap();
-    let variants = fluidform::shaders::variants();
+    let variants = fluidform::gpu::pass::compiled_files();
     let cases = [
         ("render/metaball/march.comp", "DENSITY"),
         ("render/metaball/march.comp", "LIST"),

@@ -24,7 +24,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         }};
     }
     let c = fluidform::gpu::shader::ShaderCompiler::new().unwrap();
-    let variants = fluidform::shaders::variants();
+    let variants = fluidform::gpu::pass::compiled_files();
     let spv = |file: &str| {
         let (_, d) = variants.iter().find(|(f, _)| *f == file).unwrap();
         let d: Vec<(&str, String)> = d.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();

@@ -5,7 +5,7 @@
 use super::protocol::{self, Case};
 use super::BenchOptions;
 use crate::error::Result;
-use crate::gpu::{ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Context, Guard};
 use serde_json::json;
 
 /// The floor's timestamp scopes: a buffer copy and the FMA-rate kernel.
@@ -20,6 +20,11 @@ crate::gpu_interface! {
     /// glsl/bench/fma.comp; push: the iterations per invocation.
     pub FmaIo / FmaBufs: "FMA", push u32 { out = 0 }
 }
+
+crate::gpu::compute_pass!(
+    /// FMA chains: the device's arithmetic rate (here), the protocol's sentinel (64 wide).
+    pub FMA_PASS: FmaIo, () = "fma rate", "bench/fma.comp"
+);
 
 /// Iterations per invocation of fma.comp (64 FLOPs each), within llvmpipe's loop budget.
 const ITERS: u32 = 512;
@@ -42,8 +47,7 @@ impl Floor {
         let src = Guard::new(ctx, ctx.storage_buffer("floor copy source", bytes)?);
         let dst = Guard::new(ctx, ctx.storage_buffer("floor copy target", bytes)?);
         let out = Guard::new(ctx, ctx.storage_buffer("floor fma out", invocations * 16)?);
-        let desc = ComputeDesc::plain("fma rate", "bench/fma.comp", &[], 256);
-        let fma = Guard::new(ctx, ComputePipeline::<FmaIo>::new(ctx, &desc)?);
+        let fma = Guard::new(ctx, FMA_PASS.pipeline(ctx, &(), 256, &[])?);
         // Its own folder: the table it serves writes rounds.csv of its own.
         let mut opts = opts.clone();
         opts.out = opts.out.join("floor");

@@ -19,8 +19,7 @@ use super::{BenchConfig, BenchOptions, Row};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
 use crate::gpu::{
-    ComputeDesc, ComputePipeline, Context, FrameTiming, Guard, Profiler, RecordOnly, ScopeKey,
-    FRAME,
+    ComputePipeline, Context, FrameTiming, Guard, Profiler, RecordOnly, ScopeKey, FRAME,
 };
 use crate::report::{pass_stats, stat, Report};
 use crate::trace::Traced;
@@ -173,9 +172,9 @@ pub fn run(ctx: &Context, opts: &BenchOptions, mut cases: Vec<Case>) -> Result<V
     let cpu = ctx.info.kind.to_lowercase().contains("cpu");
     // About a millisecond on lavapipe (noise there is a few per cent), tens of microseconds on a GPU.
     let invocations = if cpu { 1 << 12 } else { 1 << 15 };
-    let desc = ComputeDesc::plain("sentinel", "bench/fma.comp", &[], 64);
+
     let sentinel = Sentinel {
-        pipe: Guard::new(ctx, ComputePipeline::<FmaIo>::new(ctx, &desc)?),
+        pipe: Guard::new(ctx, super::floor::FMA_PASS.pipeline(ctx, &(), 64, &[])?),
         out: Guard::new(ctx, ctx.storage_buffer("sentinel out", invocations * 16)?),
         invocations,
     };

@@ -19,7 +19,7 @@ impl FrameWork for OrbitsWork {
         frame: u64,
         slot: usize,
     ) -> Result<()> {
-        prof.begin(ctx, cmd, OrbitsPass::NAME);
+        prof.begin(ctx, cmd, crate::scene::orbits::SIMULATE.name);
         self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
         prof.end(ctx, cmd);
         // New positions -> the point view's vertex shader.

@@ -149,7 +149,7 @@ impl FluidView for PointsViewer {
         slot: usize,
         save: bool,
     ) -> Result<()> {
-        prof.begin(ctx, cmd, PointsView::NAME);
+        prof.begin(ctx, cmd, crate::render::points::POINTS.name);
         if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
             v.prepare(ctx, cmd, m);
         }
@@ -333,7 +333,7 @@ impl FluidView for MetaballViewer {
         _: bool,
     ) -> Result<()> {
         if let Some(target) = &self.target {
-            prof.begin(ctx, cmd, MeshView::NAME);
+            prof.begin(ctx, cmd, crate::render::mesh::MESH.name);
             let mesh = match &self.mesh {
                 Some(view) => Some((
                     view,

@@ -1,7 +1,7 @@
 //! Axis-aligned bounding box of vec4 positions by a two-level min/max reduction;
 //! the result (min, max as two vec4) stays on the GPU for the Morton pass.
 use crate::error::Result;
-use crate::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::{Buffer, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -21,6 +21,11 @@ crate::gpu_interface! {
     /// glsl/primitives/bounds.comp
     pub BoundsIo / BoundsBufs: "BOUNDS", push BoundsPush { src = 0, dst = 1 }
 }
+
+crate::compute_pass!(
+    /// Both levels of the reduction (`pairs` says which input it reads).
+    pub BOUNDS: BoundsIo, () = "bounds", "primitives/bounds.comp"
+);
 
 pub struct BoundsPass {
     pipeline: ComputePipeline<BoundsIo>,
@@ -55,20 +60,9 @@ impl BoundsBuffers {
 }
 
 impl BoundsPass {
-    pub const NAME: &'static str = "bounds";
-
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc {
-                    name: Self::NAME,
-                    shader: "primitives/bounds.comp",
-                    defines: &[],
-                    local_size: WG,
-                    spec: &[ITEMS],
-                },
-            )?,
+            pipeline: BOUNDS.pipeline(ctx, &(), WG, &[ITEMS])?,
         })
     }
 

@@ -5,7 +5,7 @@
 //! changed every sum over a cell's elements. O(N + cells + sum of squared cell counts).
 use super::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::error::{Error, Result};
-use crate::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::{Buffer, ComputePipeline, Context, Guard};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -113,18 +113,16 @@ impl CountingBuffers {
     }
 }
 
+crate::compute_pass!(pub COUNT: CountIo, () = "count", "primitives/count.comp");
+crate::compute_pass!(pub SCATTER: ScatterIo, () = "scatter", "primitives/scatter.comp");
+crate::compute_pass!(pub CELL_ORDER: OrderIo, () = "cell order", "primitives/cell_order.comp");
+crate::compute_pass!(pub GATHER: GatherIo, () = "gather", "primitives/gather.comp");
+
 impl CountingSort {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let desc = |name, shader| ComputeDesc::plain(name, shader, &[], 256);
-        let count = Guard::new(
-            ctx,
-            ComputePipeline::new(ctx, &desc("count", "primitives/count.comp"))?,
-        );
-        let scatter = Guard::new(
-            ctx,
-            ComputePipeline::new(ctx, &desc("scatter", "primitives/scatter.comp"))?,
-        );
-        let order = ComputePipeline::new(ctx, &desc("cell order", "primitives/cell_order.comp"))?;
+        let count = Guard::new(ctx, COUNT.pipeline(ctx, &(), 256, &[])?);
+        let scatter = Guard::new(ctx, SCATTER.pipeline(ctx, &(), 256, &[])?);
+        let order = CELL_ORDER.pipeline(ctx, &(), 256, &[])?;
         Ok(Self {
             count: count.take(),
             scatter: scatter.take(),
@@ -215,10 +213,7 @@ pub struct GatherPass {
 impl GatherPass {
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain("gather", "primitives/gather.comp", &[], 256),
-            )?,
+            pipeline: GATHER.pipeline(ctx, &(), 256, &[])?,
         })
     }
 

@@ -1,6 +1,6 @@
 //! 30-bit Morton codes (10 bits per axis) of positions relative to a GPU-side box.
 use crate::error::Result;
-use crate::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::{Buffer, ComputePipeline, Context};
 use ash::vk;
 
 crate::gpu_interface! {
@@ -8,19 +8,16 @@ crate::gpu_interface! {
     pub MortonIo / MortonBufs: "MORTON", push u32 { pos = 0, bounds = 1, keys = 2, vals = 3 }
 }
 
+crate::compute_pass!(pub MORTON: MortonIo, () = "morton", "primitives/morton.comp");
+
 pub struct MortonPass {
     pipeline: ComputePipeline<MortonIo>,
 }
 
 impl MortonPass {
-    pub const NAME: &'static str = "morton";
-
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain(Self::NAME, "primitives/morton.comp", &[], 256),
-            )?,
+            pipeline: MORTON.pipeline(ctx, &(), 256, &[])?,
         })
     }
 

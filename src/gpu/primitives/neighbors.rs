@@ -14,7 +14,8 @@ use super::scan::{ScanPass, ScanVariant};
 use super::sort::{Network, NetworkSort};
 use crate::error::{Error, Result};
 use crate::kinds::{Neighbors, SortAlgo};
-use crate::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::pass::{Defines, PassKey};
+use crate::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -113,6 +114,58 @@ crate::gpu_interface! {
 }
 
 /// The default sort of each strategy.
+/// A neighbour search's shader variant: its strategy and whether its sort counts cells.
+/// Every pass that includes neighbors.glsl is keyed by it (or by a key holding it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NbKey {
+    pub strategy: Neighbors,
+    pub sort: SortAlgo,
+}
+
+impl PassKey for NbKey {
+    /// Every strategy with every sort it accepts (Morton's 30-bit codes take no counting).
+    fn all() -> Vec<Self> {
+        let mut v = Vec::new();
+        for strategy in Neighbors::all() {
+            for sort in [SortAlgo::Counting, SortAlgo::OddEven, SortAlgo::Bitonic] {
+                if !(*strategy == Neighbors::Morton && sort == SortAlgo::Counting) {
+                    v.push(Self {
+                        strategy: *strategy,
+                        sort,
+                    });
+                }
+            }
+        }
+        v
+    }
+    fn defines(&self) -> Defines {
+        NeighborSearch::defines_for(self.strategy, self.sort)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect()
+    }
+}
+
+/// The cell-key pass's variants: every search but Morton's, which makes its keys itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CellKeys(pub NbKey);
+
+impl PassKey for CellKeys {
+    fn all() -> Vec<Self> {
+        let v = NbKey::all().into_iter();
+        v.filter(|k| k.strategy != Neighbors::Morton)
+            .map(Self)
+            .collect()
+    }
+    fn defines(&self) -> Defines {
+        self.0.defines()
+    }
+}
+
+crate::compute_pass!(pub CELL_KEYS: NbKeysIo, CellKeys = "cell keys", "primitives/nb_keys.comp");
+crate::compute_pass!(pub CELL_RANGES: NbRangesIo, NbKey = "cell ranges", "primitives/nb_ranges.comp");
+crate::compute_pass!(pub NEIGHBOR_QUERY: NbQueryIo, NbKey = "neighbor query", "primitives/nb_query.comp");
+
 pub fn default_sort(strategy: Neighbors) -> SortAlgo {
     match strategy {
         Neighbors::Grid => SortAlgo::Counting,
@@ -226,8 +279,7 @@ impl NeighborSearch {
                 "--neighbors morton sorts 30-bit codes: use --sort odd-even or bitonic (counting needs bounded cell keys)".into(),
             ));
         }
-        let defines = Self::defines_for(strategy, sort);
-        let desc = |name, shader| ComputeDesc::plain(name, shader, &defines, 128);
+        let key = NbKey { strategy, sort };
         let morton = strategy == Neighbors::Morton;
         // Each part is released if a later one fails.
         let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
@@ -244,20 +296,14 @@ impl NeighborSearch {
             ctx,
             match morton {
                 true => None,
-                false => Some(ComputePipeline::new(
-                    ctx,
-                    &desc("cell keys", "primitives/nb_keys.comp"),
-                )?),
+                false => Some(CELL_KEYS.pipeline(ctx, &CellKeys(key), 128, &[])?),
             },
         );
         let bounds = Guard::new(ctx, morton.then(|| BoundsPass::new(ctx)).transpose()?);
         let morton_pass = Guard::new(ctx, morton.then(|| MortonPass::new(ctx)).transpose()?);
-        let ranges = Guard::new(
-            ctx,
-            ComputePipeline::new(ctx, &desc("cell ranges", "primitives/nb_ranges.comp"))?,
-        );
+        let ranges = Guard::new(ctx, CELL_RANGES.pipeline(ctx, &key, 128, &[])?);
         let gather = Guard::new(ctx, GatherPass::new(ctx)?);
-        let query = ComputePipeline::new(ctx, &desc("neighbor query", "primitives/nb_query.comp"))?;
+        let query = NEIGHBOR_QUERY.pipeline(ctx, &key, 128, &[])?;
         Ok(Self {
             strategy,
             sort,
@@ -297,6 +343,14 @@ impl NeighborSearch {
             ),
         ]);
         d
+    }
+
+    /// The search's shader variant.
+    pub fn key(&self) -> NbKey {
+        NbKey {
+            strategy: self.strategy,
+            sort: self.sort,
+        }
     }
 
     /// Defines for shaders that include neighbors.glsl.

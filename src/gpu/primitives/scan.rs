@@ -10,7 +10,8 @@
 //! About 3N memory traffic. Arrays longer than one storage-buffer binding
 //! (maxStorageBufferRange) are processed in bound segments.
 use crate::error::{Error, Result};
-use crate::{BindingDecl, Buffer, ComputeDesc, ComputePipeline, Context, Guard, Interface};
+use crate::pass::{Defines, PassKey};
+use crate::{BindingDecl, Buffer, ComputePipeline, Context, Guard, Interface};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
@@ -139,6 +140,33 @@ fn range(b: vk::Buffer, start: u64, len: u64) -> vk::DescriptorBufferInfo {
     }
 }
 
+/// Whether a scan adds with subgroup arithmetic (else in shared memory).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Subgroups(pub bool);
+
+impl PassKey for Subgroups {
+    fn all() -> Vec<Self> {
+        vec![Self(false), Self(true)]
+    }
+    fn defines(&self) -> Defines {
+        ScanPass::defines(self.0)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect()
+    }
+}
+
+crate::compute_pass!(
+    /// A level's chunk sums.
+    pub SCAN_CHUNK_SUMS: ScanIo, Subgroups = "scan chunk sums", "primitives/scan_chunk_reduce.comp", "TOP" = "0"
+);
+crate::compute_pass!(
+    /// A level's chunk sums, its last workgroup scanning them (up to TOP_MOST chunks).
+    pub SCAN_CHUNK_SUMS_TOP: ScanIo, Subgroups = "scan chunk sums and top", "primitives/scan_chunk_reduce.comp", "TOP" = "1"
+);
+crate::compute_pass!(pub SCAN_CHUNKS: ScanIo, Subgroups = "scan chunks", "primitives/scan_chunk_down.comp");
+crate::compute_pass!(pub SCAN_TOP: ScanIo, Subgroups = "scan top", "primitives/scan_block.comp");
+
 impl ScanPass {
     pub fn new(ctx: &Context, variant: ScanVariant) -> Result<Self> {
         let subgroup = match variant {
@@ -154,23 +182,11 @@ impl ScanPass {
                 true
             }
         };
-        let defines = Self::defines(subgroup);
-        let pipeline = |name, shader| {
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &defines, WG))
-        };
-        let reduce = |name, top: bool| {
-            let mut d = defines.to_vec();
-            d.push(("TOP", (top as u32).to_string()));
-            let desc = ComputeDesc::plain(name, "primitives/scan_chunk_reduce.comp", &d, WG);
-            ComputePipeline::new(ctx, &desc).map(|p| Guard::new(ctx, p))
-        };
-        let chunk_reduce = reduce("scan chunk sums", false)?;
-        let chunk_reduce_top = reduce("scan chunk sums and top", true)?;
-        let chunk_down = Guard::new(
-            ctx,
-            pipeline("scan chunks", "primitives/scan_chunk_down.comp")?,
-        );
-        let top = pipeline("scan top", "primitives/scan_block.comp")?;
+        let key = Subgroups(subgroup);
+        let chunk_reduce = Guard::new(ctx, SCAN_CHUNK_SUMS.pipeline(ctx, &key, WG, &[])?);
+        let chunk_reduce_top = Guard::new(ctx, SCAN_CHUNK_SUMS_TOP.pipeline(ctx, &key, WG, &[])?);
+        let chunk_down = Guard::new(ctx, SCAN_CHUNKS.pipeline(ctx, &key, WG, &[])?);
+        let top = SCAN_TOP.pipeline(ctx, &key, WG, &[])?;
         Ok(Self {
             chunk_reduce: chunk_reduce.take(),
             chunk_reduce_top: chunk_reduce_top.take(),

@@ -3,12 +3,15 @@
 //! elements are sorted (and, for bitonic, merged) in shared memory; the remaining
 //! comparator stages are one dispatch each.
 use crate::error::{Error, Result};
-use crate::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::{Buffer, ComputePipeline, Context};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
 pub const BLOCK: u32 = 2048;
 const WG: u32 = 256;
+
+crate::compute_pass!(pub ODD_EVEN: SortIo, () = "odd-even merge sort", "primitives/oddeven.comp");
+crate::compute_pass!(pub BITONIC: SortIo, () = "bitonic sort", "primitives/bitonic.comp");
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Network {
@@ -41,21 +44,12 @@ pub struct NetworkSort {
 
 impl NetworkSort {
     pub fn new(ctx: &Context, network: Network) -> Result<Self> {
-        let (name, shader) = match network {
-            Network::OddEven => ("odd-even merge sort", "primitives/oddeven.comp"),
-            Network::Bitonic => ("bitonic sort", "primitives/bitonic.comp"),
+        let decl = match network {
+            Network::OddEven => ODD_EVEN,
+            Network::Bitonic => BITONIC,
         };
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc {
-                    name,
-                    shader,
-                    defines: &[],
-                    local_size: WG,
-                    spec: &[BLOCK],
-                },
-            )?,
+            pipeline: decl.pipeline(ctx, &(), WG, &[BLOCK])?,
             network,
         })
     }

@@ -308,7 +308,7 @@ impl SceneCharacter {
     ) -> Result<()> {
         let mats = self.matrices(t);
         let joints = self.ch.gpu_joints(&mats, self.method)?;
-        prof.begin(ctx, cmd, crate::character::skin::SkinPass::NAME);
+        prof.begin(ctx, cmd, crate::character::skin::SKIN.name);
         self.skinner.record(ctx, cmd, &joints)?;
         prof.end(ctx, cmd);
         Ok(())

@@ -1,7 +1,7 @@
 //! Test scene: particles orbiting an attractor inside a box, moved by one compute pass.
 use crate::error::Result;
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard};
 use bytemuck::{Pod, Zeroable};
 use rand::{Rng, SeedableRng};
 
@@ -86,20 +86,17 @@ crate::gpu_interface! {
     pub OrbitsIo / OrbitsBufs: "ORB", push OrbitsPush { pos = 0, vel = 1 }
 }
 
+crate::gpu::compute_pass!(pub SIMULATE: OrbitsIo, () = "simulate", "scene/orbits.comp");
+
 /// The size-independent part: the step pipeline.
 pub struct OrbitsPass {
     pipeline: ComputePipeline<OrbitsIo>,
 }
 
 impl OrbitsPass {
-    pub const NAME: &'static str = "simulate";
-
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain(Self::NAME, "scene/orbits.comp", &[], 256),
-            )?,
+            pipeline: SIMULATE.pipeline(ctx, &(), 256, &[])?,
         })
     }
 

@@ -4,8 +4,9 @@ use super::model::Mesh;
 use super::pose::GpuJoint;
 use crate::character::Skinning;
 use crate::error::{Error, Result};
+use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard};
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
@@ -27,9 +28,29 @@ pub struct SkinPass {
     pub sets: usize,
 }
 
-impl SkinPass {
-    pub const NAME: &'static str = "skin";
+/// The skinning shader's variant: the method and the influence sets (1: 4 per vertex, 2: 8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SkinKey {
+    pub method: Skinning,
+    pub sets: usize,
+}
 
+impl PassKey for SkinKey {
+    fn all() -> Vec<Self> {
+        let methods = Skinning::all().iter();
+        methods
+            .flat_map(|m| [1, 2].map(|sets| Self { method: *m, sets }))
+            .collect()
+    }
+    fn defines(&self) -> Defines {
+        let d = SkinPass::defines(self.method, self.sets).into_iter();
+        d.map(|(k, v)| (k.to_string(), v)).collect()
+    }
+}
+
+crate::gpu::compute_pass!(pub SKIN: SkinIo, SkinKey = "skin", "character/skin.comp");
+
+impl SkinPass {
     pub fn defines(method: Skinning, sets: usize) -> Vec<(&'static str, String)> {
         let m = match method {
             Skinning::Lbs => 0,
@@ -43,10 +64,8 @@ impl SkinPass {
 
     /// For meshes of `sets` influence sets (1: 4 per vertex, 2: 8).
     pub fn new(ctx: &Context, method: Skinning, sets: usize) -> Result<Self> {
-        let defines = Self::defines(method, sets);
-        let desc = ComputeDesc::plain(Self::NAME, "character/skin.comp", &defines, 64);
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, &desc)?,
+            pipeline: SKIN.pipeline(ctx, &SkinKey { method, sets }, 64, &[])?,
             method,
             sets,
         })

@@ -5,13 +5,17 @@
 //! (`control-force`, over the control grid), with adaptive control pressure and an
 //! optional velocity term.
 use super::cache::ForceCache;
+use super::passes::{
+    ControlKey, CONTROL_AGGREGATE, CONTROL_DENSITY, CONTROL_FIELD, CONTROL_FORCE,
+    CONTROL_FORCE_STORED,
+};
 pub use super::settings::ControlSettings;
 use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
@@ -214,21 +218,16 @@ impl ControlForce {
         let m = control_count(mesh, &settings, rays)?;
         let (kind, sort) = (Neighbors::Grid, SortAlgo::Counting);
         // The passes walk the fluid's grid with the fluid search's defines.
-        let eos = crate::sph::params::defines();
-        let mut defines = solver.search.defines();
-        defines.extend(eos.iter().map(|(k, v)| (k.as_str(), v.clone())));
-        defines.extend(ControlSettings::defines(settings.adaptive));
-        let pipeline = |name, shader, refresh: Option<&str>| {
-            let mut d = defines.clone();
-            d.extend(refresh.map(|r| ("CONTROL_REFRESH", r.to_string())));
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &d, 64))
-                .map(|p| Guard::new(ctx, p))
+        let key = ControlKey {
+            search: solver.search.key(),
+            adaptive: settings.adaptive,
         };
-        let density = pipeline("control-density", "control/density.comp", None)?;
-        let aggregate = pipeline("control-aggregate", "control/aggregate.comp", None)?;
-        let field = pipeline("control-field", "control/field.comp", None)?;
-        let force = pipeline("control-force", "control/force.comp", Some("1"))?;
-        let apply = pipeline("control-force-stored", "control/force.comp", Some("0"))?;
+        let pipeline = |p: Result<ComputePipeline<ControlIo>>| p.map(|p| Guard::new(ctx, p));
+        let density = pipeline(CONTROL_DENSITY.pipeline(ctx, &key, 64, &[]))?;
+        let aggregate = pipeline(CONTROL_AGGREGATE.pipeline(ctx, &key, 64, &[]))?;
+        let field = pipeline(CONTROL_FIELD.pipeline(ctx, &key, 64, &[]))?;
+        let force = pipeline(CONTROL_FORCE.pipeline(ctx, &key, 64, &[]))?;
+        let apply = pipeline(CONTROL_FORCE_STORED.pipeline(ctx, &key, 64, &[]))?;
         // Rays: three more layers above the domain in z, the last one parking the unused
         // slots two cells away from any fluid particle's.
         let r = settings.radius;

@@ -12,6 +12,7 @@ pub mod inside;
 pub mod mesh_distance;
 pub mod metrics;
 mod metrics_worker;
+pub mod passes;
 pub mod placement;
 pub mod rays;
 pub mod settings;

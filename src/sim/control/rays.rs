@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
 use crate::gpu::{
-    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
+    Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Scopes,
 };
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch, ScanVariant};
 use bytemuck::{Pod, Zeroable};
@@ -104,28 +104,26 @@ pub struct RaysPlacer {
     pub park: f32,
 }
 
+crate::gpu::graphics_pass!(
+    /// Counts each pixel's fragments along z.
+    pub RAYS_COUNT: RaysIo, () = "rays count", "control/rays.vert", "control/rays.frag", "PASS" = "0"
+);
+crate::gpu::graphics_pass!(
+    /// Writes each pixel's fragments into its range.
+    pub RAYS_FILL: RaysIo, () = "rays fill", "control/rays.vert", "control/rays.frag", "PASS" = "1"
+);
+crate::gpu::compute_pass!(pub RAYS_SORT: RaysIo, () = "rays sort", "control/rays_count.comp");
+crate::gpu::compute_pass!(pub RAYS_EMIT: RaysIo, () = "rays emit", "control/rays_emit.comp");
+
 impl RaysPlacer {
     pub const NAME: &'static str = "place";
 
     pub fn new(ctx: &Context, grid: RaysGrid, capacity: u32, park: f32) -> Result<Self> {
-        let graphics = |name: &str, pass: u32| -> Result<Guard<GraphicsPipeline<RaysIo>>> {
-            let defines = [("PASS", pass.to_string())];
-            let desc = GraphicsDesc::storage_only(
-                name,
-                "control/rays.vert",
-                "control/rays.frag",
-                &defines,
-            );
-            Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
-        };
-        let count = graphics("rays count", 0)?;
-        let fill = graphics("rays fill", 1)?;
-        let compute = |name, shader| -> Result<Guard<ComputePipeline<RaysIo>>> {
-            let desc = ComputeDesc::plain(name, shader, &[], 64);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
-        };
-        let sort_count = compute("rays sort", "control/rays_count.comp")?;
-        let emit = compute("rays emit", "control/rays_emit.comp")?;
+        let storage = GraphicsStates::STORAGE_ONLY;
+        let count = Guard::new(ctx, RAYS_COUNT.pipeline(ctx, &(), storage)?);
+        let fill = Guard::new(ctx, RAYS_FILL.pipeline(ctx, &(), storage)?);
+        let sort_count = Guard::new(ctx, RAYS_SORT.pipeline(ctx, &(), 64, &[])?);
+        let emit = Guard::new(ctx, RAYS_EMIT.pipeline(ctx, &(), 64, &[])?);
         let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
         let px = grid.pixels();
         let frag_capacity = (px * FRAGMENTS_PER_PIXEL).min(u32::MAX as u64 / 8);

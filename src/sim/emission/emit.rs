@@ -5,8 +5,9 @@
 //! step (due, alive, birth requests), per frame (births, speeds) and per emitting
 //! primitive (births) stay on the GPU.
 use crate::error::{Error, Result};
+use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard};
 use bytemuck::{Pod, Zeroable};
 
 /// glsl/emission/emit.comp `EmitParams`.
@@ -50,6 +51,21 @@ pub struct EmitSettings {
     /// Half the finite-difference interval in tau (0 < dtau < 1/2).
     pub dtau: f32,
 }
+
+/// Whether the emitter's sources are UV-layout texels (else mesh vertices).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FromTexels(pub bool);
+
+impl PassKey for FromTexels {
+    fn all() -> Vec<Self> {
+        vec![Self(false), Self(true)]
+    }
+    fn defines(&self) -> Defines {
+        vec![("EMIT_UV".to_string(), (self.0 as u32).to_string())]
+    }
+}
+
+crate::gpu::compute_pass!(pub EMIT: EmitIo, FromTexels = "emit", "emission/emit.comp");
 
 impl Default for EmitSettings {
     fn default() -> Self {
@@ -123,9 +139,7 @@ impl EmitPass {
     /// For an emitter over `primitives` histogram bins; `uv`: the sources are texels whose
     /// w holds the layout triangle + 1 (else vertices, binned by index).
     pub fn new(ctx: &Context, uv: bool, primitives: u32) -> Result<Self> {
-        let defines = [("EMIT_UV", (uv as u32).to_string())];
-        let d = ComputeDesc::plain("emit", "emission/emit.comp", &defines, 64);
-        let pipeline = Guard::new(ctx, ComputePipeline::new(ctx, &d)?);
+        let pipeline = Guard::new(ctx, EMIT.pipeline(ctx, &FromTexels(uv), 64, &[])?);
         let buf = |name: &str, bytes| ctx.storage_buffer(name, bytes).map(|b| Guard::new(ctx, b));
         let params = buf("emit params", std::mem::size_of::<EmitGpuParams>() as u64)?;
         let counts = buf("emit counts", 16)?;

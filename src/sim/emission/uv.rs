@@ -10,8 +10,7 @@ use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
 use crate::gpu::{
-    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
-    Scopes,
+    Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Labels, Scopes,
 };
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch, ScanVariant};
 use bytemuck::{Pod, Zeroable};
@@ -83,6 +82,13 @@ fn check_size(ctx: &Context, layout: &UvLayout, size: [u32; 2]) -> Result<()> {
     Ok(())
 }
 
+crate::gpu::graphics_pass!(
+    /// Rasterises the UV layout: each covered texel's triangle.
+    pub UV: UvIo, () = "uv", "emission/uv.vert", "emission/uv.frag"
+);
+crate::gpu::compute_pass!(pub UV_FLAGS: UvIo, () = "uv flags", "emission/uv_flags.comp");
+crate::gpu::compute_pass!(pub UV_COMPACT: UvIo, () = "uv compact", "emission/uv_compact.comp");
+
 impl UvSurface {
     pub const NAME: &'static str = "uv";
 
@@ -97,14 +103,9 @@ impl UvSurface {
     ) -> Result<Self> {
         check_size(ctx, layout, size)?;
         let texels = size[0] as u64 * size[1] as u64;
-        let desc = GraphicsDesc::storage_only("uv", "emission/uv.vert", "emission/uv.frag", &[]);
-        let raster = Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?);
-        let compute = |name, shader| -> Result<Guard<ComputePipeline<UvIo>>> {
-            let d = ComputeDesc::plain(name, shader, &[], 64);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &d)?))
-        };
-        let flags_pass = compute("uv flags", "emission/uv_flags.comp")?;
-        let compact = compute("uv compact", "emission/uv_compact.comp")?;
+        let raster = Guard::new(ctx, UV.pipeline(ctx, &(), GraphicsStates::STORAGE_ONLY)?);
+        let flags_pass = Guard::new(ctx, UV_FLAGS.pipeline(ctx, &(), 64, &[])?);
+        let compact = Guard::new(ctx, UV_COMPACT.pipeline(ctx, &(), 64, &[])?);
         let scan = Guard::new(ctx, ScanPass::new(ctx, ScanVariant::Auto)?);
         let scratch = Guard::new(ctx, scan.scratch(ctx, texels + 1)?);
         let buf =

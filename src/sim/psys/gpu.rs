@@ -6,14 +6,14 @@ use super::spec::{
     MAX_KEYS,
 };
 use crate::error::Result;
+use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::vk;
-use crate::gpu::{
-    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard,
-};
+use crate::gpu::{Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard};
 use crate::kinds::Neighbors;
 use crate::kinds::SortAlgo;
 use crate::primitives::counting::CountingSort;
+use crate::primitives::neighbors::NbKey;
 use crate::primitives::neighbors::{GridSpec, NeighborSearch};
 use crate::primitives::scan::{ScanPass, ScanVariant};
 use crate::primitives::sort::{Network, NetworkSort};
@@ -299,6 +299,52 @@ crate::gpu_interface! {
 }
 
 /// The draw mode's shader define and primitive topology.
+/// Whether the update aggregates its list appends per subgroup (ballot).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ballot(pub bool);
+
+impl PassKey for Ballot {
+    fn all() -> Vec<Self> {
+        vec![Self(false), Self(true)]
+    }
+    fn defines(&self) -> Defines {
+        let d = Passes::update_defines(self.0).into_iter();
+        d.map(|(k, v)| (k.to_string(), v)).collect()
+    }
+}
+
+/// The boids' neighbour search: the counting grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoidsGrid(pub NbKey);
+
+impl PassKey for BoidsGrid {
+    fn all() -> Vec<Self> {
+        vec![Self(NbKey {
+            strategy: Neighbors::Grid,
+            sort: SortAlgo::Counting,
+        })]
+    }
+    fn defines(&self) -> Defines {
+        self.0.defines()
+    }
+}
+
+impl PassKey for SpriteMode {
+    fn all() -> Vec<Self> {
+        SpriteMode::all().to_vec()
+    }
+    fn defines(&self) -> Defines {
+        vec![("MODE".to_string(), draw_mode(*self).0.to_string())]
+    }
+}
+
+crate::gpu::compute_pass!(pub EMIT: PsysIo, () = "psys emit", "psys/emit.comp");
+crate::gpu::compute_pass!(pub ARGS: PsysIo, () = "psys args", "psys/args.comp");
+crate::gpu::compute_pass!(pub UPDATE: PsysIo, Ballot = "psys update", "psys/update.comp");
+crate::gpu::compute_pass!(pub KEYS: PsysIo, () = "psys keys", "psys/keys.comp");
+crate::gpu::compute_pass!(pub BOIDS: BoidsIo, BoidsGrid = "psys boids", "psys/boids.comp");
+crate::gpu::graphics_pass!(pub DRAW: DrawIo, SpriteMode = "psys draw", "psys/draw.vert", "psys/draw.frag");
+
 pub fn draw_mode(mode: SpriteMode) -> (u32, vk::PrimitiveTopology, bool) {
     match mode {
         SpriteMode::Points => (0, vk::PrimitiveTopology::POINT_LIST, false),
@@ -350,44 +396,25 @@ impl Passes {
     /// `subgroups`: aggregate the update's list appends per subgroup (the device must
     /// have subgroup ballot); off, one atomic per particle (the plain variant).
     pub fn with_subgroups(ctx: &Context, subgroups: bool) -> Result<Self> {
-        let c = |name, shader, ls, defines: &[(&str, String)]| {
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, defines, ls))
-                .map(|p| Guard::new(ctx, p))
-        };
-        let emit = c("psys emit", "psys/emit.comp", 256, &[])?;
-        let args = c("psys args", "psys/args.comp", 1, &[])?;
-        let update = c(
-            "psys update",
-            "psys/update.comp",
-            256,
-            &Self::update_defines(subgroups),
-        )?;
-        let keys = c("psys keys", "psys/keys.comp", 256, &[])?;
+        let emit = Guard::new(ctx, EMIT.pipeline(ctx, &(), 256, &[])?);
+        let args = Guard::new(ctx, ARGS.pipeline(ctx, &(), 1, &[])?);
+        let update = Guard::new(ctx, UPDATE.pipeline(ctx, &Ballot(subgroups), 256, &[])?);
+        let keys = Guard::new(ctx, KEYS.pipeline(ctx, &(), 256, &[])?);
         let grid = Guard::new(
             ctx,
             NeighborSearch::new(ctx, Neighbors::Grid, Some(SortAlgo::Counting))?,
         );
-        let boids = ComputePipeline::new(
-            ctx,
-            &ComputeDesc::plain("psys boids", "psys/boids.comp", &grid.defines(), 256),
-        )
-        .map(|p| Guard::new(ctx, p))?;
+        let boids = Guard::new(ctx, BOIDS.pipeline(ctx, &BoidsGrid(grid.key()), 256, &[])?);
         let mut draw = Guard::new(ctx, Vec::new());
         for mode in [SpriteMode::Points, SpriteMode::Streaks, SpriteMode::Sprites] {
-            let (m, topology, blend) = draw_mode(mode);
-            draw.push(GraphicsPipeline::new(
-                ctx,
-                &GraphicsDesc {
-                    name: "psys draw",
-                    vertex: "psys/draw.vert",
-                    fragment: "psys/draw.frag",
-                    defines: &[("MODE", m.to_string())],
-                    color_format: Some(COLOR_FORMAT),
-                    depth_format: Some(DEPTH_FORMAT),
-                    blend,
-                    topology,
-                },
-            )?);
+            let (_, topology, blend) = draw_mode(mode);
+            let states = GraphicsStates {
+                color_format: Some(COLOR_FORMAT),
+                depth_format: Some(DEPTH_FORMAT),
+                blend,
+                topology,
+            };
+            draw.push(DRAW.pipeline(ctx, &mode, states)?);
         }
         let odd_even = Guard::new(ctx, NetworkSort::new(ctx, Network::OddEven)?);
         let bitonic = Guard::new(ctx, NetworkSort::new(ctx, Network::Bitonic)?);

@@ -2,12 +2,12 @@
 //! skinning pass's positions and normals, depth-tested in the frame's colour target.
 use super::Camera;
 use crate::error::{Error, Result};
-use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, Context, GraphicsDesc, GraphicsPipeline};
+use crate::gpu::{Buffer, Context, GraphicsPipeline};
 use crate::render::ShowMesh;
 use bytemuck::{Pod, Zeroable};
 
+crate::gpu::graphics_pass!(pub MESH: MeshIo, () = "mesh", "render/mesh.vert", "render/mesh.frag");
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct MeshPush {
@@ -40,8 +40,6 @@ pub struct MeshView {
 pub const MESH_COLOR: [f32; 3] = [0.85, 0.55, 0.35];
 
 impl MeshView {
-    pub const NAME: &'static str = "mesh";
-
     pub fn new(ctx: &Context, cam: &Camera, show: ShowMesh) -> Result<Self> {
         let wire = match show {
             ShowMesh::Shaded => 0.0,
@@ -55,19 +53,7 @@ impl MeshView {
         };
         let e = cam.eye;
         Ok(Self {
-            pipeline: GraphicsPipeline::new(
-                ctx,
-                &GraphicsDesc {
-                    name: Self::NAME,
-                    vertex: "render/mesh.vert",
-                    fragment: "render/mesh.frag",
-                    defines: &[],
-                    color_format: Some(COLOR_FORMAT),
-                    depth_format: Some(DEPTH_FORMAT),
-                    blend: false,
-                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                },
-            )?,
+            pipeline: MESH.pipeline(ctx, &(), super::opaque_states())?,
             push: MeshPush {
                 view_proj: cam.view_proj().to_cols_array_2d(),
                 eye: [e.x, e.y, e.z, 1.0],

@@ -20,3 +20,14 @@ use crate::gpu::ScopeKey;
 /// A frame's rendering scope: every surface's passes are timed inside it.
 pub const SCOPE: ScopeKey = ScopeKey::new("render");
 pub use points::PointsView;
+
+/// An opaque draw into the frame's colour and depth targets.
+pub fn opaque_states() -> crate::gpu::GraphicsStates {
+    use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
+    crate::gpu::GraphicsStates {
+        color_format: Some(COLOR_FORMAT),
+        depth_format: Some(DEPTH_FORMAT),
+        blend: false,
+        topology: crate::gpu::vk::PrimitiveTopology::TRIANGLE_LIST,
+    }
+}

@@ -1,9 +1,8 @@
 //! Particle view: instanced camera-facing sphere impostors from position/colour buffers.
 use super::Camera;
 use crate::error::Result;
-use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, Context, GraphicsDesc, GraphicsPipeline};
+use crate::gpu::{Buffer, Context, GraphicsPipeline};
 use bytemuck::{Pod, Zeroable};
 
 #[repr(C)]
@@ -36,24 +35,12 @@ pub struct PointsView {
     pipeline: GraphicsPipeline<PointsIo>,
 }
 
-impl PointsView {
-    pub const NAME: &'static str = "points";
+crate::gpu::graphics_pass!(pub POINTS: PointsIo, () = "points", "render/points.vert", "render/points.frag");
 
+impl PointsView {
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: GraphicsPipeline::new(
-                ctx,
-                &GraphicsDesc {
-                    name: Self::NAME,
-                    vertex: "render/points.vert",
-                    fragment: "render/points.frag",
-                    defines: &[],
-                    color_format: Some(COLOR_FORMAT),
-                    depth_format: Some(DEPTH_FORMAT),
-                    blend: false,
-                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-                },
-            )?,
+            pipeline: POINTS.pipeline(ctx, &(), super::opaque_states())?,
         })
     }
 

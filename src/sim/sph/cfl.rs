@@ -12,7 +12,7 @@ use super::params::SphGpuParams;
 use super::solver::SphState;
 use crate::error::Result;
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard};
 use bytemuck::{Pod, Zeroable};
 
 const WG: u32 = 256;
@@ -44,23 +44,16 @@ const CLOCK_BYTES: u64 = 32;
 const HEAD: usize = std::mem::offset_of!(SphGpuParams, h) + 4;
 const DT_PREV: u32 = ((std::mem::offset_of!(SphGpuParams, dt_prev) - HEAD) / 4) as u32;
 
+crate::gpu::compute_pass!(pub CFL: CflIo, () = "cfl", "sph/cfl.comp");
+
 pub struct CflPass {
     pipeline: ComputePipeline<CflIo>,
 }
 
 impl CflPass {
-    pub const NAME: &'static str = "cfl";
-
     pub fn new(ctx: &Context) -> Result<Self> {
-        let desc = ComputeDesc {
-            name: "sph/cfl",
-            shader: "sph/cfl.comp",
-            defines: &[],
-            local_size: WG,
-            spec: &[ITEMS],
-        };
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, &desc)?,
+            pipeline: CFL.pipeline(ctx, &(), WG, &[ITEMS])?,
         })
     }
 

@@ -9,10 +9,10 @@
 //! iteration's source pass ends the iteration: a step at 2 + 1 iterations runs 14
 //! dispatches from factor to Euler, and each spare iteration recorded 2 empty ones.
 use super::pressure::{
-    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
-    EULER,
+    check_iterations, check_range, check_step, Convergence, PassCode, PassDecl, Pipelines,
+    PressureSolver, EULER,
 };
-use super::solver::{SphSolver, SphState};
+use super::solver::{SphKey, SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
@@ -126,43 +126,33 @@ impl DfsphParams {
     }
 }
 
-/// The passes, in [`PASSES`] order.
-#[derive(Clone, Copy)]
-enum Pass {
-    Factor,
-    Forces,
-    WarmDensity,
-    PredictDensity,
-    SourceDensity,
-    VelocityDensity,
-    CheckDensity,
-    VelocityDivergence,
-    SourceDivergence,
-    CheckDivergence,
-    Euler,
-}
-
 const SHADER: &str = "sph/dfsph.comp";
 
-pub const PASSES: [PassDecl; 11] = [
-    PassDecl::new("factor", SHADER, "PASS_FACTOR")
-        .divergence()
-        .starts(),
-    PassDecl::new("forces", "sph/forces.comp", "PASS_FORCES"),
-    PassDecl::new("warm/density", SHADER, "PASS_WARM")
-        .starts()
-        .predicted(),
-    PassDecl::new("predict/density", SHADER, "PASS_VELOCITY").predicted(),
-    PassDecl::new("source/density", SHADER, "PASS_SOURCE"),
-    PassDecl::new("velocity/density", SHADER, "PASS_VELOCITY"),
-    PassDecl::new("check/density", SHADER, "PASS_SOURCE").check(),
-    PassDecl::new("velocity/divergence", SHADER, "PASS_VELOCITY").divergence(),
-    PassDecl::new("source/divergence", SHADER, "PASS_SOURCE").divergence(),
-    PassDecl::new("check/divergence", SHADER, "PASS_SOURCE")
-        .divergence()
-        .check(),
-    EULER,
-];
+super::pressure::solver_passes!(
+    "dfsph",
+    /// The passes: each variant with its declaration, in the order that indexes the pipelines.
+    enum Pass {
+        Factor = PassDecl::new("factor", SHADER, PassCode::Factor)
+            .divergence()
+            .starts(),
+        Forces = PassDecl::new("forces", "sph/forces.comp", PassCode::Forces),
+        WarmDensity = PassDecl::new("warm/density", SHADER, PassCode::Warm)
+            .starts()
+            .predicted(),
+        PredictDensity = PassDecl::new("predict/density", SHADER, PassCode::Velocity).predicted(),
+        SourceDensity = PassDecl::new("source/density", SHADER, PassCode::Source),
+        VelocityDensity = PassDecl::new("velocity/density", SHADER, PassCode::Velocity),
+        CheckDensity = PassDecl::new("check/density", SHADER, PassCode::Source).check(),
+        VelocityDivergence =
+            PassDecl::new("velocity/divergence", SHADER, PassCode::Velocity).divergence(),
+        SourceDivergence =
+            PassDecl::new("source/divergence", SHADER, PassCode::Source).divergence(),
+        CheckDivergence = PassDecl::new("check/divergence", SHADER, PassCode::Source)
+            .divergence()
+            .check(),
+        Euler = EULER,
+    }
+);
 
 /// One of the two solves after its warm start: its scope, the passes that apply the warm
 /// start's change and take the first residual, and an iteration's passes.
@@ -190,8 +180,8 @@ const DENSITY: Solve = Solve {
 pub struct Dfsph(Pipelines);
 
 impl Dfsph {
-    pub fn new(ctx: &Context, base: &[(&str, String)]) -> Result<Self> {
-        Pipelines::new(ctx, Solver::Dfsph, &PASSES, base).map(Self)
+    pub fn new(ctx: &Context, key: &SphKey) -> Result<Self> {
+        Pipelines::new(ctx, Solver::Dfsph, Pass::TABLE, key).map(Self)
     }
 
     /// One solve after its warm start (the factor pass's or the warm pass's, in `warm`):

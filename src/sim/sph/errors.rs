@@ -5,7 +5,7 @@
 use super::solver::SphState;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, MemoryLocation};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
@@ -115,24 +115,14 @@ pub struct StepErrors {
     max_steps: u32,
 }
 
+crate::gpu::compute_pass!(pub STEP_ERROR: StepErrorIo, () = "sph/errors", "sph/step_error.comp");
+
 impl StepErrors {
     pub const NAME: &'static str = "sph/errors";
 
     /// For up to `capacity` particles and `max_steps` steps per frame in each of `slots`.
     pub fn new(ctx: &Context, capacity: u64, slots: usize, max_steps: u32) -> Result<Self> {
-        let pipeline = Guard::new(
-            ctx,
-            ComputePipeline::new(
-                ctx,
-                &ComputeDesc {
-                    name: Self::NAME,
-                    shader: "sph/step_error.comp",
-                    defines: &[],
-                    local_size: WG,
-                    spec: &[ITEMS],
-                },
-            )?,
-        );
+        let pipeline = Guard::new(ctx, STEP_ERROR.pipeline(ctx, &(), WG, &[ITEMS])?);
         let partials = Guard::new(
             ctx,
             ctx.storage_buffer("step error partials", capacity.div_ceil(BLOCK).max(1) * 16)?,

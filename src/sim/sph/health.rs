@@ -4,12 +4,13 @@
 use super::solver::SphState;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, MemoryLocation};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, MemoryLocation};
 use bytemuck::{Pod, Zeroable};
 
 /// Mirror of `Health` in glsl/sph/health.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+
 pub struct GpuHealth {
     pub nonfinite: u32,
     /// Bits of the largest speed squared.
@@ -33,6 +34,8 @@ crate::gpu_interface! {
     pub HealthIo / HealthBufs: "HEALTH", push u32 { vel = 0, rho_p = 1, out = 2 }
 }
 
+crate::gpu::compute_pass!(pub HEALTH: HealthIo, () = "health", "sph/health.comp");
+
 /// Densities above this many times rho_0 mean the step cannot resolve the compression.
 pub const MAX_DENSITY_RATIO: f32 = 10.0;
 
@@ -48,13 +51,7 @@ pub struct Health {
 
 impl Health {
     pub fn new(ctx: &Context, slots: usize) -> Result<Self> {
-        let pipeline = Guard::new(
-            ctx,
-            ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain("health", "sph/health.comp", &[], 128),
-            )?,
-        );
+        let pipeline = Guard::new(ctx, HEALTH.pipeline(ctx, &(), 128, &[])?);
         let out = Guard::new(ctx, ctx.storage_buffer("sph health", 16)?);
         let mut readbacks = Guard::new(ctx, Vec::new());
         for _ in 0..slots {

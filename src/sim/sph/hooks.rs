@@ -5,7 +5,7 @@
 use super::solver::SphState;
 use crate::error::Result;
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context};
+use crate::gpu::{Buffer, ComputePipeline, Context};
 use bytemuck::{Pod, Zeroable};
 
 pub trait SphHook {
@@ -41,6 +41,7 @@ impl Hooks<'_> {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
+
 pub struct ConstantForcePush {
     /// xyz: acceleration added to every particle, m/s^2.
     pub accel: [f32; 4],
@@ -52,6 +53,8 @@ crate::gpu_interface! {
     pub ConstantForceIo / ConstantForceBufs: "CF", push ConstantForcePush { acc = 0 }
 }
 
+crate::gpu::compute_pass!(pub CONSTANT_FORCE: ConstantForceIo, () = "constant force", "sph/constant_force.comp");
+
 /// A uniform extra acceleration (a steady wind, a tilted gravity): the smallest force
 /// term, the reference for how one plugs into the step.
 pub struct ConstantForce {
@@ -62,10 +65,7 @@ pub struct ConstantForce {
 impl ConstantForce {
     pub fn new(ctx: &Context, accel: [f32; 3]) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain("constant force", "sph/constant_force.comp", &[], 128),
-            )?,
+            pipeline: CONSTANT_FORCE.pipeline(ctx, &(), 128, &[])?,
             accel,
         })
     }

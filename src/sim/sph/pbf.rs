@@ -3,9 +3,10 @@
 //! apply) to the density error target or a fixed count, velocities from the positions,
 //! then vorticity confinement and XSPH viscosity (glsl/sph/pbf.comp).
 use super::pressure::{
-    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
+    check_iterations, check_range, check_step, Convergence, PassCode, PassDecl, Pipelines,
+    PressureSolver,
 };
-use super::solver::{SphSolver, SphState};
+use super::solver::{SphKey, SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
@@ -109,39 +110,31 @@ impl PbfParams {
     }
 }
 
-/// The passes, in [`PASSES`] order.
-#[derive(Clone, Copy)]
-enum Pass {
-    Predict,
-    Lambda,
-    Delta,
-    Apply,
-    Velocity,
-    Vorticity,
-    Confine,
-}
-
 const SHADER: &str = "sph/pbf.comp";
 
 /// An iteration: the pass that checks, and the ones after it.
 const CHECKED: [Pass; 1] = [Pass::Lambda];
 const REST: [Pass; 2] = [Pass::Delta, Pass::Apply];
 
-pub const PASSES: [PassDecl; 7] = [
-    PassDecl::new("predict", SHADER, "PASS_PREDICT").starts(),
-    PassDecl::new("lambda", SHADER, "PASS_LAMBDA").check(),
-    PassDecl::new("delta", SHADER, "PASS_DELTA"),
-    PassDecl::new("apply", SHADER, "PASS_APPLY"),
-    PassDecl::new("velocity", SHADER, "PASS_VELOCITY"),
-    PassDecl::new("vorticity", SHADER, "PASS_VORTICITY"),
-    PassDecl::new("confine", SHADER, "PASS_CONFINE"),
-];
+super::pressure::solver_passes!(
+    "pbf",
+    /// The passes: each variant with its declaration, in the order that indexes the pipelines.
+    enum Pass {
+        Predict = PassDecl::new("predict", SHADER, PassCode::Predict).starts(),
+        Lambda = PassDecl::new("lambda", SHADER, PassCode::Lambda).check(),
+        Delta = PassDecl::new("delta", SHADER, PassCode::Delta),
+        Apply = PassDecl::new("apply", SHADER, PassCode::Apply),
+        Velocity = PassDecl::new("velocity", SHADER, PassCode::Velocity),
+        Vorticity = PassDecl::new("vorticity", SHADER, PassCode::Vorticity),
+        Confine = PassDecl::new("confine", SHADER, PassCode::Confine),
+    }
+);
 
 pub struct Pbf(Pipelines);
 
 impl Pbf {
-    pub fn new(ctx: &Context, base: &[(&str, String)]) -> Result<Self> {
-        Pipelines::new(ctx, Solver::Pbf, &PASSES, base).map(Self)
+    pub fn new(ctx: &Context, key: &SphKey) -> Result<Self> {
+        Pipelines::new(ctx, Solver::Pbf, Pass::TABLE, key).map(Self)
     }
 }
 

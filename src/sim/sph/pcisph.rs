@@ -2,10 +2,10 @@
 //! pressure iterations to the density error target, then symplectic Euler
 //! (glsl/sph/pcisph.comp, euler.comp).
 use super::pressure::{
-    check_iterations, check_range, check_step, Convergence, PassDecl, Pipelines, PressureSolver,
-    EULER,
+    check_iterations, check_range, check_step, Convergence, PassCode, PassDecl, Pipelines,
+    PressureSolver, EULER,
 };
-use super::solver::{SphSolver, SphState};
+use super::solver::{SphKey, SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Context, Scopes};
@@ -68,35 +68,29 @@ impl PcisphParams {
     }
 }
 
-/// The passes, in [`PASSES`] order.
-#[derive(Clone, Copy)]
-enum Pass {
-    Factor,
-    Predict,
-    Pressure,
-    Accel,
-    Euler,
-}
-
 const SHADER: &str = "sph/pcisph.comp";
 
 /// An iteration: the passes up to the one that checks, and the one after it.
 const CHECKED: [Pass; 2] = [Pass::Predict, Pass::Pressure];
 const REST: [Pass; 1] = [Pass::Accel];
 
-pub const PASSES: [PassDecl; 5] = [
-    PassDecl::new("factor", SHADER, "PASS_FACTOR").starts(),
-    PassDecl::new("predict", SHADER, "PASS_PREDICT"),
-    PassDecl::new("pressure", SHADER, "PASS_PRESSURE").check(),
-    PassDecl::new("accel", SHADER, "PASS_ACCEL"),
-    EULER,
-];
+super::pressure::solver_passes!(
+    "pcisph",
+    /// The passes: each variant with its declaration, in the order that indexes the pipelines.
+    enum Pass {
+        Factor = PassDecl::new("factor", SHADER, PassCode::Factor).starts(),
+        Predict = PassDecl::new("predict", SHADER, PassCode::Predict),
+        Pressure = PassDecl::new("pressure", SHADER, PassCode::Pressure).check(),
+        Accel = PassDecl::new("accel", SHADER, PassCode::Accel),
+        Euler = EULER,
+    }
+);
 
 pub struct Pcisph(Pipelines);
 
 impl Pcisph {
-    pub fn new(ctx: &Context, base: &[(&str, String)]) -> Result<Self> {
-        Pipelines::new(ctx, Solver::Pcisph, &PASSES, base).map(Self)
+    pub fn new(ctx: &Context, key: &SphKey) -> Result<Self> {
+        Pipelines::new(ctx, Solver::Pcisph, Pass::TABLE, key).map(Self)
     }
 }
 

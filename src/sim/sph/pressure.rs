@@ -6,8 +6,10 @@
 //! once it has converged, zeroes the group count of the indirect dispatches that remain:
 //! no read-back per iteration and no pass of its own, and an iteration past convergence
 //! costs its passes' empty dispatches (see `Stepper::retire_slot` for how few are recorded).
+use super::solver::SphKey;
 use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
+use crate::gpu::pass::{complete, Defines, PassKey};
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
 use crate::primitives::neighbors::NeighborPush;
@@ -63,8 +65,8 @@ pub fn list_bytes(len: u32) -> u64 {
 pub struct PassDecl {
     pub name: &'static str,
     pub shader: &'static str,
-    /// The shader's `PASS` (one of [`PASS_NAMES`]).
-    pub pass: &'static str,
+    /// The shader's `PASS`.
+    pub pass: PassCode,
     /// DFSPH's divergence solve (its targets and iteration counts).
     pub divergence: bool,
     /// The pass before a solve's iterations: it starts the solve's state.
@@ -76,7 +78,7 @@ pub struct PassDecl {
 }
 
 impl PassDecl {
-    pub const fn new(name: &'static str, shader: &'static str, pass: &'static str) -> Self {
+    pub const fn new(name: &'static str, shader: &'static str, pass: PassCode) -> Self {
         Self {
             name,
             shader,
@@ -113,23 +115,68 @@ impl PassDecl {
     }
 }
 
-pub const EULER: PassDecl = PassDecl::new("euler", "sph/euler.comp", "PASS_EULER");
+pub const EULER: PassDecl = PassDecl::new("euler", "sph/euler.comp", PassCode::Euler);
 
-/// A solver's constructor (`base`: the neighbour search's and the EOS's defines).
-type Make = fn(&Context, &[(&str, String)]) -> Result<Box<dyn PressureSolver>>;
+crate::gpu::switch_enum!(
+    /// The pressure shaders' `PASS` values (glsl/sph/pcisph.comp, dfsph.comp, pbf.comp,
+    /// euler.comp and forces.comp; each shader's switch ends in `#error`).
+    PassCode {
+        Predict,
+        Pressure,
+        Accel,
+        Factor,
+        Warm,
+        Source,
+        Velocity,
+        Lambda,
+        Delta,
+        Apply,
+        Vorticity,
+        Confine,
+        Euler,
+        Forces
+    }
+);
+
+/// A solver's passes as one declaration: `enum Pass { Name = PassDecl, ... }` gives the
+/// enum that indexes its pipelines and its table (`Pass::TABLE`) in one order, and
+/// registers every pass with every SPH variant for the shader test.
+macro_rules! solver_passes {
+    ($solver:literal, $(#[$m:meta])* enum $name:ident { $($v:ident = $decl:expr),+ $(,)? }) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub(crate) enum $name { $($v),+ }
+        impl $name {
+            /// The passes, in the enum's order (its values index the pipelines).
+            pub const TABLE: &'static [$crate::sph::pressure::PassDecl] = &[$($decl),+];
+        }
+        $crate::gpu::inventory::submit! {
+            $crate::gpu::pass::Registered {
+                name: $solver,
+                variants: || $crate::sph::pressure::table_variants($name::TABLE),
+            }
+        }
+    };
+}
+pub(crate) use solver_passes;
+
+/// A solver's constructor.
+type Make = fn(&Context, &SphKey) -> Result<Box<dyn PressureSolver>>;
 
 /// Each solver's pass table and constructor: its one registration line.
 fn registered(kind: Solver) -> (&'static [PassDecl], Make) {
     use super::{dfsph::Dfsph, pbf::Pbf, pcisph::Pcisph, wcsph::Wcsph};
     match kind {
         Solver::Wcsph => (&[], |_, _| Ok(Box::new(Wcsph))),
-        Solver::Pcisph => (&super::pcisph::PASSES, |c, b| {
-            Ok(Box::new(Pcisph::new(c, b)?))
+        Solver::Pcisph => (super::pcisph::Pass::TABLE, |c, k| {
+            Ok(Box::new(Pcisph::new(c, k)?))
         }),
-        Solver::Dfsph => (&super::dfsph::PASSES, |c, b| {
-            Ok(Box::new(Dfsph::new(c, b)?))
+        Solver::Dfsph => (super::dfsph::Pass::TABLE, |c, k| {
+            Ok(Box::new(Dfsph::new(c, k)?))
         }),
-        Solver::Pbf => (&super::pbf::PASSES, |c, b| Ok(Box::new(Pbf::new(c, b)?))),
+        Solver::Pbf => (super::pbf::Pass::TABLE, |c, k| {
+            Ok(Box::new(Pbf::new(c, k)?))
+        }),
     }
 }
 
@@ -138,13 +185,22 @@ pub fn passes(solver: Solver) -> Vec<PassDecl> {
     registered(solver).0.to_vec()
 }
 
-/// Build `kind`'s passes (`base`: the neighbour search's and the EOS's defines).
-pub fn build(
-    ctx: &Context,
-    kind: Solver,
-    base: &[(&str, String)],
-) -> Result<Box<dyn PressureSolver>> {
-    (registered(kind).1)(ctx, base)
+/// Build `kind`'s passes for the SPH variant `key`.
+pub fn build(ctx: &Context, kind: Solver, key: &SphKey) -> Result<Box<dyn PressureSolver>> {
+    (registered(kind).1)(ctx, key)
+}
+
+/// Every (file, complete define set) of a solver's table: each pass with every SPH variant.
+pub fn table_variants(table: &[PassDecl]) -> Vec<(&'static str, Defines)> {
+    let mut v = Vec::new();
+    for key in SphKey::all() {
+        for d in table {
+            let mut own = key.defines();
+            own.extend(pass_defines(d));
+            v.push((d.shader, complete::<PressureIo>(own)));
+        }
+    }
+    v
 }
 
 /// A pressure solver: what a step records after the arrange. The base passes (density,
@@ -204,31 +260,9 @@ pub trait PressureSolver {
     fn destroy(&mut self, ctx: &Context);
 }
 
-const PASS_NAMES: [&str; 14] = [
-    "PASS_PREDICT",
-    "PASS_PRESSURE",
-    "PASS_ACCEL",
-    "PASS_FACTOR",
-    "PASS_WARM",
-    "PASS_SOURCE",
-    "PASS_VELOCITY",
-    "PASS_LAMBDA",
-    "PASS_DELTA",
-    "PASS_APPLY",
-    "PASS_VORTICITY",
-    "PASS_CONFINE",
-    "PASS_EULER",
-    "PASS_FORCES",
-];
-
 /// The defines of one pass, on top of the neighbour search's and the EOS's.
 pub fn pass_defines(d: &PassDecl) -> Vec<(String, String)> {
-    let mut v: Vec<(String, String)> = PASS_NAMES
-        .iter()
-        .enumerate()
-        .map(|(k, n)| (n.to_string(), (k + 1).to_string()))
-        .collect();
-    v.push(("PASS".into(), d.pass.into()));
+    let mut v = d.pass.define("PASS");
     for (name, on) in [
         ("DIVERGENCE", d.divergence),
         ("START_SOLVE", d.starts),
@@ -255,12 +289,12 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    /// `base`: the neighbour search's and the EOS's defines.
+    /// `key`: the SPH variant (neighbour search, the EOS's constants).
     pub fn new(
         ctx: &Context,
         solver: Solver,
         table: &'static [PassDecl],
-        base: &[(&str, String)],
+        key: &SphKey,
     ) -> Result<Self> {
         let mut out = Guard::new(
             ctx,
@@ -270,9 +304,9 @@ impl Pipelines {
             },
         );
         for d in table {
-            let own = pass_defines(d);
-            let mut defines: Vec<(&str, String)> = base.to_vec();
-            defines.extend(crate::gpu::pipeline::as_refs(&own));
+            let mut own = key.defines();
+            own.extend(pass_defines(d));
+            let defines = crate::gpu::pipeline::as_refs(&own);
             let label = format!("{}/{}", solver.as_str(), d.name);
             let desc = ComputeDesc::plain(&label, d.shader, &defines, LOCAL_SIZE);
             let p = ComputePipeline::new(ctx, &desc)?;

@@ -8,11 +8,14 @@ use super::params::{FluidParams, GpuCollider, LatticeTerms, SphGpuParams, MAX_CO
 use super::pressure::{PressureBuffers, PressureSolver};
 use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
+use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
-use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
+use crate::primitives::neighbors::{
+    GridSpec, NbKey, NeighborBuffers, NeighborPush, NeighborSearch,
+};
 use crate::sph::store::{AttrId, AttributeDecl, ParticleStore};
 use crate::sph::Solver;
 
@@ -93,8 +96,8 @@ pub struct SphSolver {
     cfl: super::cfl::CflPass,
     /// The pressure solvers built so far (`state` builds its fluid's).
     pressure: Vec<Box<dyn PressureSolver>>,
-    /// The neighbour search's and the EOS's defines (for those passes).
-    defines: Vec<(String, String)>,
+    /// The SPH variant its pressure solvers' passes are built as.
+    key: SphKey,
 }
 
 /// Particle state and scratch for up to `particles.capacity` particles.
@@ -264,23 +267,34 @@ impl StateDump {
     }
 }
 
+/// The SPH passes' variant: the neighbour search they include, with the fluid's and the
+/// pressure solvers' constants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SphKey(pub NbKey);
+
+impl PassKey for SphKey {
+    fn all() -> Vec<Self> {
+        NbKey::all().into_iter().map(Self).collect()
+    }
+    fn defines(&self) -> Defines {
+        let mut d = self.0.defines();
+        d.extend(super::params::defines());
+        d.extend(super::pressure::solver_defines());
+        d
+    }
+}
+
+crate::gpu::compute_pass!(pub DENSITY: SphIo, SphKey = "density", "sph/density.comp");
+crate::gpu::compute_pass!(pub FORCES: SphIo, SphKey = "forces", "sph/forces.comp");
+crate::gpu::compute_pass!(pub INTEGRATE: SphIo, SphKey = "integrate", "sph/integrate.comp");
+
 impl SphSolver {
     pub fn new(ctx: &Context, neighbors: Neighbors, sort: Option<SortAlgo>) -> Result<Self> {
         let search = Guard::new(ctx, NeighborSearch::new(ctx, neighbors, sort)?);
-        let mut defines: Vec<(String, String)> = search
-            .defines()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect();
-        defines.extend(super::params::defines());
-        defines.extend(super::pressure::solver_defines());
-        let refs = crate::gpu::pipeline::as_refs(&defines);
-        let pipeline = |name, shader| {
-            ComputePipeline::new(ctx, &ComputeDesc::plain(name, shader, &refs, LOCAL_SIZE))
-        };
-        let density = Guard::new(ctx, pipeline("density", "sph/density.comp")?);
-        let forces = Guard::new(ctx, pipeline("forces", "sph/forces.comp")?);
-        let integrate = Guard::new(ctx, pipeline("integrate", "sph/integrate.comp")?);
+        let key = SphKey(search.key());
+        let density = Guard::new(ctx, DENSITY.pipeline(ctx, &key, LOCAL_SIZE, &[])?);
+        let forces = Guard::new(ctx, FORCES.pipeline(ctx, &key, LOCAL_SIZE, &[])?);
+        let integrate = Guard::new(ctx, INTEGRATE.pipeline(ctx, &key, LOCAL_SIZE, &[])?);
         let cfl = Guard::new(ctx, super::cfl::CflPass::new(ctx)?);
         let gather = GatherPass::new(ctx)?;
         Ok(Self {
@@ -291,7 +305,7 @@ impl SphSolver {
             gather,
             search: search.take(),
             pressure: Vec::new(),
-            defines,
+            key,
         })
     }
 
@@ -300,9 +314,8 @@ impl SphSolver {
         let k = match self.pressure.iter().position(|p| p.kind() == solver) {
             Some(k) => k,
             None => {
-                let refs = crate::gpu::pipeline::as_refs(&self.defines);
                 self.pressure
-                    .push(super::pressure::build(ctx, solver, &refs)?);
+                    .push(super::pressure::build(ctx, solver, &self.key)?);
                 self.pressure.len() - 1
             }
         };
@@ -527,7 +540,7 @@ impl SphSolver {
         let uploaded = self.record_changed_params(ctx, cmd, st);
         let recording = ctx.recording(cmd);
         if uploaded || st.next_dt != Some(recording) {
-            scopes.begin(ctx, cmd, super::cfl::CflPass::NAME);
+            scopes.begin(ctx, cmd, super::cfl::CFL.name);
             self.cfl.record(ctx, cmd, st);
             scopes.end(ctx, cmd);
         }

@@ -6,7 +6,7 @@
 //! GPU passes such as emission and death can change with no CPU round trip).
 use crate::error::{Error, Result};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Destroy, Guard, Scopes};
+use crate::gpu::{Buffer, ComputePipeline, Context, Destroy, Guard, Scopes};
 use crate::primitives::counting::GatherPass;
 use bytemuck::{Pod, Zeroable};
 
@@ -61,6 +61,8 @@ crate::gpu_interface! {
     pub LiveArgsIo / LiveArgsBufs: "LIVE", push () { count = 0 }
 }
 
+crate::gpu::compute_pass!(pub LIVE_ARGS: LiveArgsIo, () = "live args", "common/live_args.comp");
+
 /// Writes the indirect-dispatch arguments from the GPU-side count.
 pub struct LiveArgsPass {
     pipeline: ComputePipeline<LiveArgsIo>,
@@ -69,10 +71,7 @@ pub struct LiveArgsPass {
 impl LiveArgsPass {
     pub fn new(ctx: &Context) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                &ComputeDesc::plain("live args", "common/live_args.comp", &[], 1),
-            )?,
+            pipeline: LIVE_ARGS.pipeline(ctx, &(), 1, &[])?,
         })
     }
 

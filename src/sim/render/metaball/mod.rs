@@ -3,6 +3,7 @@
 //! six materials, and a CPU reference ray marcher the GPU passes are checked against.
 pub mod buffers;
 pub mod density;
+pub mod passes;
 pub mod readback;
 pub mod reference;
 pub mod renderer;

@@ -4,6 +4,9 @@
 //! the caller grows them (`MetaballBuffers::grow`) and redoes the frame; `render_sync`
 //! does both. Sized buffers live in buffers.rs.
 use super::buffers::MetaballBuffers;
+use super::passes::{
+    ListKey, Lists, MarchKey, ABUFFER_FILL, COUNT, DEPTHS, FILL, MARCH, SORT_LISTS,
+};
 use super::settings::{MetaballSettings, RenderParams};
 use super::stats::{FrameStats, GpuStats};
 use super::tiles::{blocks, TilePasses};
@@ -12,8 +15,7 @@ use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
 use crate::gpu::Destroy;
 use crate::gpu::{
-    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Labels,
-    Scopes,
+    Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Labels, Scopes,
 };
 use crate::primitives::bounds::BoundsPass;
 use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
@@ -54,54 +56,43 @@ pub struct FluidRenderer {
 impl FluidRenderer {
     pub fn new(ctx: &Context, settings: MetaballSettings) -> Result<Self> {
         settings.validate()?;
-        let common = settings.shader_defines();
-        let refs = |extra: &[(&'static str, String)]| -> Vec<(&str, String)> {
-            let mut d: Vec<(&str, String)> = common
-                .iter()
-                .map(|(k, v)| (k.as_str(), v.clone()))
-                .collect();
-            d.extend(extra.iter().cloned());
-            d
-        };
-        let graphics = |name: &str, pass: u32| -> Result<Guard<Graphics>> {
-            let defines = refs(&[("PASS", pass.to_string())]);
-            let desc = GraphicsDesc::storage_only(
-                name,
-                "render/metaball/billboard.vert",
-                "render/metaball/billboard.frag",
-                &defines,
-            );
-            Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
-        };
+        let key = ListKey::of(&settings);
+        let storage = GraphicsStates::STORAGE_ONLY;
+        let graphics = |p: Result<Graphics>| p.map(|p| Guard::new(ctx, p));
         let (count, fill) = match settings.list {
             _ if !settings.marches() || settings.build == BuildKind::Compute => (None, None),
             ListKind::None | ListKind::Tiles => (None, None),
-            ListKind::Sbuffer => (Some(graphics("count", 0)?), Some(graphics("fill", 1)?)),
-            ListKind::Abuffer => (None, Some(graphics("fill", 2)?)),
-        };
-        let defines = refs(&[]);
-        let compute = |name, shader| -> Result<Guard<Compute>> {
-            let desc = ComputeDesc::plain(name, shader, &defines, 64);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
+            ListKind::Sbuffer => (
+                Some(graphics(COUNT.pipeline(ctx, &Lists(key), storage))?),
+                Some(graphics(FILL.pipeline(ctx, &Lists(key), storage))?),
+            ),
+            ListKind::Abuffer => (
+                None,
+                Some(graphics(ABUFFER_FILL.pipeline(ctx, &Lists(key), storage))?),
+            ),
         };
         let (march, surface) = match settings.marches() {
             true => (
-                Some(compute("march", "render/metaball/march.comp")?.take()),
+                Some(MARCH.pipeline(ctx, &MarchKey::of(&settings), 64, &[])?),
                 None,
             ),
-            false => (None, Some(Surface::new(ctx, settings.surface, &defines)?)),
+            false => (
+                None,
+                Some(Surface::new(ctx, settings.surface, settings.material)?),
+            ),
         };
         let march = Guard::new(ctx, march);
         let surface = Guard::new(ctx, surface);
         let tiles = match settings.bins_tiles() {
-            true => Some(TilePasses::new(ctx, &settings, &defines)?),
+            true => Some(TilePasses::new(ctx, &settings)?),
             false => None,
         };
         let tiles = Guard::new(ctx, tiles);
+        let compute = |p: Result<Compute>| p.map(|p| Guard::new(ctx, p));
         let sort = match settings.sort_pass() {
             true => Some((
-                compute("depths", "render/metaball/depths.comp")?,
-                compute("sort lists", "render/metaball/sort_lists.comp")?,
+                compute(DEPTHS.pipeline(ctx, &Lists(key), 64, &[]))?,
+                compute(SORT_LISTS.pipeline(ctx, &Lists(key), 64, &[]))?,
             )),
             false => None,
         };

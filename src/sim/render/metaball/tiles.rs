@@ -4,11 +4,14 @@
 //! network sort, then each tile's range and its metaballs gathered in (tile, depth) order.
 //! `--list tiles` marches over them; `--build compute` fills the S-buffer from them, each
 //! pixel's range already in depth order. Pair overflow is counted, grown and redone.
+use super::passes::{
+    ListKey, Lists, PIXEL_COUNT, PIXEL_FILL, TILE_BIN, TILE_COUNT, TILE_EMIT, TILE_RANGES,
+};
 use super::renderer::{MetaballBufs, MetaballIo};
 use super::settings::{tile_grid, MetaballSettings};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::primitives::sort::{Network, NetworkSort};
 
@@ -148,25 +151,19 @@ pub struct TilePasses {
 }
 
 impl TilePasses {
-    pub fn new(ctx: &Context, s: &MetaballSettings, defines: &[(&str, String)]) -> Result<Self> {
-        let compute = |name, shader, pass: Option<u32>, local| -> Result<Guard<Compute>> {
-            let mut d: Vec<(&str, String)> = defines.to_vec();
-            if let Some(p) = pass {
-                d.push(("PASS", p.to_string()));
-            }
-            let desc = ComputeDesc::plain(name, shader, &d, local);
-            Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
-        };
-        let bin = compute("tile bin", "render/metaball/tile_bin.comp", None, 64)?;
-        let count = compute("tile count", "render/metaball/tile_pairs.comp", Some(0), 64)?;
-        let emit = compute("tile emit", "render/metaball/tile_pairs.comp", Some(1), 64)?;
-        let ranges = compute("tile ranges", "render/metaball/tile_ranges.comp", None, 64)?;
+    pub fn new(ctx: &Context, s: &MetaballSettings) -> Result<Self> {
+        let key = Lists(ListKey::of(s));
+        let g = |p: Result<Compute>| p.map(|p| Guard::new(ctx, p));
+        let bin = g(TILE_BIN.pipeline(ctx, &key, 64, &[]))?;
+        let count = g(TILE_COUNT.pipeline(ctx, &key, 64, &[]))?;
+        let emit = g(TILE_EMIT.pipeline(ctx, &key, 64, &[]))?;
+        let ranges = g(TILE_RANGES.pipeline(ctx, &key, 64, &[]))?;
         let pixels = match s.list {
             crate::render::ListKind::Sbuffer => {
-                let shader = "render/metaball/pixel_lists.comp";
+                let key = Lists(ListKey::of(s));
                 Some((
-                    compute("pixel count", shader, Some(0), BLOCK_INVOCATIONS)?,
-                    compute("pixel fill", shader, Some(1), BLOCK_INVOCATIONS)?,
+                    g(PIXEL_COUNT.pipeline(ctx, &key, BLOCK_INVOCATIONS, &[]))?,
+                    g(PIXEL_FILL.pipeline(ctx, &key, BLOCK_INVOCATIONS, &[]))?,
                 ))
             }
             _ => None,

@@ -3,12 +3,14 @@
 //! appended to a soup whose count drives an indirect draw, and the soup rasterised into
 //! the G-buffer in two passes (nearest depth and thickness, then the nearest fragment's
 //! interpolated normal). Checked against `crate::isosurface::march` on the same grid.
-use super::{compute_pass, raster_pass, Rec, SurfaceIo};
+use super::{Rec, Scales, SurfaceIo};
 use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::track::BufferUse;
 use crate::gpu::vk;
-use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, ScopeKey, Scopes};
+use crate::gpu::{
+    ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, ScopeKey, Scopes,
+};
 
 /// The mesh surface's timestamp scopes, inside the frame's rendering scope.
 pub const DENSITY_SCOPE: ScopeKey = ScopeKey::new("render/density");
@@ -16,6 +18,17 @@ pub const CELLS_SCOPE: ScopeKey = ScopeKey::new("render/cells");
 pub const RASTER_SCOPE: ScopeKey = ScopeKey::new("render/raster");
 
 type Graphics = GraphicsPipeline<SurfaceIo>;
+
+crate::gpu::compute_pass!(pub DENSITY: SurfaceIo, Scales = "density", "render/surface/density.comp");
+crate::gpu::compute_pass!(pub CELLS: SurfaceIo, Scales = "cells", "render/surface/cells.comp");
+crate::gpu::graphics_pass!(
+    /// Nearest depth and thickness.
+    pub MESH_DEPTH: SurfaceIo, Scales = "mesh depth", "render/surface/mesh.vert", "render/surface/mesh.frag", "PASS" = "0"
+);
+crate::gpu::graphics_pass!(
+    /// The nearest fragment's interpolated normal.
+    pub MESH_NORMALS: SurfaceIo, Scales = "mesh normals", "render/surface/mesh.vert", "render/surface/mesh.frag", "PASS" = "1"
+);
 
 pub struct Cubes {
     density: ComputePipeline<SurfaceIo>,
@@ -26,11 +39,11 @@ pub struct Cubes {
 
 impl Cubes {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let density = compute_pass(ctx, "density", "render/surface/density.comp")?;
-        let cells = compute_pass(ctx, "cells", "render/surface/cells.comp")?;
-        let shaders = ("render/surface/mesh.vert", "render/surface/mesh.frag");
-        let depth = raster_pass(ctx, "mesh depth", shaders, Some(0))?;
-        let normals = raster_pass(ctx, "mesh normals", shaders, Some(1))?;
+        let storage = GraphicsStates::STORAGE_ONLY;
+        let density = Guard::new(ctx, DENSITY.pipeline(ctx, &Scales, 64, &[])?);
+        let cells = Guard::new(ctx, CELLS.pipeline(ctx, &Scales, 64, &[])?);
+        let depth = Guard::new(ctx, MESH_DEPTH.pipeline(ctx, &Scales, storage)?);
+        let normals = Guard::new(ctx, MESH_NORMALS.pipeline(ctx, &Scales, storage)?);
         Ok(Self {
             density: density.take(),
             cells: cells.take(),

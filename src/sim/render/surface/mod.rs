@@ -11,9 +11,9 @@ pub mod screen;
 pub use buffers::SurfaceBuffers;
 
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Buffer, ComputeDesc, ComputePipeline, Context, GraphicsDesc, GraphicsPipeline, Guard, Scopes,
-};
+use crate::gpu::pass::{Defines, PassKey};
+use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
+use crate::render::Material;
 use crate::render::SurfaceKind;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
@@ -93,25 +93,36 @@ impl SurfaceFluid {
 
 type Compute = ComputePipeline<SurfaceIo>;
 
-/// A compute pass of the surfaces (the fixed-point scales defined).
-fn compute_pass<'c>(ctx: &'c Context, name: &str, shader: &str) -> Result<Guard<'c, Compute>> {
-    let defines = scale_defines();
-    let desc = ComputeDesc::plain(name, shader, &defines, 64);
-    Ok(Guard::new(ctx, ComputePipeline::new(ctx, &desc)?))
+/// The surfaces' passes' key: one variant, the fixed-point scales defined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Scales;
+
+impl PassKey for Scales {
+    fn all() -> Vec<Self> {
+        vec![Self]
+    }
+    fn defines(&self) -> Defines {
+        let d = scale_defines().into_iter();
+        d.map(|(k, v)| (k.to_string(), v)).collect()
+    }
 }
 
-/// A pass drawing into no attachment (the scales and, if given, PASS defined).
-fn raster_pass<'c>(
-    ctx: &'c Context,
-    name: &str,
-    (vertex, fragment): (&str, &str),
-    pass: Option<u32>,
-) -> Result<Guard<'c, GraphicsPipeline<SurfaceIo>>> {
-    let mut defines = scale_defines();
-    defines.extend(pass.map(|p| ("PASS", p.to_string())));
-    let desc = GraphicsDesc::storage_only(name, vertex, fragment, &defines);
-    Ok(Guard::new(ctx, GraphicsPipeline::new(ctx, &desc)?))
+/// The surface shading's variant: the material (its path; the metals share one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadeKey(pub Material);
+
+impl PassKey for ShadeKey {
+    fn all() -> Vec<Self> {
+        Material::all().iter().map(|m| Self(*m)).collect()
+    }
+    fn defines(&self) -> Defines {
+        let mut d = self.0.define_path();
+        d.extend(Scales.defines());
+        d
+    }
 }
+
+crate::gpu::compute_pass!(pub SHADE: SurfaceIo, ShadeKey = "shade", "render/surface/shade.comp");
 
 /// What every pass of a frame's surface records with: its buffers, push constants and the
 /// particle count.
@@ -165,12 +176,9 @@ pub struct Surface {
 }
 
 impl Surface {
-    /// `defines`: the metaball renderer's (MATERIAL and its named values among them).
-    pub fn new(ctx: &Context, kind: SurfaceKind, defines: &[(&str, String)]) -> Result<Self> {
-        let mut defines = defines.to_vec();
-        defines.extend(scale_defines());
-        let shade = ComputeDesc::plain("shade", "render/surface/shade.comp", &defines, 64);
-        let shade = Guard::new(ctx, ComputePipeline::new(ctx, &shade)?);
+    /// `material`: the look it shades with.
+    pub fn new(ctx: &Context, kind: SurfaceKind, material: Material) -> Result<Self> {
+        let shade = Guard::new(ctx, SHADE.pipeline(ctx, &ShadeKey(material), 64, &[])?);
         let (screen, cubes) = match kind {
             SurfaceKind::ScreenSpace => (Some(screen::ScreenSpace::new(ctx)?), None),
             SurfaceKind::Mesh => (None, Some(cubes::Cubes::new(ctx)?)),

@@ -1,11 +1,15 @@
 //! Screen-space fluid (van der Laan, Green & Sainz 2009): particles splatted as spheres
 //! into the nearest depth and an additive thickness, a separable bilateral filter of the
 //! depth (x, then y), and normals from the smoothed depth into the G-buffer.
-use super::{compute_pass, raster_pass, Rec, SurfaceIo};
+use super::{Rec, Scales, SurfaceIo};
 use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
-use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, Scopes};
+use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Scopes};
+
+crate::gpu::graphics_pass!(pub SPLAT: SurfaceIo, Scales = "splat", "render/surface/splat.vert", "render/surface/splat.frag");
+crate::gpu::compute_pass!(pub SMOOTH: SurfaceIo, Scales = "smooth", "render/surface/smooth.comp");
+crate::gpu::compute_pass!(pub NORMALS: SurfaceIo, Scales = "normals", "render/surface/normals.comp");
 
 pub struct ScreenSpace {
     splat: GraphicsPipeline<SurfaceIo>,
@@ -15,10 +19,10 @@ pub struct ScreenSpace {
 
 impl ScreenSpace {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let shaders = ("render/surface/splat.vert", "render/surface/splat.frag");
-        let splat = raster_pass(ctx, "splat", shaders, None)?;
-        let smooth = compute_pass(ctx, "smooth", "render/surface/smooth.comp")?;
-        let normals = compute_pass(ctx, "normals", "render/surface/normals.comp")?;
+        let storage = GraphicsStates::STORAGE_ONLY;
+        let splat = Guard::new(ctx, SPLAT.pipeline(ctx, &Scales, storage)?);
+        let smooth = Guard::new(ctx, SMOOTH.pipeline(ctx, &Scales, 64, &[])?);
+        let normals = Guard::new(ctx, NORMALS.pipeline(ctx, &Scales, 64, &[])?);
         Ok(Self {
             splat: splat.take(),
             smooth: smooth.take(),
