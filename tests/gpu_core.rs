@@ -283,11 +283,12 @@ fn profiler_scopes_present_and_nested_inside_frame() {
             _: u64,
             _: usize,
         ) -> fluidform::Result<()> {
-            for name in ["first", "second"] {
-                prof.begin(ctx, cmd, name);
+            use fluidform::gpu::{Open, ScopeName};
+            const SCOPES: [ScopeName; 2] = [ScopeName::new("first"), ScopeName::new("second")];
+            for name in SCOPES {
+                let _scope = prof.open(ctx, cmd, name);
                 self.p.dispatch(ctx, cmd, &self.bufs, &self.push, self.n);
                 ctx.compute_barrier(cmd);
-                prof.end(ctx, cmd);
             }
             Ok(())
         }

@@ -6,6 +6,7 @@
 use super::protocol::{self, Case};
 use super::{BenchOptions, Row};
 use crate::error::Result;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::scene::emission::EmissionDesc;
@@ -93,10 +94,17 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 crate::gpu::FRAME,
                 detail,
                 move |prof, cmd| {
-                    prof.begin(ctx, cmd, crate::gpu::FRAME.name());
-                    targets.record_before(ctx, cmd, prof, &mut st, t, dt, 1)?;
-                    solver.record_hooked_step(ctx, cmd, prof, &mut st, &mut targets.hooks())?;
-                    prof.end(ctx, cmd);
+                    {
+                        let mut prof = prof.open(ctx, cmd, crate::gpu::FRAME.scope());
+                        targets.record_before(ctx, cmd, &mut prof, &mut st, t, dt, 1)?;
+                        solver.record_hooked_step(
+                            ctx,
+                            cmd,
+                            &mut *prof,
+                            &mut st,
+                            &mut targets.hooks(),
+                        )?;
+                    }
                     t += dt as f64;
                     Ok(())
                 },

@@ -5,6 +5,7 @@
 use super::protocol::{self, Case};
 use super::BenchOptions;
 use crate::error::Result;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard};
 use serde_json::json;
 
@@ -56,15 +57,17 @@ impl Floor {
         let fma = &*fma;
         let cases = vec![
             Case::new("copy", bytes, COPY, json!({}), move |prof, cmd| {
-                prof.begin(ctx, cmd, COPY.name());
-                ctx.copy(cmd, src, 0, dst, 0, bytes);
-                prof.end(ctx, cmd);
+                {
+                    let _scope = prof.open(ctx, cmd, COPY.scope());
+                    ctx.copy(cmd, src, 0, dst, 0, bytes);
+                }
                 Ok(())
             }),
             Case::new("fma", invocations, FMA, json!({}), move |prof, cmd| {
-                prof.begin(ctx, cmd, FMA.name());
-                fma.dispatch(ctx, cmd, &FmaBufs { out }, &ITERS, invocations);
-                prof.end(ctx, cmd);
+                {
+                    let _scope = prof.open(ctx, cmd, FMA.scope());
+                    fma.dispatch(ctx, cmd, &FmaBufs { out }, &ITERS, invocations);
+                }
                 Ok(())
             }),
         ];

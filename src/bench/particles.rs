@@ -4,6 +4,7 @@
 use super::protocol::{self, Case};
 use super::{counts, BenchOptions, Row};
 use crate::error::{Error, Result};
+use crate::gpu::Open;
 use crate::gpu::{ColorTarget, Context, Guard};
 use crate::kinds::SortAlgo;
 use crate::psys::frame::{frame_info, record_simulation};
@@ -152,12 +153,13 @@ pub fn particles(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     let f = frame_info(cam, dt, k, w, h);
                     k += 1;
                     record_simulation(ctx, cmd, prof, passes, std::slice::from_mut(s), &f)?;
-                    prof.begin(ctx, cmd, Passes::DRAW);
-                    s.prepare_draw(ctx, cmd, passes, &f);
-                    target.begin_rendering(ctx, cmd, [0.0, 0.0, 0.0, 1.0]);
-                    s.record_draw(ctx, cmd, passes, &f);
-                    target.end_rendering(ctx, cmd);
-                    prof.end(ctx, cmd);
+                    {
+                        let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::DRAW));
+                        s.prepare_draw(ctx, cmd, passes, &f);
+                        target.begin_rendering(ctx, cmd, [0.0, 0.0, 0.0, 1.0]);
+                        s.record_draw(ctx, cmd, passes, &f);
+                        target.end_rendering(ctx, cmd);
+                    }
                     Ok(())
                 },
             )

@@ -3,6 +3,7 @@ use super::protocol::{self, Case};
 use super::{counts, BenchOptions, Row};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, Context, Guard, ScopeKey};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::{CountingBuffers, CountingSort};
@@ -11,6 +12,8 @@ use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::primitives::sort::{Network, NetworkSort};
 use rand::{Rng, SeedableRng};
 use serde_json::json;
+
+const RESTORE_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("restore");
 
 /// The primitives' timestamp scopes, opened here around each primitive.
 const SCAN: ScopeKey = ScopeKey::new("scan");
@@ -58,12 +61,14 @@ pub fn scan(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         .map(|(n, input, output, copied, scratch)| {
             let (n, bytes) = (*n as u64, *n as u64 * 4);
             Case::new(variant, n, SCAN, json!({}), move |prof, cmd| {
-                prof.begin(ctx, cmd, SCAN.name());
-                pass.record(ctx, cmd, input, output, n, ScanKind::Exclusive, scratch)?;
-                prof.end(ctx, cmd);
-                prof.begin(ctx, cmd, super::floor::COPY.name());
-                copy(ctx, cmd, input, copied, bytes);
-                prof.end(ctx, cmd);
+                {
+                    let _scope = prof.open(ctx, cmd, SCAN.scope());
+                    pass.record(ctx, cmd, input, output, n, ScanKind::Exclusive, scratch)?;
+                }
+                {
+                    let _scope = prof.open(ctx, cmd, super::floor::COPY.scope());
+                    copy(ctx, cmd, input, copied, bytes);
+                }
                 Ok(())
             })
         })
@@ -142,35 +147,38 @@ pub fn sort(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     }
     let (scan, counting) = (&*scan, &*counting);
     let (odd_even, bitonic) = (&*odd_even, &*bitonic);
-    let cases = sets
-        .iter()
-        .map(|s| {
-            let network = match s.algo {
-                SortAlgo::OddEven => Some(odd_even),
-                SortAlgo::Bitonic => Some(bitonic),
-                SortAlgo::Counting | SortAlgo::None => None,
-            };
-            let (n, bytes) = (s.n as u64, s.n as u64 * 4);
-            let b = &s.bufs;
-            let cb = &*s.cb;
-            let detail = json!({ "cells": s.cells, "keys": "uniform random cell ids" });
-            Case::new(s.algo.as_str(), n, SORT, detail, move |prof, cmd| {
-                prof.begin(ctx, cmd, "restore");
-                copy(ctx, cmd, &b[0], &b[2], bytes);
-                copy(ctx, cmd, &b[1], &b[3], bytes);
-                prof.end(ctx, cmd);
-                prof.begin(ctx, cmd, SORT.name());
-                match network {
-                    Some(s) => {
-                        s.record(ctx, cmd, &b[2], &b[3], n)?;
+    let cases =
+        sets.iter()
+            .map(|s| {
+                let network = match s.algo {
+                    SortAlgo::OddEven => Some(odd_even),
+                    SortAlgo::Bitonic => Some(bitonic),
+                    SortAlgo::Counting | SortAlgo::None => None,
+                };
+                let (n, bytes) = (s.n as u64, s.n as u64 * 4);
+                let b = &s.bufs;
+                let cb = &*s.cb;
+                let detail = json!({ "cells": s.cells, "keys": "uniform random cell ids" });
+                Case::new(s.algo.as_str(), n, SORT, detail, move |prof, cmd| {
+                    {
+                        let _scope = prof.open(ctx, cmd, RESTORE_SCOPE);
+                        copy(ctx, cmd, &b[0], &b[2], bytes);
+                        copy(ctx, cmd, &b[1], &b[3], bytes);
                     }
-                    None => counting.record(ctx, cmd, scan, cb, &b[2], &b[3], &b[4], &b[5], n)?,
-                }
-                prof.end(ctx, cmd);
-                Ok(())
+                    {
+                        let _scope = prof.open(ctx, cmd, SORT.scope());
+                        match network {
+                            Some(s) => {
+                                s.record(ctx, cmd, &b[2], &b[3], n)?;
+                            }
+                            None => counting
+                                .record(ctx, cmd, scan, cb, &b[2], &b[3], &b[4], &b[5], n)?,
+                        }
+                    }
+                    Ok(())
+                })
             })
-        })
-        .collect();
+            .collect();
     protocol::run(ctx, opts, cases)
 }
 
@@ -242,12 +250,13 @@ pub fn neighbors(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let detail =
                 json!({ "radius": s.radius, "grid": s.grid.dims, "max_neighbors": s.max_nb });
             Case::new(variant, s.n as u64, NEIGHBORS, detail, move |prof, cmd| {
-                prof.begin(ctx, cmd, NEIGHBORS.name());
-                s.search
-                    .record_build(ctx, cmd, prof, &s.b, &s.p, s.n, &s.grid)?;
-                s.search
-                    .record_query(ctx, cmd, prof, &s.b, &s.p, s.n, &s.grid, s.radius)?;
-                prof.end(ctx, cmd);
+                {
+                    let mut prof = prof.open(ctx, cmd, NEIGHBORS.scope());
+                    s.search
+                        .record_build(ctx, cmd, &mut *prof, &s.b, &s.p, s.n, &s.grid)?;
+                    s.search
+                        .record_query(ctx, cmd, &mut *prof, &s.b, &s.p, s.n, &s.grid, s.radius)?;
+                }
                 Ok(())
             })
         })

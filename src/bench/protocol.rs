@@ -18,6 +18,7 @@ use super::interval::{median, Interval};
 use super::{BenchConfig, BenchOptions, Row};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{
     ComputePipeline, Context, FrameTiming, Guard, Profiler, RecordOnly, ScopeKey, FRAME,
 };
@@ -150,13 +151,14 @@ struct Sentinel<'c> {
 
 impl Sentinel<'_> {
     fn record(&self, ctx: &Context, prof: &mut Profiler, cmd: vk::CommandBuffer, times: u32) {
-        prof.begin(ctx, cmd, SENTINEL.name());
-        for _ in 0..times {
-            let bufs = FmaBufs { out: &self.out };
-            self.pipe
-                .dispatch(ctx, cmd, &bufs, &SENTINEL_ITERS, self.invocations);
+        {
+            let _scope = prof.open(ctx, cmd, SENTINEL.scope());
+            for _ in 0..times {
+                let bufs = FmaBufs { out: &self.out };
+                self.pipe
+                    .dispatch(ctx, cmd, &bufs, &SENTINEL_ITERS, self.invocations);
+            }
         }
-        prof.end(ctx, cmd);
     }
 }
 

@@ -7,6 +7,7 @@ use super::floor::Floor;
 use super::protocol::{self, Case};
 use super::{BenchOptions, Row};
 use crate::error::Result;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard};
 use crate::render::metaball::{blob, blob_camera, FluidRenderer};
 use crate::render::{BuildKind, ListKind, SurfaceKind};
@@ -77,9 +78,10 @@ pub fn time_rows(
                 crate::render::SCOPE,
                 detail,
                 move |prof, cmd| {
-                    prof.begin(ctx, cmd, crate::render::SCOPE.name());
-                    r.record(ctx, cmd, prof, b, centers, n as u32, cam, 0)?;
-                    prof.end(ctx, cmd);
+                    {
+                        let mut prof = prof.open(ctx, cmd, crate::render::SCOPE.scope());
+                        r.record(ctx, cmd, &mut *prof, b, centers, n as u32, cam, 0)?;
+                    }
                     Ok(())
                 },
             )

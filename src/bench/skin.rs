@@ -6,6 +6,7 @@ use super::{BenchOptions, Row};
 use crate::character::Skinning;
 use crate::character::{self, skin::Skinner, Animator, Character};
 use crate::error::Result;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard};
 use glam::{Mat4, Vec3};
 use serde_json::json;
@@ -75,9 +76,10 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             // Bytes the pass moves: rest position, normal, influences in; position, normal out.
             moved.push(n as f64 * (16.0 + 16.0 + 24.0 * c.mesh.influence_sets as f64 + 32.0));
             cases.push(Case::new(variant, n, SKIN, detail, move |prof, cmd| {
-                prof.begin(ctx, cmd, SKIN.name());
-                sk.record(ctx, cmd, &joints)?;
-                prof.end(ctx, cmd);
+                {
+                    let _scope = prof.open(ctx, cmd, SKIN.scope());
+                    sk.record(ctx, cmd, &joints)?;
+                }
                 Ok(())
             }));
         }

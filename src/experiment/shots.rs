@@ -7,6 +7,7 @@ use super::Env;
 use crate::bench::protocol::{self, Case};
 use crate::bench::{BenchOptions, Row};
 use crate::error::Result;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, Context, Guard};
 use crate::render::metaball::{FrameStats, MetaballSettings};
 use crate::render::Camera;
@@ -105,9 +106,10 @@ pub fn time_shots(
             crate::render::SCOPE,
             s.detail.clone(),
             move |prof, cmd| {
-                prof.begin(ctx, cmd, crate::render::SCOPE.name());
-                r.record_as(&s.settings, ctx, cmd, prof, b, s.centers, s.n, &s.cam)?;
-                prof.end(ctx, cmd);
+                {
+                    let mut prof = prof.open(ctx, cmd, crate::render::SCOPE.scope());
+                    r.record_as(&s.settings, ctx, cmd, &mut *prof, b, s.centers, s.n, &s.cam)?;
+                }
                 Ok(())
             },
         );

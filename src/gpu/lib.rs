@@ -34,7 +34,9 @@ pub use interface::{BindingDecl, BufferRange, Interface};
 pub use memory::{Buffer, Image, MemoryLocation};
 pub use pass::{ComputeDecl, GraphicsDecl, GraphicsStates, PassKey};
 pub use pipeline::{ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline};
-pub use profiler::{FrameTiming, Labels, Profiler, ScopeKey, Scopes, FRAME};
+pub use profiler::{
+    FrameTiming, Labels, Open, Profiler, Scope, ScopeKey, ScopeName, Scopes, FRAME,
+};
 pub use target::ColorTarget;
 pub use track::Recorded;
 

@@ -66,6 +66,11 @@ impl<I: Interface, K: PassKey> ComputeDecl<I, K> {
         }
     }
 
+    /// Its timestamp scope (and debug label), opened inside the caller's.
+    pub const fn scope(&self) -> crate::ScopeName {
+        crate::ScopeName::new(self.name)
+    }
+
     /// The defines of `key`: the declaration's and the key's (the interface adds its own).
     pub fn defines(&self, key: &K) -> Defines {
         with_fixed(key.defines(), self.fixed)
@@ -127,6 +132,10 @@ impl<I: Interface, K: PassKey> GraphicsDecl<I, K> {
             fixed,
             marker: PhantomData,
         }
+    }
+
+    pub const fn scope(&self) -> crate::ScopeName {
+        crate::ScopeName::new(self.name)
     }
 
     pub fn defines(&self, key: &K) -> Defines {

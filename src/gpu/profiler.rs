@@ -69,16 +69,78 @@ pub struct Profiler {
 
 /// Where passes report their named scopes: the profiler (label + timestamps) or
 /// `Labels` (debug labels only, for one-shot work and tests).
+/// Scopes are opened with [`Open::open`], whose guard closes them when dropped (early
+/// returns included); `begin` and `end` are what the guard calls.
 pub trait Scopes {
-    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str);
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: ScopeName);
     fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer);
 }
+
+/// A scope's own name (its path is its parents' and its own): declared once as a
+/// constant, or taken from a pass's declaration or a [`ScopeKey`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ScopeName(&'static str);
+
+impl ScopeName {
+    pub const fn new(name: &'static str) -> Self {
+        Self(name)
+    }
+
+    pub const fn as_str(self) -> &'static str {
+        self.0
+    }
+}
+
+/// An open scope: closed when dropped. Derefs to the scopes, for the work inside it.
+pub struct Scope<'a, S: Scopes + ?Sized> {
+    scopes: &'a mut S,
+    ctx: &'a Context,
+    cmd: vk::CommandBuffer,
+}
+
+impl<S: Scopes + ?Sized> Drop for Scope<'_, S> {
+    fn drop(&mut self) {
+        self.scopes.end(self.ctx, self.cmd);
+    }
+}
+
+impl<S: Scopes + ?Sized> std::ops::Deref for Scope<'_, S> {
+    type Target = S;
+    fn deref(&self) -> &S {
+        self.scopes
+    }
+}
+
+impl<S: Scopes + ?Sized> std::ops::DerefMut for Scope<'_, S> {
+    fn deref_mut(&mut self) -> &mut S {
+        self.scopes
+    }
+}
+
+/// Opening a scope as a guard, on any [`Scopes`] (a profiler, labels, `dyn Scopes`).
+pub trait Open: Scopes {
+    fn open<'a>(
+        &'a mut self,
+        ctx: &'a Context,
+        cmd: vk::CommandBuffer,
+        name: ScopeName,
+    ) -> Scope<'a, Self> {
+        self.begin(ctx, cmd, name);
+        Scope {
+            scopes: self,
+            ctx,
+            cmd,
+        }
+    }
+}
+
+impl<S: Scopes + ?Sized> Open for S {}
 
 pub struct Labels;
 
 impl Scopes for Labels {
-    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
-        ctx.begin_label(cmd, name);
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: ScopeName) {
+        ctx.begin_label(cmd, name.as_str());
     }
     fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         ctx.end_label(cmd);
@@ -86,11 +148,11 @@ impl Scopes for Labels {
 }
 
 impl Scopes for Profiler {
-    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
-        Profiler::begin(self, ctx, cmd, name)
+    fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: ScopeName) {
+        Profiler::open_scope(self, ctx, cmd, name.as_str())
     }
     fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        Profiler::end(self, ctx, cmd)
+        Profiler::close_scope(self, ctx, cmd)
     }
 }
 
@@ -126,6 +188,11 @@ impl ScopeKey {
     /// The scope's own name, opened inside its parent scopes.
     pub const fn name(self) -> &'static str {
         self.name
+    }
+
+    /// The scope to open, inside its parents, for this key.
+    pub const fn scope(self) -> ScopeName {
+        ScopeName(self.name)
     }
 
     /// The error for a reader that did not find this scope among `recorded`.
@@ -227,12 +294,12 @@ impl Profiler {
         s.frame = Some(frame);
         self.current = slot;
         self.stack.clear();
-        self.begin(ctx, cmd, FRAME_SCOPE);
+        self.open_scope(ctx, cmd, FRAME_SCOPE);
     }
 
     pub fn end_frame(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         while !self.stack.is_empty() {
-            self.end(ctx, cmd);
+            self.close_scope(ctx, cmd);
         }
     }
 
@@ -250,8 +317,9 @@ impl Profiler {
         Some((s.pools[(q / POOL_QUERIES) as usize], q))
     }
 
-    /// Open a named scope: a debug label and a timestamp, keyed by its path.
-    pub fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
+    /// Open a named scope: a debug label and a timestamp, keyed by its path (through
+    /// `Scopes`, whose guard closes it).
+    fn open_scope(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &str) {
         ctx.begin_label(cmd, name);
         let key = match self.stack.last() {
             Some((_, parent)) if parent != FRAME_SCOPE => format!("{parent}/{name}"),
@@ -282,7 +350,7 @@ impl Profiler {
         self.stack.push((s.scopes.len() - 1, key));
     }
 
-    pub fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    fn close_scope(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         let Some((i, _)) = self.stack.pop() else {
             return;
         };

@@ -1,5 +1,6 @@
 //! `run` of the orbits test scene: a gravity step and the point view per frame.
 use super::*;
+use crate::gpu::Open;
 use crate::scene::orbits::{self, Orbits, OrbitsPass};
 
 /// The orbits scene: a gravity step and the point view per frame.
@@ -19,9 +20,10 @@ impl FrameWork for OrbitsWork {
         frame: u64,
         slot: usize,
     ) -> Result<()> {
-        prof.begin(ctx, cmd, crate::scene::orbits::SIMULATE.name);
-        self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
-        prof.end(ctx, cmd);
+        {
+            let _scope = prof.open(ctx, cmd, crate::scene::orbits::SIMULATE.scope());
+            self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
+        }
         // New positions -> the point view's vertex shader.
         let (s, save) = (&self.scene, self.frames.save(frame));
         self.view.record(

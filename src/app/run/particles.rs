@@ -3,6 +3,7 @@ use crate::character::Skinning;
 use crate::config::Group;
 use crate::error::Result;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{ColorTarget, Context, FrameWork, Guard, Profiler, Scopes};
 use crate::kinds::SortAlgo;
 use crate::psys::character::{CharacterBufs, CharacterLink};
@@ -20,6 +21,8 @@ use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
 use crate::scene::character::SceneCharacter;
 use crate::scene::particles::ParticleScene;
 use serde::{Deserialize, Serialize};
+
+const READBACK_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("readback");
 
 /// One system's totals in summary.json.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -255,33 +258,35 @@ impl FrameWork for ParticleWork {
         }
         let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
-        prof.begin(ctx, cmd, Passes::DRAW);
-        let mesh = match &self.body {
-            Some(Body {
-                ch, view: Some(v), ..
-            }) => Some((v, ch.surface())),
-            _ => None,
-        };
-        if let Some((v, m)) = &mesh {
-            v.prepare(ctx, cmd, m);
+        {
+            let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::DRAW));
+            let mesh = match &self.body {
+                Some(Body {
+                    ch, view: Some(v), ..
+                }) => Some((v, ch.surface())),
+                _ => None,
+            };
+            if let Some((v, m)) = &mesh {
+                v.prepare(ctx, cmd, m);
+            }
+            self.scene.prepare_draws(ctx, cmd, frame, true);
+            self.scene.prepare_draws(ctx, cmd, frame, false);
+            let b = self.background;
+            self.target
+                .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);
+            if let Some((v, m)) = &mesh {
+                v.draw(ctx, cmd, m);
+            }
+            // Opaque points first, so the blended draws after them are depth-tested against them.
+            self.scene.record_draws(ctx, cmd, frame, true);
+            self.scene.record_draws(ctx, cmd, frame, false);
+            self.target.end_rendering(ctx, cmd);
         }
-        self.scene.prepare_draws(ctx, cmd, frame, true);
-        self.scene.prepare_draws(ctx, cmd, frame, false);
-        let b = self.background;
-        self.target
-            .begin_rendering(ctx, cmd, [b[0], b[1], b[2], 1.0]);
-        if let Some((v, m)) = &mesh {
-            v.draw(ctx, cmd, m);
-        }
-        // Opaque points first, so the blended draws after them are depth-tested against them.
-        self.scene.record_draws(ctx, cmd, frame, true);
-        self.scene.record_draws(ctx, cmd, frame, false);
-        self.target.end_rendering(ctx, cmd);
-        prof.end(ctx, cmd);
         if self.frames.save(frame) {
-            prof.begin(ctx, cmd, "readback");
-            self.target.copy_out(ctx, cmd, slot);
-            prof.end(ctx, cmd);
+            {
+                let _scope = prof.open(ctx, cmd, READBACK_SCOPE);
+                self.target.copy_out(ctx, cmd, slot);
+            }
         }
         Ok(())
     }

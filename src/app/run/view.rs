@@ -6,6 +6,7 @@
 use crate::config::Switches;
 use crate::error::Result;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, ColorTarget, Context, Guard, Labels, Profiler, Scopes};
 use crate::render::mesh::{MeshDraw, MeshView};
 use crate::render::metaball::{FluidRenderer, FrameStats, MetaballBuffers, MetaballSettings};
@@ -13,6 +14,9 @@ use crate::render::surface::SurfaceFluid;
 use crate::render::ShowMesh;
 use crate::render::{points::PointsPush, Camera, PointsView};
 use serde::{Deserialize, Serialize};
+
+const OVERLAY_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("overlay");
+const READBACK_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("readback");
 
 /// Draws shown with a view's particles (particle systems), inside its rendering scopes:
 /// the opaque ones write depth; the blended ones only test it, drawn after everything
@@ -149,35 +153,37 @@ impl FluidView for PointsViewer {
         slot: usize,
         save: bool,
     ) -> Result<()> {
-        prof.begin(ctx, cmd, crate::render::points::POINTS.name);
-        if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
-            v.prepare(ctx, cmd, m);
+        {
+            let _scope = prof.open(ctx, cmd, crate::render::points::POINTS.scope());
+            if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
+                v.prepare(ctx, cmd, m);
+            }
+            if n > 0 {
+                self.view.prepare(ctx, cmd, pos, attr);
+            }
+            if let Some(o) = layers.overlay {
+                o.prepare(ctx, cmd, true);
+                o.prepare(ctx, cmd, false);
+            }
+            self.target
+                .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
+            if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
+                v.draw(ctx, cmd, m);
+            }
+            if n > 0 {
+                self.view.draw(ctx, cmd, pos, attr, n, &self.push);
+            }
+            if let Some(o) = layers.overlay {
+                o.draw_opaque(ctx, cmd);
+                o.draw_blended(ctx, cmd);
+            }
+            self.target.end_rendering(ctx, cmd);
         }
-        if n > 0 {
-            self.view.prepare(ctx, cmd, pos, attr);
-        }
-        if let Some(o) = layers.overlay {
-            o.prepare(ctx, cmd, true);
-            o.prepare(ctx, cmd, false);
-        }
-        self.target
-            .begin_rendering(ctx, cmd, [0.02, 0.02, 0.04, 1.0]);
-        if let (Some(v), Some(m)) = (&self.mesh, layers.mesh) {
-            v.draw(ctx, cmd, m);
-        }
-        if n > 0 {
-            self.view.draw(ctx, cmd, pos, attr, n, &self.push);
-        }
-        if let Some(o) = layers.overlay {
-            o.draw_opaque(ctx, cmd);
-            o.draw_blended(ctx, cmd);
-        }
-        self.target.end_rendering(ctx, cmd);
-        prof.end(ctx, cmd);
         if save {
-            prof.begin(ctx, cmd, "readback");
-            self.target.copy_out(ctx, cmd, slot);
-            prof.end(ctx, cmd);
+            {
+                let _scope = prof.open(ctx, cmd, READBACK_SCOPE);
+                self.target.copy_out(ctx, cmd, slot);
+            }
         }
         Ok(())
     }
@@ -305,14 +311,15 @@ impl MetaballViewer {
             let target = self.target.as_ref().ok_or_else(|| {
                 crate::Error::Param("a metaball view made without overlays was given one".into())
             })?;
-            scopes.begin(ctx, cmd, "overlay");
-            target.load_layers(ctx, cmd, (&b.pixels, 0), (&b.scene_depth, 0));
-            o.prepare(ctx, cmd, false);
-            target.begin_rendering_loaded(ctx, cmd);
-            o.draw_blended(ctx, cmd);
-            target.end_rendering(ctx, cmd);
-            target.copy_color(ctx, cmd, &b.pixels, 0);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, OVERLAY_SCOPE);
+                target.load_layers(ctx, cmd, (&b.pixels, 0), (&b.scene_depth, 0));
+                o.prepare(ctx, cmd, false);
+                target.begin_rendering_loaded(ctx, cmd);
+                o.draw_blended(ctx, cmd);
+                target.end_rendering(ctx, cmd);
+                target.copy_color(ctx, cmd, &b.pixels, 0);
+            }
         }
         self.renderer.record_readback(ctx, cmd, b, slot);
         Ok(())
@@ -333,49 +340,50 @@ impl FluidView for MetaballViewer {
         _: bool,
     ) -> Result<()> {
         if let Some(target) = &self.target {
-            prof.begin(ctx, cmd, crate::render::mesh::MESH.name);
-            let mesh = match &self.mesh {
-                Some(view) => Some((
-                    view,
-                    layers.mesh.ok_or_else(|| {
-                        crate::Error::Param(
-                            "a metaball view made to draw a mesh was given none".into(),
-                        )
-                    })?,
-                )),
-                None => None,
-            };
-            if let Some((view, m)) = mesh {
-                view.prepare(ctx, cmd, m);
+            {
+                let _scope = prof.open(ctx, cmd, crate::render::mesh::MESH.scope());
+                let mesh = match &self.mesh {
+                    Some(view) => Some((
+                        view,
+                        layers.mesh.ok_or_else(|| {
+                            crate::Error::Param(
+                                "a metaball view made to draw a mesh was given none".into(),
+                            )
+                        })?,
+                    )),
+                    None => None,
+                };
+                if let Some((view, m)) = mesh {
+                    view.prepare(ctx, cmd, m);
+                }
+                if let Some(o) = layers.overlay {
+                    o.prepare(ctx, cmd, true);
+                }
+                target.begin_rendering(ctx, cmd, [0.0; 4]);
+                if let Some((view, m)) = mesh {
+                    view.draw(ctx, cmd, m);
+                }
+                if let Some(o) = layers.overlay {
+                    o.draw_opaque(ctx, cmd);
+                }
+                target.end_rendering(ctx, cmd);
+                let px = self.renderer.settings.pixels();
+                target.copy_layers(ctx, cmd, &self.buffers.opaque, 0, px * 4);
             }
-            if let Some(o) = layers.overlay {
-                o.prepare(ctx, cmd, true);
-            }
-            target.begin_rendering(ctx, cmd, [0.0; 4]);
-            if let Some((view, m)) = mesh {
-                view.draw(ctx, cmd, m);
-            }
-            if let Some(o) = layers.overlay {
-                o.draw_opaque(ctx, cmd);
-            }
-            target.end_rendering(ctx, cmd);
-            let px = self.renderer.settings.pixels();
-            target.copy_layers(ctx, cmd, &self.buffers.opaque, 0, px * 4);
-            prof.end(ctx, cmd);
         }
         ctx.copy(cmd, pos, 0, &self.centers[slot], 0, n as u64 * 16);
-        prof.begin(ctx, cmd, crate::render::SCOPE.name());
-        let r = self.renderer.record_picture(
-            ctx,
-            cmd,
-            prof,
-            &self.buffers,
-            &self.centers[slot],
-            n,
-            &self.cam,
-        );
-        prof.end(ctx, cmd);
-        r?;
+        {
+            let mut prof = prof.open(ctx, cmd, crate::render::SCOPE.scope());
+            self.renderer.record_picture(
+                ctx,
+                cmd,
+                &mut *prof,
+                &self.buffers,
+                &self.centers[slot],
+                n,
+                &self.cam,
+            )?;
+        }
         self.record_finish(ctx, cmd, prof, layers.overlay, slot)
     }
 

@@ -4,6 +4,7 @@ pub mod bounds;
 pub mod counting;
 pub mod cpu;
 pub mod morton;
+mod nb_passes;
 pub mod neighbors;
 pub mod scan;
 pub mod sort;

@@ -10,14 +10,22 @@
 use super::bounds::{BoundsBuffers, BoundsPass};
 use super::counting::{CountingBuffers, CountingSort, GatherPass};
 use super::morton::MortonPass;
+pub use super::nb_passes::{CellKeys, NbKey};
+use super::nb_passes::{CELL_KEYS, CELL_RANGES, NEIGHBOR_QUERY};
 use super::scan::{ScanPass, ScanVariant};
 use super::sort::{Network, NetworkSort};
 use crate::error::{Error, Result};
 use crate::kinds::{Neighbors, SortAlgo};
-use crate::pass::{Defines, PassKey};
+use crate::Open;
 use crate::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
+
+const KEYS_SCOPE: crate::ScopeName = crate::ScopeName::new("keys");
+const QUERY_SCOPE: crate::ScopeName = crate::ScopeName::new("query");
+const RANGES_SCOPE: crate::ScopeName = crate::ScopeName::new("ranges");
+const REORDER_SCOPE: crate::ScopeName = crate::ScopeName::new("reorder");
+const SORT_SCOPE: crate::ScopeName = crate::ScopeName::new("sort");
 
 /// A uniform grid: origin, cell size (>= search radius) and cell counts per axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,58 +122,6 @@ crate::gpu_interface! {
 }
 
 /// The default sort of each strategy.
-/// A neighbour search's shader variant: its strategy and whether its sort counts cells.
-/// Every pass that includes neighbors.glsl is keyed by it (or by a key holding it).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct NbKey {
-    pub strategy: Neighbors,
-    pub sort: SortAlgo,
-}
-
-impl PassKey for NbKey {
-    /// Every strategy with every sort it accepts (Morton's 30-bit codes take no counting).
-    fn all() -> Vec<Self> {
-        let mut v = Vec::new();
-        for strategy in Neighbors::all() {
-            for sort in [SortAlgo::Counting, SortAlgo::OddEven, SortAlgo::Bitonic] {
-                if !(*strategy == Neighbors::Morton && sort == SortAlgo::Counting) {
-                    v.push(Self {
-                        strategy: *strategy,
-                        sort,
-                    });
-                }
-            }
-        }
-        v
-    }
-    fn defines(&self) -> Defines {
-        NeighborSearch::defines_for(self.strategy, self.sort)
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect()
-    }
-}
-
-/// The cell-key pass's variants: every search but Morton's, which makes its keys itself.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CellKeys(pub NbKey);
-
-impl PassKey for CellKeys {
-    fn all() -> Vec<Self> {
-        let v = NbKey::all().into_iter();
-        v.filter(|k| k.strategy != Neighbors::Morton)
-            .map(Self)
-            .collect()
-    }
-    fn defines(&self) -> Defines {
-        self.0.defines()
-    }
-}
-
-crate::compute_pass!(pub CELL_KEYS: NbKeysIo, CellKeys = "cell keys", "primitives/nb_keys.comp");
-crate::compute_pass!(pub CELL_RANGES: NbRangesIo, NbKey = "cell ranges", "primitives/nb_ranges.comp");
-crate::compute_pass!(pub NEIGHBOR_QUERY: NbQueryIo, NbKey = "neighbor query", "primitives/nb_query.comp");
-
 pub fn default_sort(strategy: Neighbors) -> SortAlgo {
     match strategy {
         Neighbors::Grid => SortAlgo::Counting,
@@ -466,62 +422,66 @@ impl NeighborSearch {
         } else {
             (&b.sorted_keys, &b.perm)
         };
-        scopes.begin(ctx, cmd, "keys");
-        if let (Some(bounds), Some(morton), Some(bb)) = (&self.bounds, &self.morton, &b.bounds) {
-            bounds.record(ctx, cmd, pos, n as u64, bb)?;
-            morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
-        } else if let Some(keys) = &self.keys {
-            // With the counting sort the keys pass counts too (NB_CELL_COUNTS); a network
-            // sort's keys pass binds the keys again in their place, unused.
-            let (counts, rank) = match &b.counting {
-                Some(cb) if counting => {
-                    ctx.fill(cmd, &cb.counts, 0);
-                    (&cb.counts, &cb.rank)
+        {
+            let _scope = scopes.open(ctx, cmd, KEYS_SCOPE);
+            if let (Some(bounds), Some(morton), Some(bb)) = (&self.bounds, &self.morton, &b.bounds)
+            {
+                bounds.record(ctx, cmd, pos, n as u64, bb)?;
+                morton.record(ctx, cmd, pos, &bb.result, kd, vd, n);
+            } else if let Some(keys) = &self.keys {
+                // With the counting sort the keys pass counts too (NB_CELL_COUNTS); a network
+                // sort's keys pass binds the keys again in their place, unused.
+                let (counts, rank) = match &b.counting {
+                    Some(cb) if counting => {
+                        ctx.fill(cmd, &cb.counts, 0);
+                        (&cb.counts, &cb.rank)
+                    }
+                    _ => (kd, vd),
+                };
+                let bufs = NbKeysBufs {
+                    pos,
+                    keys: kd,
+                    vals: vd,
+                    counts,
+                    rank,
+                };
+                keys.dispatch(ctx, cmd, &bufs, &push, n as u64);
+            }
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, SORT_SCOPE);
+            match &self.sorter {
+                Sorter::Counting(c) => {
+                    let cb = b.counting.as_ref().expect("counting buffers");
+                    c.record_counted(
+                        ctx,
+                        cmd,
+                        &self.scan,
+                        cb,
+                        &b.keys,
+                        &b.vals,
+                        &b.sorted_keys,
+                        &b.perm,
+                        n as u64,
+                    )?;
                 }
-                _ => (kd, vd),
-            };
-            let bufs = NbKeysBufs {
-                pos,
-                keys: kd,
-                vals: vd,
-                counts,
-                rank,
-            };
-            keys.dispatch(ctx, cmd, &bufs, &push, n as u64);
-        }
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "sort");
-        match &self.sorter {
-            Sorter::Counting(c) => {
-                let cb = b.counting.as_ref().expect("counting buffers");
-                c.record_counted(
-                    ctx,
-                    cmd,
-                    &self.scan,
-                    cb,
-                    &b.keys,
-                    &b.vals,
-                    &b.sorted_keys,
-                    &b.perm,
-                    n as u64,
-                )?;
-            }
-            Sorter::Network(s) => {
-                s.record(ctx, cmd, &b.sorted_keys, &b.perm, n as u64)?;
+                Sorter::Network(s) => {
+                    s.record(ctx, cmd, &b.sorted_keys, &b.perm, n as u64)?;
+                }
             }
         }
-        scopes.end(ctx, cmd);
         if !counting && self.strategy != Neighbors::Morton {
-            scopes.begin(ctx, cmd, "ranges");
-            ctx.fill(cmd, &b.starts, 0);
-            ctx.fill(cmd, &b.ends, 0);
-            let bufs = NbRangesBufs {
-                keys: &b.sorted_keys,
-                start: &b.starts,
-                end: &b.ends,
-            };
-            self.ranges.dispatch(ctx, cmd, &bufs, &n, n as u64);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, RANGES_SCOPE);
+                ctx.fill(cmd, &b.starts, 0);
+                ctx.fill(cmd, &b.ends, 0);
+                let bufs = NbRangesBufs {
+                    keys: &b.sorted_keys,
+                    start: &b.starts,
+                    end: &b.ends,
+                };
+                self.ranges.dispatch(ctx, cmd, &bufs, &n, n as u64);
+            }
         }
         Ok(())
     }
@@ -548,22 +508,24 @@ impl NeighborSearch {
         }
         let push = Self::push(b, grid, radius, n);
         let (starts, ends) = b.cell_buffers();
-        scopes.begin(ctx, cmd, "reorder");
-        self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "query");
-        let bufs = NbQueryBufs {
-            pos: &b.sorted_pos,
-            nb_keys: &b.sorted_keys,
-            nb_start: starts,
-            nb_end: ends,
-            nb_box: b.box_buffer(),
-            counts: &b.counts,
-            list: &b.list,
-            visited: &b.visited,
-        };
-        self.query.dispatch(ctx, cmd, &bufs, &push, n as u64);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, REORDER_SCOPE);
+            self.gather.record(ctx, cmd, &b.perm, pos, &b.sorted_pos, n);
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, QUERY_SCOPE);
+            let bufs = NbQueryBufs {
+                pos: &b.sorted_pos,
+                nb_keys: &b.sorted_keys,
+                nb_start: starts,
+                nb_end: ends,
+                nb_box: b.box_buffer(),
+                counts: &b.counts,
+                list: &b.list,
+                visited: &b.visited,
+            };
+            self.query.dispatch(ctx, cmd, &bufs, &push, n as u64);
+        }
         Ok(())
     }
 

@@ -4,6 +4,7 @@ use crate::character::Skinning;
 use crate::character::{self, anim, anim::Up, skin::Skinner, Animator, Character};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard};
 use crate::render::mesh::MeshDraw;
 use crate::render::ShowMesh;
@@ -308,9 +309,10 @@ impl SceneCharacter {
     ) -> Result<()> {
         let mats = self.matrices(t);
         let joints = self.ch.gpu_joints(&mats, self.method)?;
-        prof.begin(ctx, cmd, crate::character::skin::SKIN.name);
-        self.skinner.record(ctx, cmd, &joints)?;
-        prof.end(ctx, cmd);
+        {
+            let _scope = prof.open(ctx, cmd, crate::character::skin::SKIN.scope());
+            self.skinner.record(ctx, cmd, &joints)?;
+        }
         Ok(())
     }
 

@@ -14,14 +14,15 @@ use crate::character::pose::GpuJoint;
 use crate::character::skin::{SkinPass, SkinnedMesh};
 use crate::character::Mesh;
 use crate::error::{Error, Result};
-use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::{vk, Buffer, ComputePipeline, Context, Guard, Open, ScopeName, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
 use crate::primitives::neighbors::{GridSpec, NeighborBuffers, NeighborPush, NeighborSearch};
 use crate::sph::hooks::SphHook;
 use crate::sph::solver::SphState;
 use bytemuck::{Pod, Zeroable};
+
+const CONTROL_GRID_SCOPE: ScopeName = ScopeName::new("control-grid");
 
 crate::gpu_interface! {
     /// glsl/control/common.glsl: the SPH bindings, then the control set's.
@@ -380,25 +381,30 @@ impl ControlForce {
         let bytes = self.m as u64 * 16;
         // (Rays: the surface is skinned, not the particles; they have no other pose.)
         let ahead = pose.next.as_ref().filter(|_| g.rays.is_none());
-        scopes.begin(ctx, cmd, "skin");
-        if !first && g.rays.is_none() && ahead.is_none() {
-            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
-        }
-        let params = self.gpu_params(g, pose.frame_dt, ahead.is_some());
-        ctx.update(cmd, &g.params, 0, &[params]);
-        if let Some(next) = ahead {
-            // The pose a frame ahead, skinned into `prev`, then the frame's own.
-            g.mesh.set_pose(ctx, cmd, next)?;
+        {
+            let _scope = scopes.open(ctx, cmd, crate::character::skin::SKIN.scope());
+            if !first && g.rays.is_none() && ahead.is_none() {
+                ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            }
+            let params = self.gpu_params(g, pose.frame_dt, ahead.is_some());
+            ctx.update(cmd, &g.params, 0, &[params]);
+            if let Some(next) = ahead {
+                // The pose a frame ahead, skinned into `prev`, then the frame's own.
+                g.mesh.set_pose(ctx, cmd, next)?;
+                g.skin.record(ctx, cmd, &g.mesh)?;
+                ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            }
+            g.mesh.set_pose(ctx, cmd, &pose.joints)?;
             g.skin.record(ctx, cmd, &g.mesh)?;
-            ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            // Re-placed particles have no previous pose: both are the new set.
+            if g.rays.is_none() && first && ahead.is_none() {
+                ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
+            }
         }
-        g.mesh.set_pose(ctx, cmd, &pose.joints)?;
-        g.skin.record(ctx, cmd, &g.mesh)?;
         // The control set and its previous pose: the skinned particles, or the rays
-        // placement's (re-placed particles have no previous pose: both are the new set).
+        // placement's.
         let (pos, prev) = match &g.rays {
             Some(r) => {
-                scopes.end(ctx, cmd);
                 r.record(
                     ctx,
                     cmd,
@@ -417,22 +423,17 @@ impl ControlForce {
                 );
                 (&r.out, &r.out)
             }
-            None => {
-                if first && ahead.is_none() {
-                    ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
-                }
-                scopes.end(ctx, cmd);
-                (&g.mesh.pos, &g.prev)
-            }
+            None => (&g.mesh.pos, &g.prev),
         };
-        scopes.begin(ctx, cmd, "control-grid");
-        g.search
-            .record_build(ctx, cmd, scopes, &g.nb, pos, self.m, &g.fine)?;
-        g.gather
-            .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
-        g.gather
-            .record(ctx, cmd, &g.nb.perm, prev, &g.sorted_prev, self.m);
-        scopes.end(ctx, cmd);
+        {
+            let mut scopes = scopes.open(ctx, cmd, CONTROL_GRID_SCOPE);
+            g.search
+                .record_build(ctx, cmd, &mut *scopes, &g.nb, pos, self.m, &g.fine)?;
+            g.gather
+                .record(ctx, cmd, &g.nb.perm, pos, &g.sorted_pos, self.m);
+            g.gather
+                .record(ctx, cmd, &g.nb.perm, prev, &g.sorted_prev, self.m);
+        }
         Ok(())
     }
 
@@ -521,8 +522,8 @@ pub const SCOPE: crate::gpu::ScopeKey = crate::gpu::ScopeKey::new("sph/control")
 
 /// The control force as a force hook of the SPH step (scope `SCOPE`).
 impl SphHook for ControlForce {
-    fn name(&self) -> &str {
-        SCOPE.name()
+    fn scope(&self) -> crate::gpu::ScopeName {
+        SCOPE.scope()
     }
 
     fn record(
@@ -561,30 +562,35 @@ impl SphHook for ControlForce {
         let bufs = c.bufs(g, st, cache.current());
         if !refresh {
             // The last step's stored sums, gathered into this step's particle order.
-            scopes.begin(ctx, cmd, "control-force-stored");
-            g.gather
-                .record_many(ctx, cmd, &st.nb.perm, &cache.gathers(), st.n);
-            g.apply.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, CONTROL_FORCE_STORED.scope());
+                g.gather
+                    .record_many(ctx, cmd, &st.nb.perm, &cache.gathers(), st.n);
+                g.apply.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
+            }
             return Ok(());
         }
-        scopes.begin(ctx, cmd, "control-density");
-        g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, CONTROL_DENSITY.scope());
+            g.density.dispatch(ctx, cmd, &bufs, &push, c.m as u64);
+        }
         let s = &c.settings;
         // The attraction and damping field follows the pose (once a frame): refreshed at
         // every eq. 7 refresh it cost 0.05 of the step on the walker and changed no metric.
         if (s.attraction > 0.0 || s.damping > 0.0) && posed {
-            scopes.begin(ctx, cmd, "control-aggregate");
-            g.aggregate.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
-            scopes.end(ctx, cmd);
-            scopes.begin(ctx, cmd, "control-field");
-            g.field.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, CONTROL_AGGREGATE.scope());
+                g.aggregate.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
+            }
+            {
+                let _scope = scopes.open(ctx, cmd, CONTROL_FIELD.scope());
+                g.field.dispatch(ctx, cmd, &bufs, &push, g.grid.cells());
+            }
         }
-        scopes.begin(ctx, cmd, "control-force");
-        g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, CONTROL_FORCE.scope());
+            g.force.dispatch(ctx, cmd, &bufs, &push, st.n as u64);
+        }
         Ok(())
     }
 

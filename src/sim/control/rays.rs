@@ -10,6 +10,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{
     Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Scopes,
 };
@@ -190,30 +191,31 @@ impl RaysPlacer {
             out: &self.out,
             stats: &self.stats,
         };
-        scopes.begin(ctx, cmd, Self::NAME);
-        ctx.fill(cmd, &self.offsets, 0);
-        ctx.fill(cmd, &self.out, self.park.to_bits());
-        let [w, h, _] = self.grid.dims;
-        let draw = |p: &GraphicsPipeline<RaysIo>| {
-            p.prepare(ctx, cmd, &bufs);
-            begin_empty_rendering(ctx, cmd, w, h);
-            p.bind(ctx, cmd, &bufs, &push);
-            ctx.draw(cmd, 3 * triangles, 1);
-            ctx.end_rendering(cmd);
-        };
-        draw(&self.count);
-        let scan = |b: &Buffer| {
-            self.scan
-                .record(ctx, cmd, b, b, px + 1, ScanKind::Exclusive, &self.scratch)
-        };
-        scan(&self.offsets)?;
-        ctx.copy(cmd, &self.offsets, px * 4, &self.stats, STATS_FRAGMENTS, 4);
-        draw(&self.fill);
-        self.sort_count.dispatch(ctx, cmd, &bufs, &push, px);
-        scan(&self.emit_buf)?;
-        self.emit.dispatch(ctx, cmd, &bufs, &push, px);
-        ctx.copy(cmd, &self.emit_buf, px * 4, &self.stats, STATS_PARTICLES, 4);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Self::NAME));
+            ctx.fill(cmd, &self.offsets, 0);
+            ctx.fill(cmd, &self.out, self.park.to_bits());
+            let [w, h, _] = self.grid.dims;
+            let draw = |p: &GraphicsPipeline<RaysIo>| {
+                p.prepare(ctx, cmd, &bufs);
+                begin_empty_rendering(ctx, cmd, w, h);
+                p.bind(ctx, cmd, &bufs, &push);
+                ctx.draw(cmd, 3 * triangles, 1);
+                ctx.end_rendering(cmd);
+            };
+            draw(&self.count);
+            let scan = |b: &Buffer| {
+                self.scan
+                    .record(ctx, cmd, b, b, px + 1, ScanKind::Exclusive, &self.scratch)
+            };
+            scan(&self.offsets)?;
+            ctx.copy(cmd, &self.offsets, px * 4, &self.stats, STATS_FRAGMENTS, 4);
+            draw(&self.fill);
+            self.sort_count.dispatch(ctx, cmd, &bufs, &push, px);
+            scan(&self.emit_buf)?;
+            self.emit.dispatch(ctx, cmd, &bufs, &push, px);
+            ctx.copy(cmd, &self.emit_buf, px * 4, &self.stats, STATS_PARTICLES, 4);
+        }
         Ok(())
     }
 

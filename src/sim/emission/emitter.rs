@@ -10,11 +10,14 @@ use super::uv::UvSurface;
 use crate::emission::EmitterKind;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, Context, Guard, Scopes};
 use crate::sph::hooks::SphHook;
 use crate::sph::params::SphGpuParams;
 use crate::sph::store::{AttrId, AttributeDecl};
 use crate::sph::SphState;
+
+const VERTICES_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("vertices");
 
 /// The vertex emitter's source: the skinned positions of this frame and the last.
 pub struct VertexSource {
@@ -102,9 +105,10 @@ impl EmitSource {
             EmitSource::Uv(uv, _) => uv.record(ctx, cmd, scopes, verts),
             EmitSource::Vertices(v) => {
                 let next = 1 - v.current;
-                scopes.begin(ctx, cmd, "vertices");
-                ctx.copy(cmd, verts, 0, &v.pos[next], 0, v.vertices as u64 * 16);
-                scopes.end(ctx, cmd);
+                {
+                    let _scope = scopes.open(ctx, cmd, VERTICES_SCOPE);
+                    ctx.copy(cmd, verts, 0, &v.pos[next], 0, v.vertices as u64 * 16);
+                }
                 v.current = next;
                 Ok(())
             }
@@ -299,8 +303,8 @@ impl Emitter {
 /// The emitter is the SPH step's pre-arrange hook (scope `sph/emit`); the scene owns it
 /// and lends it to each frame's steps.
 impl SphHook for Emitter {
-    fn name(&self) -> &str {
-        EmitPass::NAME
+    fn scope(&self) -> crate::gpu::ScopeName {
+        crate::gpu::ScopeName::new(EmitPass::NAME)
     }
 
     fn record(

@@ -9,6 +9,7 @@ use super::layout::UvLayout;
 use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{
     Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Labels, Scopes,
 };
@@ -196,10 +197,11 @@ impl UvSurface {
         verts: &Buffer,
     ) -> Result<()> {
         let next = 1 - self.current;
-        scopes.begin(ctx, cmd, Self::NAME);
-        ctx.fill(cmd, &self.pos[next], 0);
-        self.raster_into(ctx, cmd, verts, &self.pos[next], 0);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Self::NAME));
+            ctx.fill(cmd, &self.pos[next], 0);
+            self.raster_into(ctx, cmd, verts, &self.pos[next], 0);
+        }
         self.current = next;
         Ok(())
     }

@@ -4,6 +4,7 @@ use super::gpu::Passes;
 use super::system::{FrameInfo, ParticleSystem};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Context, Scopes};
 use crate::render::Camera;
 
@@ -68,21 +69,22 @@ fn record_events(
     if links.is_empty() {
         return Ok(());
     }
-    prof.begin(ctx, cmd, Passes::EVENTS);
-    for (i, s) in systems.iter().enumerate() {
-        if links.iter().any(|l| l.0 == i) {
-            s.record_event_args(ctx, cmd, passes, f);
+    {
+        let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::EVENTS));
+        for (i, s) in systems.iter().enumerate() {
+            if links.iter().any(|l| l.0 == i) {
+                s.record_event_args(ctx, cmd, passes, f);
+            }
+        }
+        for &(i, j, e) in &links {
+            systems[j].record_spawn(ctx, cmd, passes, f, &systems[i], e);
+        }
+        let mut targets: Vec<usize> = links.iter().map(|l| l.1).collect();
+        targets.sort_unstable();
+        targets.dedup();
+        for j in targets {
+            systems[j].record_draw_count(ctx, cmd, passes, f);
         }
     }
-    for &(i, j, e) in &links {
-        systems[j].record_spawn(ctx, cmd, passes, f, &systems[i], e);
-    }
-    let mut targets: Vec<usize> = links.iter().map(|l| l.1).collect();
-    targets.sort_unstable();
-    targets.dedup();
-    for j in targets {
-        systems[j].record_draw_count(ctx, cmd, passes, f);
-    }
-    prof.end(ctx, cmd);
     Ok(())
 }

@@ -12,6 +12,7 @@ use super::spec::{Shape, SystemSpec};
 use super::sprite;
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, Context, Guard, Scopes};
 use crate::kinds::SortAlgo;
 use crate::primitives::counting::CountingBuffers;
@@ -415,59 +416,68 @@ impl ParticleSystem {
         self.last_time = f.time + f.dt as f64;
         let push = self.push(f, f.time, births);
         let bufs = self.bufs(passes, f);
-        scopes.begin(ctx, cmd, Passes::EMIT);
-        passes.emit.dispatch(ctx, cmd, &bufs, &push, births as u64);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::EMIT));
+            passes.emit.dispatch(ctx, cmd, &bufs, &push, births as u64);
+        }
         if self.closed() {
             self.head = ((self.head as u64 + births as u64) % self.capacity as u64) as u32;
             return;
         }
-        scopes.begin(ctx, cmd, Passes::UPDATE);
-        passes.args.dispatch_groups(ctx, cmd, &bufs, &push, 1);
-        if let (Some(nb), Some(b)) = (&self.flock, &self.spec.boids) {
-            // The grid over every slot (dead ones sort last), then each boid's steering.
-            scopes.begin(ctx, cmd, Passes::BOIDS);
-            let r =
-                passes
-                    .grid
-                    .record_build(ctx, cmd, scopes, nb, &self.pos, self.capacity, &b.grid());
-            debug_assert!(r.is_ok(), "the grid was sized for every slot");
-            let (nb_start, nb_end) = nb.cell_buffers();
-            let b = BoidsBufs {
-                params: &self.params,
-                counters: &self.counters,
-                alive: &self.alive,
-                pos: &self.pos,
-                vel: &self.vel,
-                steer: &self.steer,
-                perm: &nb.perm,
-                nb_keys: &nb.sorted_keys,
-                nb_start,
-                nb_end,
-                nb_box: nb.box_buffer(),
-                capsules: bufs.capsules,
-            };
-            passes.boids.dispatch_indirect(
+        {
+            let mut scopes = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::UPDATE));
+            passes.args.dispatch_groups(ctx, cmd, &bufs, &push, 1);
+            if let (Some(nb), Some(b)) = (&self.flock, &self.spec.boids) {
+                // The grid over every slot (dead ones sort last), then each boid's steering.
+                {
+                    let mut scopes =
+                        scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::BOIDS));
+                    let r = passes.grid.record_build(
+                        ctx,
+                        cmd,
+                        &mut *scopes,
+                        nb,
+                        &self.pos,
+                        self.capacity,
+                        &b.grid(),
+                    );
+                    debug_assert!(r.is_ok(), "the grid was sized for every slot");
+                    let (nb_start, nb_end) = nb.cell_buffers();
+                    let b = BoidsBufs {
+                        params: &self.params,
+                        counters: &self.counters,
+                        alive: &self.alive,
+                        pos: &self.pos,
+                        vel: &self.vel,
+                        steer: &self.steer,
+                        perm: &nb.perm,
+                        nb_keys: &nb.sorted_keys,
+                        nb_start,
+                        nb_end,
+                        nb_box: nb.box_buffer(),
+                        capsules: bufs.capsules,
+                    };
+                    passes.boids.dispatch_indirect(
+                        ctx,
+                        cmd,
+                        &b,
+                        &push,
+                        &self.counters,
+                        Counters::UPDATE_ARGS,
+                    );
+                }
+            }
+            passes.update.dispatch_indirect(
                 ctx,
                 cmd,
-                &b,
+                &bufs,
                 &push,
                 &self.counters,
                 Counters::UPDATE_ARGS,
             );
-            scopes.end(ctx, cmd);
+            self.drawn = 1 - self.drawn;
+            self.record_draw_count(ctx, cmd, passes, f);
         }
-        passes.update.dispatch_indirect(
-            ctx,
-            cmd,
-            &bufs,
-            &push,
-            &self.counters,
-            Counters::UPDATE_ARGS,
-        );
-        self.drawn = 1 - self.drawn;
-        self.record_draw_count(ctx, cmd, passes, f);
-        scopes.end(ctx, cmd);
     }
 
     /// Record the spawn's indirect dispatch over the events this frame's step recorded

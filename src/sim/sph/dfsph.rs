@@ -15,7 +15,11 @@ use super::pressure::{
 use super::solver::{SphKey, SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
-use crate::gpu::{Context, Scopes};
+use crate::gpu::Open;
+use crate::gpu::{Context, ScopeName, Scopes};
+
+/// DFSPH's iterations, inside each solve's scope.
+const ITERATIONS: ScopeName = ScopeName::new("iterations");
 use crate::sph::Solver;
 
 /// DFSPH's neighbour list length: a particle has about 20 neighbours at rest (h = 1.68
@@ -157,21 +161,21 @@ super::pressure::solver_passes!(
 /// One of the two solves after its warm start: its scope, the passes that apply the warm
 /// start's change and take the first residual, and an iteration's passes.
 struct Solve {
-    scope: &'static str,
+    scope: ScopeName,
     first: [Pass; 2],
     iteration: [Pass; 2],
     divergence: bool,
 }
 
 const DIVERGENCE: Solve = Solve {
-    scope: super::DIVERGENCE_SCOPE.name(),
+    scope: super::DIVERGENCE_SCOPE.scope(),
     first: [Pass::VelocityDivergence, Pass::SourceDivergence],
     iteration: [Pass::VelocityDivergence, Pass::CheckDivergence],
     divergence: true,
 };
 
 const DENSITY: Solve = Solve {
-    scope: super::PRESSURE_SCOPE.name(),
+    scope: super::PRESSURE_SCOPE.scope(),
     first: [Pass::PredictDensity, Pass::SourceDensity],
     iteration: [Pass::VelocityDensity, Pass::CheckDensity],
     divergence: false,
@@ -195,18 +199,21 @@ impl Dfsph {
         (s, warm): (&Solve, Option<Pass>),
     ) -> Result<()> {
         let p = &self.0;
-        scopes.begin(ctx, cmd, s.scope);
+        let mut scopes = scopes.open(ctx, cmd, s.scope);
         let iteration = s.iteration.map(|k| k as usize);
-        let r = warm
-            .into_iter()
+        warm.into_iter()
             .chain(s.first)
-            .try_for_each(|k| p.run(ctx, cmd, st, k as usize))
-            .and_then(|_| {
-                let iterations = (&iteration[..], &[][..]);
-                p.solve(ctx, cmd, scopes, st, "iterations", iterations, s.divergence)
-            });
-        scopes.end(ctx, cmd);
-        r
+            .try_for_each(|k| p.run(ctx, cmd, st, k as usize))?;
+        let iterations = (&iteration[..], &[][..]);
+        p.solve(
+            ctx,
+            cmd,
+            &mut *scopes,
+            st,
+            ITERATIONS,
+            iterations,
+            s.divergence,
+        )
     }
 }
 

@@ -10,7 +10,7 @@ use bytemuck::{Pod, Zeroable};
 
 pub trait SphHook {
     /// Timestamp scope and debug label (under `sph/`).
-    fn name(&self) -> &str;
+    fn scope(&self) -> crate::gpu::ScopeName;
     /// Record the hook's passes for the state's `n` particles (sub-scopes in `scopes`);
     /// the solver orders them after the previous pass and before the next.
     fn record(
@@ -93,8 +93,8 @@ impl ConstantForce {
 }
 
 impl SphHook for ConstantForce {
-    fn name(&self) -> &str {
-        "constant-force"
+    fn scope(&self) -> crate::gpu::ScopeName {
+        CONSTANT_FORCE.scope()
     }
 
     fn record(

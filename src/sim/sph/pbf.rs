@@ -9,8 +9,11 @@ use super::pressure::{
 use super::solver::{SphKey, SphSolver, SphState};
 use crate::error::Result;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Context, Scopes};
 use crate::sph::Solver;
+
+const VORTICITY_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("vorticity");
 
 /// `[fluid.pbf]`: the constraint iterations, relaxation, tensile correction, XSPH and
 /// vorticity confinement.
@@ -164,16 +167,17 @@ impl PressureSolver for Pbf {
             cmd,
             scopes,
             st,
-            super::PRESSURE_SCOPE.name(),
+            super::PRESSURE_SCOPE.scope(),
             (&checked, &rest),
             false,
         )?;
         p.scoped(ctx, cmd, scopes, st, Pass::Velocity as usize)?;
         if st.fluid.pbf.xsph > 0.0 || st.fluid.pbf.vorticity > 0.0 {
-            scopes.begin(ctx, cmd, "vorticity");
-            p.run(ctx, cmd, st, Pass::Vorticity as usize)?;
-            p.run(ctx, cmd, st, Pass::Confine as usize)?;
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, VORTICITY_SCOPE);
+                p.run(ctx, cmd, st, Pass::Vorticity as usize)?;
+                p.run(ctx, cmd, st, Pass::Confine as usize)?;
+            }
         }
         Ok(())
     }

@@ -121,7 +121,7 @@ impl PressureSolver for Pcisph {
             cmd,
             scopes,
             st,
-            super::PRESSURE_SCOPE.name(),
+            super::PRESSURE_SCOPE.scope(),
             (&checked, &rest),
             false,
         )?;

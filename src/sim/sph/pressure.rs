@@ -11,7 +11,8 @@ use super::solver::{SphSolver, SphState, LOCAL_SIZE};
 use crate::error::{Error, Result};
 use crate::gpu::pass::{complete, Defines, PassKey};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, Scopes};
+use crate::gpu::Open;
+use crate::gpu::{Buffer, ComputeDesc, ComputePipeline, Context, Guard, ScopeName, Scopes};
 use crate::primitives::neighbors::NeighborPush;
 use crate::sph::Solver;
 use bytemuck::{Pod, Zeroable};
@@ -344,10 +345,8 @@ impl Pipelines {
         st: &SphState,
         k: usize,
     ) -> Result<()> {
-        scopes.begin(ctx, cmd, self.pass(k).0);
-        let r = self.run(ctx, cmd, st, k);
-        scopes.end(ctx, cmd);
-        r
+        let _scope = scopes.open(ctx, cmd, ScopeName::new(self.pass(k).0));
+        self.run(ctx, cmd, st, k)
     }
 
     /// An iterative solve in the scope `scope`, its state started by the pass before it:
@@ -362,26 +361,27 @@ impl Pipelines {
         cmd: vk::CommandBuffer,
         scopes: &mut dyn Scopes,
         st: &SphState,
-        scope: &str,
+        scope: ScopeName,
         (checked, rest): (&[usize], &[usize]),
         divergence: bool,
     ) -> Result<()> {
         let b = st.pressure_bufs()?;
         let solve = st.pressure()?.solve();
         let push = st.neighbor_push();
-        scopes.begin(ctx, cmd, scope);
-        let checked: Vec<_> = checked.iter().map(|k| self.pass(*k).1).collect();
-        let rest: Vec<_> = rest.iter().map(|k| self.pass(*k).1).collect();
-        for k in 0..st.recorded_iterations(divergence) {
-            let passes = if k == 0 { &rest[..0] } else { &rest[..] };
-            for p in passes.iter().chain(&checked) {
-                p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
+        {
+            let _scope = scopes.open(ctx, cmd, scope);
+            let checked: Vec<_> = checked.iter().map(|k| self.pass(*k).1).collect();
+            let rest: Vec<_> = rest.iter().map(|k| self.pass(*k).1).collect();
+            for k in 0..st.recorded_iterations(divergence) {
+                let passes = if k == 0 { &rest[..0] } else { &rest[..] };
+                for p in passes.iter().chain(&checked) {
+                    p.dispatch_indirect(ctx, cmd, &b, &push, solve, 0);
+                }
+            }
+            for p in &rest {
+                p.dispatch(ctx, cmd, &b, &push, st.n as u64);
             }
         }
-        for p in &rest {
-            p.dispatch(ctx, cmd, &b, &push, st.n as u64);
-        }
-        scopes.end(ctx, cmd);
         Ok(())
     }
 

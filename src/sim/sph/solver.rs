@@ -10,6 +10,7 @@ use super::setup::{Particles, SphSetup};
 use crate::error::{Error, Result};
 use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::kinds::{Neighbors, SortAlgo};
 use crate::primitives::counting::GatherPass;
@@ -18,6 +19,8 @@ use crate::primitives::neighbors::{
 };
 use crate::sph::store::{AttrId, AttributeDecl, ParticleStore};
 use crate::sph::Solver;
+
+const ARRANGE_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("arrange");
 
 crate::gpu_interface! {
     /// glsl/sph/common.glsl: every SPH pass declares all of these.
@@ -437,12 +440,13 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &mut SphState,
     ) -> Result<()> {
-        scopes.begin(ctx, cmd, "arrange");
-        self.search
-            .record_build(ctx, cmd, scopes, &st.nb, st.pos(), st.n, &st.grid)?;
-        st.particles
-            .record_reorder(ctx, cmd, scopes, &self.gather, &st.nb.perm);
-        scopes.end(ctx, cmd);
+        {
+            let mut scopes = scopes.open(ctx, cmd, ARRANGE_SCOPE);
+            self.search
+                .record_build(ctx, cmd, &mut *scopes, &st.nb, st.pos(), st.n, &st.grid)?;
+            st.particles
+                .record_reorder(ctx, cmd, &mut *scopes, &self.gather, &st.nb.perm);
+        }
         Ok(())
     }
 
@@ -453,7 +457,7 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &SphState,
     ) {
-        self.run(ctx, cmd, scopes, st, &self.density, "density");
+        self.run(ctx, cmd, scopes, st, &self.density, DENSITY.scope());
     }
 
     pub fn record_forces(
@@ -463,7 +467,7 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &SphState,
     ) {
-        self.run(ctx, cmd, scopes, st, &self.forces, "forces");
+        self.run(ctx, cmd, scopes, st, &self.forces, FORCES.scope());
     }
 
     pub fn record_integrate(
@@ -473,7 +477,7 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &SphState,
     ) {
-        self.run(ctx, cmd, scopes, st, &self.integrate, "integrate");
+        self.run(ctx, cmd, scopes, st, &self.integrate, INTEGRATE.scope());
     }
 
     fn run(
@@ -483,11 +487,10 @@ impl SphSolver {
         scopes: &mut dyn Scopes,
         st: &SphState,
         p: &ComputePipeline<SphIo>,
-        name: &str,
+        name: crate::gpu::ScopeName,
     ) {
-        scopes.begin(ctx, cmd, name);
+        let _scope = scopes.open(ctx, cmd, name);
         p.dispatch(ctx, cmd, &st.bufs(), &st.neighbor_push(), st.n as u64);
-        scopes.end(ctx, cmd);
     }
 
     fn run_hooks(
@@ -498,9 +501,8 @@ impl SphSolver {
         st: &SphState,
     ) -> Result<()> {
         for h in hooks {
-            scopes.begin(ctx, cmd, h.name());
-            h.record(ctx, cmd, scopes, st)?;
-            scopes.end(ctx, cmd);
+            let mut scopes = scopes.open(ctx, cmd, h.scope());
+            h.record(ctx, cmd, &mut *scopes, st)?;
         }
         Ok(())
     }
@@ -536,28 +538,28 @@ impl SphSolver {
             st.pressure()?; // a state made for another solver: a clear error, nothing recorded
         }
         let start = ctx.recorded(cmd);
-        scopes.begin(ctx, cmd, super::SCOPE.name());
-        let uploaded = self.record_changed_params(ctx, cmd, st);
-        let recording = ctx.recording(cmd);
-        if uploaded || st.next_dt != Some(recording) {
-            scopes.begin(ctx, cmd, super::cfl::CFL.name);
-            self.cfl.record(ctx, cmd, st);
-            scopes.end(ctx, cmd);
-        }
-        st.next_dt = None;
-        Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, scopes, st)?;
-        self.record_arrange(ctx, cmd, scopes, st)?;
-        let forces = ctx.recorded(cmd);
-        p.record_forces(self, ctx, cmd, scopes, st)?;
-        let hooked = ctx.recorded(cmd);
-        Self::run_hooks(&mut hooks.force, ctx, cmd, scopes, st)?;
-        let solve = ctx.recorded(cmd);
-        p.record_solve(self, ctx, cmd, scopes, st)?;
-        if p.sets_next_dt() && st.fluid.cfl.is_some() {
-            st.next_dt = Some(recording);
-        }
-        let end = ctx.recorded(cmd);
-        scopes.end(ctx, cmd);
+        let (forces, hooked, solve, end) = {
+            let mut scopes = scopes.open(ctx, cmd, super::SCOPE.scope());
+            let uploaded = self.record_changed_params(ctx, cmd, st);
+            let recording = ctx.recording(cmd);
+            if uploaded || st.next_dt != Some(recording) {
+                let _scope = scopes.open(ctx, cmd, super::cfl::CFL.scope());
+                self.cfl.record(ctx, cmd, st);
+            }
+            st.next_dt = None;
+            Self::run_hooks(&mut hooks.pre_arrange, ctx, cmd, &mut *scopes, st)?;
+            self.record_arrange(ctx, cmd, &mut *scopes, st)?;
+            let forces = ctx.recorded(cmd);
+            p.record_forces(self, ctx, cmd, &mut *scopes, st)?;
+            let hooked = ctx.recorded(cmd);
+            Self::run_hooks(&mut hooks.force, ctx, cmd, &mut *scopes, st)?;
+            let solve = ctx.recorded(cmd);
+            p.record_solve(self, ctx, cmd, &mut *scopes, st)?;
+            if p.sets_next_dt() && st.fluid.cfl.is_some() {
+                st.next_dt = Some(recording);
+            }
+            (forces, hooked, solve, ctx.recorded(cmd))
+        };
         let solves = p.solves();
         let iterations = [false, true].map(|d| match solves[d as usize] {
             true => st.recorded_iterations(d),

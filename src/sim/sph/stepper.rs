@@ -8,9 +8,12 @@ use super::setup::Domain;
 use super::solver::{SphSolver, SphState, StateDump};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Context, Profiler};
 use crate::sph::Solver;
 use serde::{Deserialize, Serialize};
+
+const SPH_HEALTH_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("sph/health");
 
 /// Chooses steps per frame and watches the state's health. With `cfl`, each step's dt is
 /// the GPU's, from the step's own velocities (sph/cfl.rs); a frame records as many steps
@@ -153,16 +156,18 @@ impl Stepper {
         for k in 0..steps {
             solver.record_hooked_step(ctx, cmd, prof, st, hooks)?;
             self.recorded[slot].push(st.commands);
-            prof.begin(ctx, cmd, StepErrors::NAME);
-            self.errors.record(ctx, cmd, st, slot, k)?;
-            prof.end(ctx, cmd);
+            {
+                let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(StepErrors::NAME));
+                self.errors.record(ctx, cmd, st, slot, k)?;
+            }
         }
         self.errors.record_frame_end(ctx, cmd, slot);
         self.steps_taken += steps as u64;
         self.sim_time += steps as f64 * dt as f64;
-        prof.begin(ctx, cmd, "sph/health");
-        self.health.record(ctx, cmd, st, slot);
-        prof.end(ctx, cmd);
+        {
+            let _scope = prof.open(ctx, cmd, SPH_HEALTH_SCOPE);
+            self.health.record(ctx, cmd, st, slot);
+        }
         Ok(())
     }
 

@@ -6,9 +6,12 @@
 //! GPU passes such as emission and death can change with no CPU round trip).
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, ComputePipeline, Context, Destroy, Guard, Scopes};
 use crate::primitives::counting::GatherPass;
 use bytemuck::{Pod, Zeroable};
+
+const REORDER_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("reorder");
 
 /// How an attribute is stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -206,13 +209,14 @@ impl ParticleStore {
         gather: &GatherPass,
         perm: &Buffer,
     ) {
-        scopes.begin(ctx, cmd, "reorder");
         let (a, b) = (self.cur, 1 - self.cur);
-        let pairs: Vec<_> = (self.attrs.iter().filter(|x| x.decl.reorder))
-            .map(|x| (&x.bufs[a], &x.bufs[b]))
-            .collect();
-        gather.record_many(ctx, cmd, perm, &pairs, self.live);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, REORDER_SCOPE);
+            let pairs: Vec<_> = (self.attrs.iter().filter(|x| x.decl.reorder))
+                .map(|x| (&x.bufs[a], &x.bufs[b]))
+                .collect();
+            gather.record_many(ctx, cmd, perm, &pairs, self.live);
+        }
         self.cur = b;
     }
 

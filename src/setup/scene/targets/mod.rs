@@ -15,6 +15,7 @@ use crate::emission::emitter::{EmitSource, Emitter};
 use crate::emission::layout::UvLayout;
 use crate::error::Result;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
 use crate::render::ShowMesh;
@@ -25,6 +26,9 @@ use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::{SphSolver, SphState};
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
+
+const CONTROL_METRICS_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("control-metrics");
+const EMISSION_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("emission");
 
 mod viewer;
 
@@ -314,17 +318,18 @@ impl SceneTargets {
         };
         let ch = &self.live[e.character].character;
         let end = t + frame_dt as f64;
-        prof.begin(ctx, cmd, "emission");
         let emitter = &mut e.emitter;
-        let times: &[f64] = match e.primed {
-            true => &[end],
-            false => &[t, end],
-        };
-        for &at in times {
-            ch.record(ctx, cmd, prof, at)?;
-            emitter.source.record(ctx, cmd, prof, ch.skinned())?;
+        {
+            let mut prof = prof.open(ctx, cmd, EMISSION_SCOPE);
+            let times: &[f64] = match e.primed {
+                true => &[end],
+                false => &[t, end],
+            };
+            for &at in times {
+                ch.record(ctx, cmd, &mut *prof, at)?;
+                emitter.source.record(ctx, cmd, &mut *prof, ch.skinned())?;
+            }
         }
-        prof.end(ctx, cmd);
         e.primed = true;
         emitter.begin_frame(steps, frame_dt);
         if !self.capsules.is_empty() {
@@ -365,9 +370,10 @@ impl SceneTargets {
         }
         for (i, l) in self.live.iter().enumerate() {
             if let (Some((c, m)), Some(_)) = (&l.control, &l.poses[slot]) {
-                prof.begin(ctx, cmd, "control-metrics");
-                m.record(ctx, cmd, st, &c.force, slot)?;
-                prof.end(ctx, cmd);
+                {
+                    let _scope = prof.open(ctx, cmd, CONTROL_METRICS_SCOPE);
+                    m.record(ctx, cmd, st, &c.force, slot)?;
+                }
             }
             // (The emitting character is already skinned at t, the frame's end.)
             if l.character.show != ShowMesh::Off && emitting != Some(i) {

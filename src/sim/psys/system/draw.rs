@@ -1,6 +1,7 @@
 //! A particle system's depth sort (odd-even, bitonic or counting, by view depth) and its
 //! indirect draw.
 use super::*;
+use crate::gpu::Open;
 
 impl ParticleSystem {
     /// The sorted slots (NO_SLOT past the drawn ones) and their keys after `record_sort`.
@@ -54,39 +55,40 @@ impl ParticleSystem {
         push.mode = (self.sort == SortAlgo::Counting) as u32;
         let bufs = self.bufs(passes, f);
         let cap = self.capacity as u64;
-        scopes.begin(ctx, cmd, Passes::SORT);
-        if self.closed() {
-            let zero = StepPush { mode: 2, ..push };
-            passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);
+        {
+            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::SORT));
+            if self.closed() {
+                let zero = StepPush { mode: 2, ..push };
+                passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);
+            }
+            passes.keys.dispatch(ctx, cmd, &bufs, &push, cap);
+            match (self.sort, &self.counting) {
+                (SortAlgo::Counting, Some(d)) => {
+                    passes.counting.record(
+                        ctx,
+                        cmd,
+                        &passes.scan,
+                        &d.cells,
+                        &self.keys,
+                        &self.vals,
+                        &d.keys,
+                        &d.vals,
+                        cap,
+                    )?;
+                }
+                (SortAlgo::OddEven, _) => {
+                    passes
+                        .odd_even
+                        .record(ctx, cmd, &self.keys, &self.vals, cap)?;
+                }
+                (SortAlgo::Bitonic, _) => {
+                    passes
+                        .bitonic
+                        .record(ctx, cmd, &self.keys, &self.vals, cap)?;
+                }
+                _ => unreachable!("counting buffers exist for the counting sort"),
+            }
         }
-        passes.keys.dispatch(ctx, cmd, &bufs, &push, cap);
-        match (self.sort, &self.counting) {
-            (SortAlgo::Counting, Some(d)) => {
-                passes.counting.record(
-                    ctx,
-                    cmd,
-                    &passes.scan,
-                    &d.cells,
-                    &self.keys,
-                    &self.vals,
-                    &d.keys,
-                    &d.vals,
-                    cap,
-                )?;
-            }
-            (SortAlgo::OddEven, _) => {
-                passes
-                    .odd_even
-                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
-            }
-            (SortAlgo::Bitonic, _) => {
-                passes
-                    .bitonic
-                    .record(ctx, cmd, &self.keys, &self.vals, cap)?;
-            }
-            _ => unreachable!("counting buffers exist for the counting sort"),
-        }
-        scopes.end(ctx, cmd);
         Ok(())
     }
 

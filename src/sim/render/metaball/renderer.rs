@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
 use crate::gpu::Destroy;
+use crate::gpu::Open;
 use crate::gpu::{
     Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Labels, Scopes,
 };
@@ -22,6 +23,10 @@ use crate::primitives::scan::{ScanKind, ScanPass, ScanVariant};
 use crate::render::surface::{Frame, Surface};
 use crate::render::Camera;
 use crate::render::{BuildKind, Lanes, ListKind};
+
+const BOUNDS_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("bounds");
+const SCAN_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("scan");
+const SORT_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("sort");
 
 crate::gpu_interface! {
     /// glsl/render/metaball/common.glsl: every metaball pass declares all of these.
@@ -294,9 +299,10 @@ impl FluidRenderer {
             .march
             .as_ref()
             .ok_or_else(|| Error::Param("a renderer without a surface was given a frame".into()))?;
-        scopes.begin(ctx, cmd, "bounds");
-        self.bounds.record(ctx, cmd, centers, n as u64, &b.bounds)?;
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, BOUNDS_SCOPE);
+            self.bounds.record(ctx, cmd, centers, n as u64, &b.bounds)?;
+        }
         let bufs = self.bufs(b, centers);
         let draw = |p: &Graphics| {
             p.prepare(ctx, cmd, &bufs);
@@ -310,24 +316,26 @@ impl FluidRenderer {
         }
         let compute_lists = s.list == ListKind::Sbuffer && s.build == BuildKind::Compute;
         if self.count.is_some() || compute_lists {
-            scopes.begin(ctx, cmd, "count");
-            match (&self.count, &self.tiles) {
-                (Some(count), _) => draw(count),
-                (None, Some(tiles)) => tiles.record_pixels(ctx, cmd, &bufs, s, false),
-                (None, None) => {}
+            {
+                let _scope = scopes.open(ctx, cmd, COUNT.scope());
+                match (&self.count, &self.tiles) {
+                    (Some(count), _) => draw(count),
+                    (None, Some(tiles)) => tiles.record_pixels(ctx, cmd, &bufs, s, false),
+                    (None, None) => {}
+                }
             }
-            scopes.end(ctx, cmd);
-            scopes.begin(ctx, cmd, "scan");
-            self.scan.record(
-                ctx,
-                cmd,
-                &b.offsets,
-                &b.offsets,
-                px + 1,
-                ScanKind::Exclusive,
-                &b.scan,
-            )?;
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, SCAN_SCOPE);
+                self.scan.record(
+                    ctx,
+                    cmd,
+                    &b.offsets,
+                    &b.offsets,
+                    px + 1,
+                    ScanKind::Exclusive,
+                    &b.scan,
+                )?;
+            }
             ctx.copy(
                 cmd,
                 &b.offsets,
@@ -338,30 +346,34 @@ impl FluidRenderer {
             );
         }
         if let Some(fill) = &self.fill {
-            scopes.begin(ctx, cmd, "fill");
-            draw(fill);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, FILL.scope());
+                draw(fill);
+            }
         } else if let (true, Some(tiles)) = (compute_lists, &self.tiles) {
-            scopes.begin(ctx, cmd, "fill");
-            tiles.record_pixels(ctx, cmd, &bufs, s, true);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, FILL.scope());
+                tiles.record_pixels(ctx, cmd, &bufs, s, true);
+            }
         }
         let groups = px.div_ceil(march.local_size as u64);
         if let Some((depths, sort)) = &self.sort {
-            scopes.begin(ctx, cmd, "sort");
-            let metaball_groups = (n as u64).div_ceil(depths.local_size as u64);
-            depths.dispatch_groups(ctx, cmd, &bufs, &(), metaball_groups);
-            sort.dispatch_groups(ctx, cmd, &bufs, &(), groups);
-            scopes.end(ctx, cmd);
+            {
+                let _scope = scopes.open(ctx, cmd, SORT_SCOPE);
+                let metaball_groups = (n as u64).div_ceil(depths.local_size as u64);
+                depths.dispatch_groups(ctx, cmd, &bufs, &(), metaball_groups);
+                sort.dispatch_groups(ctx, cmd, &bufs, &(), groups);
+            }
         }
-        scopes.begin(ctx, cmd, "march");
-        // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
-        let march_groups = match (s.list, s.lanes) {
-            (ListKind::Tiles, _) | (_, Lanes::Blocks) => blocks(s),
-            (_, Lanes::Rows) => groups,
-        };
-        march.dispatch_groups(ctx, cmd, &bufs, &(), march_groups);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, MARCH.scope());
+            // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
+            let march_groups = match (s.list, s.lanes) {
+                (ListKind::Tiles, _) | (_, Lanes::Blocks) => blocks(s),
+                (_, Lanes::Rows) => groups,
+            };
+            march.dispatch_groups(ctx, cmd, &bufs, &(), march_groups);
+        }
         Ok(())
     }
 

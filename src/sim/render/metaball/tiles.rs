@@ -11,9 +11,14 @@ use super::renderer::{MetaballBufs, MetaballIo};
 use super::settings::{tile_grid, MetaballSettings};
 use crate::error::{Error, Result};
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::primitives::scan::{ScanKind, ScanPass, ScanScratch};
 use crate::primitives::sort::{Network, NetworkSort};
+
+const BIN_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("bin");
+const PAIR_SORT_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("pair sort");
+const RANGES_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("ranges");
 
 type Compute = ComputePipeline<MetaballIo>;
 
@@ -191,31 +196,34 @@ impl TilePasses {
         bufs: &MetaballBufs,
         n: u64,
     ) -> Result<()> {
-        scopes.begin(ctx, cmd, "bin");
-        ctx.fill(cmd, &t.tile_ranges, 0);
-        ctx.fill(cmd, &t.pair_keys, u32::MAX);
-        self.bin.dispatch(ctx, cmd, bufs, &(), n);
-        self.sort.record(ctx, cmd, &t.ball_keys, &t.ball_ids, n)?;
-        self.count.dispatch(ctx, cmd, bufs, &(), n + 1);
-        let counts = &t.pair_counts;
-        scan.record(
-            ctx,
-            cmd,
-            counts,
-            counts,
-            n + 1,
-            ScanKind::Exclusive,
-            &t.scan,
-        )?;
-        self.emit.dispatch(ctx, cmd, bufs, &(), n);
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "pair sort");
-        self.sort
-            .record(ctx, cmd, &t.pair_keys, &t.pair_ids, t.pair_capacity)?;
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "ranges");
-        self.ranges.dispatch(ctx, cmd, bufs, &(), t.pair_capacity);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, BIN_SCOPE);
+            ctx.fill(cmd, &t.tile_ranges, 0);
+            ctx.fill(cmd, &t.pair_keys, u32::MAX);
+            self.bin.dispatch(ctx, cmd, bufs, &(), n);
+            self.sort.record(ctx, cmd, &t.ball_keys, &t.ball_ids, n)?;
+            self.count.dispatch(ctx, cmd, bufs, &(), n + 1);
+            let counts = &t.pair_counts;
+            scan.record(
+                ctx,
+                cmd,
+                counts,
+                counts,
+                n + 1,
+                ScanKind::Exclusive,
+                &t.scan,
+            )?;
+            self.emit.dispatch(ctx, cmd, bufs, &(), n);
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, PAIR_SORT_SCOPE);
+            self.sort
+                .record(ctx, cmd, &t.pair_keys, &t.pair_ids, t.pair_capacity)?;
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, RANGES_SCOPE);
+            self.ranges.dispatch(ctx, cmd, bufs, &(), t.pair_capacity);
+        }
         Ok(())
     }
 

@@ -8,6 +8,7 @@ use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::track::BufferUse;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{
     ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, ScopeKey, Scopes,
 };
@@ -59,30 +60,33 @@ impl Cubes {
         r: &Rec,
     ) -> Result<()> {
         let (bufs, push, b) = (&r.bufs, &r.push, r.b);
-        scopes.begin(ctx, cmd, DENSITY_SCOPE.name());
-        ctx.fill(cmd, &b.grid, 0);
-        // The draw's arguments, then the box of nodes reached (empty).
-        let m = u32::MAX;
-        ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0, m, m, m, 0, 0, 0]);
-        self.density.dispatch(ctx, cmd, bufs, push, r.n as u64);
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, CELLS_SCOPE.name());
-        self.cells.dispatch(ctx, cmd, bufs, push, b.shape.cells());
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, RASTER_SCOPE.name());
-        ctx.fill(cmd, &b.zbits, u32::MAX);
-        ctx.fill(cmd, &b.thick, 0);
-        ctx.fill(cmd, &b.gbuf, 0);
-        let (w, h) = b.size;
-        for pass in &self.raster {
-            pass.prepare(ctx, cmd, bufs);
-            ctx.prepare_draws(cmd, &[BufferUse::indirect(b.args.raw)]);
-            begin_empty_rendering(ctx, cmd, w, h);
-            pass.bind(ctx, cmd, bufs, push);
-            ctx.draw_indirect(cmd, &b.args, 0);
-            ctx.end_rendering(cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, DENSITY_SCOPE.scope());
+            ctx.fill(cmd, &b.grid, 0);
+            // The draw's arguments, then the box of nodes reached (empty).
+            let m = u32::MAX;
+            ctx.update(cmd, &b.args, 0, &[0u32, 1, 0, 0, m, m, m, 0, 0, 0]);
+            self.density.dispatch(ctx, cmd, bufs, push, r.n as u64);
         }
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, CELLS_SCOPE.scope());
+            self.cells.dispatch(ctx, cmd, bufs, push, b.shape.cells());
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, RASTER_SCOPE.scope());
+            ctx.fill(cmd, &b.zbits, u32::MAX);
+            ctx.fill(cmd, &b.thick, 0);
+            ctx.fill(cmd, &b.gbuf, 0);
+            let (w, h) = b.size;
+            for pass in &self.raster {
+                pass.prepare(ctx, cmd, bufs);
+                ctx.prepare_draws(cmd, &[BufferUse::indirect(b.args.raw)]);
+                begin_empty_rendering(ctx, cmd, w, h);
+                pass.bind(ctx, cmd, bufs, push);
+                ctx.draw_indirect(cmd, &b.args, 0);
+                ctx.end_rendering(cmd);
+            }
+        }
         Ok(())
     }
 

@@ -12,6 +12,7 @@ pub use buffers::SurfaceBuffers;
 
 use crate::error::{Error, Result};
 use crate::gpu::pass::{Defines, PassKey};
+use crate::gpu::Open;
 use crate::gpu::{Buffer, ComputePipeline, Context, Guard, Scopes};
 use crate::render::Material;
 use crate::render::SurfaceKind;
@@ -54,6 +55,7 @@ pub struct SurfaceFluid {
 }
 
 pub use crate::isosurface::ISO;
+
 /// Fixed point of the density grid (atomic adds of the density over the rest density).
 pub const GRID_SCALE: f32 = 4194304.0;
 /// Fixed point of the thickness (per metre).
@@ -219,9 +221,10 @@ impl Surface {
         if let Some(c) = &self.cubes {
             c.record(ctx, cmd, scopes, &r)?;
         }
-        scopes.begin(ctx, cmd, "shade");
-        self.shade.dispatch(ctx, cmd, &r.bufs, &r.push, b.pixels);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, SHADE.scope());
+            self.shade.dispatch(ctx, cmd, &r.bufs, &r.push, b.pixels);
+        }
         Ok(())
     }
 

@@ -5,6 +5,7 @@ use super::{Rec, Scales, SurfaceIo};
 use crate::error::Result;
 use crate::gpu::target::begin_empty_rendering;
 use crate::gpu::vk;
+use crate::gpu::Open;
 use crate::gpu::{ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, Scopes};
 
 crate::gpu::graphics_pass!(pub SPLAT: SurfaceIo, Scales = "splat", "render/surface/splat.vert", "render/surface/splat.frag");
@@ -39,26 +40,29 @@ impl ScreenSpace {
     ) {
         let (bufs, push, b, n) = (&r.bufs, &r.push, r.b, r.n);
         let px = b.pixels;
-        scopes.begin(ctx, cmd, "splat");
-        ctx.fill(cmd, &b.zbits, u32::MAX);
-        ctx.fill(cmd, &b.thick, 0);
-        self.splat.prepare(ctx, cmd, bufs);
-        let (width, height) = b.size;
-        begin_empty_rendering(ctx, cmd, width, height);
-        self.splat.bind(ctx, cmd, bufs, push);
-        ctx.draw(cmd, 6, n);
-        ctx.end_rendering(cmd);
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "smooth");
-        for axis in [0.0, 1.0] {
-            let mut p = *push;
-            p.look[1] = axis;
-            self.smooth.dispatch(ctx, cmd, bufs, &p, px);
+        {
+            let _scope = scopes.open(ctx, cmd, SPLAT.scope());
+            ctx.fill(cmd, &b.zbits, u32::MAX);
+            ctx.fill(cmd, &b.thick, 0);
+            self.splat.prepare(ctx, cmd, bufs);
+            let (width, height) = b.size;
+            begin_empty_rendering(ctx, cmd, width, height);
+            self.splat.bind(ctx, cmd, bufs, push);
+            ctx.draw(cmd, 6, n);
+            ctx.end_rendering(cmd);
         }
-        scopes.end(ctx, cmd);
-        scopes.begin(ctx, cmd, "normals");
-        self.normals.dispatch(ctx, cmd, bufs, push, px);
-        scopes.end(ctx, cmd);
+        {
+            let _scope = scopes.open(ctx, cmd, SMOOTH.scope());
+            for axis in [0.0, 1.0] {
+                let mut p = *push;
+                p.look[1] = axis;
+                self.smooth.dispatch(ctx, cmd, bufs, &p, px);
+            }
+        }
+        {
+            let _scope = scopes.open(ctx, cmd, NORMALS.scope());
+            self.normals.dispatch(ctx, cmd, bufs, push, px);
+        }
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
