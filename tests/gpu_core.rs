@@ -99,7 +99,7 @@ fn compute_round_trip_matches_cpu_exactly() {
 
 #[test]
 fn orbits_step_matches_cpu_reference() {
-    use fluidform::scene::orbits::*;
+    use fluidform::orbits::*;
     let ctx = common::ctx();
     let n = 5000;
     let state = initial_state(n, 7);

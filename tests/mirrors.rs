@@ -165,7 +165,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         (
             "scene/orbits.comp",
             "Push",
-            fields!(fluidform::scene::orbits::OrbitsPush; dt, strength, eps, n),
+            fields!(fluidform::orbits::OrbitsPush; dt, strength, eps, n),
         ),
         (
             "render/surface/cells.comp",

@@ -10,4 +10,4 @@ pub mod window;
 pub use fluidform_gpu as gpu;
 pub use fluidform_gpu::{error, gpu_interface, impl_destroy, kinds, primitives, Error, Result};
 pub use fluidform_setup::{animation, config, export, progress, report, scene, settings, trace};
-pub use fluidform_sim::{character, control, emission, isosurface, psys, render, sph};
+pub use fluidform_sim::{character, control, emission, isosurface, orbits, psys, render, sph};

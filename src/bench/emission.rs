@@ -69,11 +69,12 @@ pub fn emission(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let mut scene = scene(n);
             scene.fluid = sw.fluid_args.apply(&scene.fluid)?;
             let parts = scene.particles(sw.common.seed);
+            let opts = crate::settings::target_options(sw);
             let mut solver = Guard::new(ctx, SphSolver::new(ctx, strategy, Some(sort))?);
             let mut st = Guard::new(ctx, solver.state(ctx, &scene, &parts)?);
             let mut targets = Guard::new(
                 ctx,
-                SceneTargets::new(ctx, &scene, sw, &solver, &mut st, &parts.pos, 1)?,
+                SceneTargets::new(ctx, &scene, &opts, &solver, &mut st, &parts.pos, 1)?,
             );
             let actual = st.n as u64;
             let dt = st.dt;

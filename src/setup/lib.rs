@@ -16,4 +16,4 @@ pub mod trace;
 // The lower layers under the names this crate's modules use for them.
 pub use fluidform_gpu as gpu;
 pub use fluidform_gpu::{error, gpu_interface, impl_destroy, kinds, primitives, Error, Result};
-pub use fluidform_sim::{character, control, emission, isosurface, psys, render, sph};
+pub use fluidform_sim::{character, control, emission, isosurface, orbits, psys, render, sph};

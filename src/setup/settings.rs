@@ -5,6 +5,9 @@ use crate::control::target::ControlDesc;
 use crate::error::{Error, Result};
 use crate::render::metaball::MetaballSettings;
 use crate::render::{BuildKind, ListKind, Material, SurfaceKind};
+use crate::scene::emission::EmissionOverrides;
+use crate::scene::schema::Look;
+use crate::scene::targets::{ControlOverrides, TargetOptions};
 
 /// The metaball settings: the thesis's (`MetaballSettings::thesis`), overridden by the
 /// switches that are set.
@@ -119,7 +122,7 @@ pub fn run_metaball_settings(sw: &Switches, n: u32) -> Result<MetaballSettings> 
 }
 
 /// `desc` with the control switches applied.
-pub fn control_with_switches(desc: &ControlDesc, sw: &Switches) -> Result<ControlDesc> {
+fn control_with_switches(desc: &ControlDesc, sw: &Switches) -> Result<ControlDesc> {
     let c = &sw.control;
     let thresholds = pair("--adaptive-thresholds", &c.adaptive_thresholds)?;
     let factors = pair("--adaptive-factors", &c.adaptive_factors)?;
@@ -154,4 +157,51 @@ fn pair(name: &str, v: &Option<Vec<f32>>) -> Result<Option<[f32; 2]>> {
             v.len()
         ))),
     }
+}
+
+/// The control switches over a target's own settings, for every target of the run.
+pub fn control_overrides(sw: &Switches) -> ControlOverrides {
+    let sw = sw.clone();
+    Box::new(move |d| control_with_switches(d, &sw))
+}
+
+/// What the scene's characters, targets and emission take from the switches.
+pub fn target_options(sw: &Switches) -> TargetOptions {
+    let e = &sw.emission;
+    TargetOptions {
+        skinning: sw
+            .character
+            .skinning
+            .unwrap_or(crate::character::Skinning::Lbs),
+        show_mesh: sw.character.show_mesh,
+        quiet: sw.common.quiet,
+        metrics_from: sw.control.metrics_from,
+        seed: sw.common.seed,
+        emission: EmissionOverrides {
+            emitter: e.emitter,
+            life_limit: e.life_limit,
+            rate: e.emission_rate,
+            transfer: e.transfer,
+            uv_size: e.uv_size,
+        },
+        control: control_overrides(sw),
+    }
+}
+
+/// `sw` with the scene's `[look]` where the switches leave it unset.
+pub fn with_look(look: &Look, sw: &Switches) -> Switches {
+    let mut sw = sw.clone();
+    if sw.metaball.material.is_none() {
+        sw.metaball.material = look.material;
+    }
+    if sw.metaball.surface.is_none()
+        && sw.view.render.or(look.render) != Some(crate::render::RenderKind::Points)
+    {
+        sw.metaball.surface = look.surface;
+    }
+    if let Some([w, h]) = look.size {
+        sw.frame.width = sw.frame.width.or(Some(w));
+        sw.frame.height = sw.frame.height.or(Some(h));
+    }
+    sw
 }

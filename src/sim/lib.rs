@@ -7,6 +7,7 @@ pub mod control;
 pub mod emission;
 pub mod isosurface;
 pub mod non_finite_as_null;
+pub mod orbits;
 pub mod psys;
 pub mod render;
 pub mod sph;

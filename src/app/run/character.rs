@@ -60,7 +60,7 @@ impl FrameWork for CharacterWork {
 
 pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Result<RunResult> {
     use crate::config::Group;
-    let sw = &scene.look.apply(&opts.switches);
+    let sw = &crate::settings::with_look(&scene.look, &opts.switches);
     sw.reject_unused(
         &format!("scene {} (a character with no fluid)", scene.name),
         &[Group::Character, Group::Camera],

@@ -134,7 +134,7 @@ impl LiveScene {
     pub fn rebuild_view(&mut self, ctx: &Context, sw: &Switches) -> Result<Camera> {
         self.settle(ctx)?;
         ctx.wait_idle()?;
-        let mut sw = self.scene.look.apply(sw);
+        let mut sw = crate::settings::with_look(&self.scene.look, sw);
         if sw.metaball.radius.is_none() {
             sw.metaball.radius = self.sw.metaball.radius;
         }
@@ -153,7 +153,7 @@ impl LiveScene {
     /// Control switches that change only per-frame values, applied from the next frame
     /// (the simulation goes on); false when they need a rebuilt scene.
     pub fn set_control(&mut self, sw: &Switches) -> Result<bool> {
-        let sw = self.scene.look.apply(sw);
+        let sw = crate::settings::with_look(&self.scene.look, sw);
         let ok = self.work.set_control(&sw, &self.scene.fluid)?;
         if ok {
             self.sw.control = sw.control;

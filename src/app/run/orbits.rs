@@ -1,7 +1,7 @@
 //! `run` of the orbits test scene: a gravity step and the point view per frame.
 use super::*;
 use crate::gpu::Open;
-use crate::scene::orbits::{self, Orbits, OrbitsPass};
+use crate::orbits::{self, Orbits, OrbitsPass};
 
 /// The orbits scene: a gravity step and the point view per frame.
 struct OrbitsWork {
@@ -21,7 +21,7 @@ impl FrameWork for OrbitsWork {
         slot: usize,
     ) -> Result<()> {
         {
-            let _scope = prof.open(ctx, cmd, crate::scene::orbits::SIMULATE.scope());
+            let _scope = prof.open(ctx, cmd, crate::orbits::SIMULATE.scope());
             self.pass.step(ctx, cmd, &self.scene, 1.0 / 120.0);
         }
         // New positions -> the point view's vertex shader.

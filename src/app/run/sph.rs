@@ -177,7 +177,8 @@ impl SphWork {
         sw: &Switches,
         fluid: &crate::sph::FluidParams,
     ) -> Result<bool> {
-        self.targets.set_control(sw, fluid)
+        self.targets
+            .set_control(&crate::settings::control_overrides(sw), fluid)
     }
 
     pub(super) fn events(&self) -> Vec<(f32, String)> {
@@ -268,7 +269,7 @@ fn prepare(scene: crate::scene::Scene, sw: &Switches) -> Result<(crate::scene::S
     use crate::sph::solver::{bytes_per_particle, MAX_PARTICLES};
     let mut scene = scene;
     // The scene's look where the switches leave it open; summary.json records the result.
-    let mut sw = scene.look.apply(sw);
+    let mut sw = crate::settings::with_look(&scene.look, sw);
     scene.fluid = sw.fluid_args.apply(&scene.fluid)?;
     // A liquid character's spacing and pool from its character (scene::fit).
     let mut lines = crate::scene::fit::fit(&mut scene)?.describe();
@@ -382,8 +383,9 @@ impl SphWork {
         let parts = scene.particles(sw.common.seed);
         let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
         let cam = scene_camera(scene, sw);
+        let opts = crate::settings::target_options(sw);
         let targets = crate::scene::targets::SceneTargets::new(
-            ctx, scene, sw, &solver, &mut st, &parts.pos, SLOTS,
+            ctx, scene, &opts, &solver, &mut st, &parts.pos, SLOTS,
         )?;
         let targets = Guard::new(ctx, targets);
         let view = make_view(ctx, scene, sw, render, &cam, st.n, targets.show())?;

@@ -18,7 +18,7 @@ macro_rules! scene {
 }
 
 /// Every built-in, fluid scenes first, then particle scenes (`orbits`, the test scene that
-/// makes its particles in code, is not a file: see `scene::orbits`).
+/// makes its particles in code, is not a file: see `crate::orbits`).
 pub const BUILT_IN: &[BuiltIn] = &[
     scene!("demo"),
     scene!("dam-break"),

@@ -5,7 +5,6 @@
 //! surface (the coefficient of variation of births per unit area over buckets of
 //! triangles of equal area).
 use crate::character::Mesh;
-use crate::config::Switches;
 use crate::emission::emit::EmitSettings;
 use crate::emission::emitter::Emitter;
 use crate::emission::EmitterKind;
@@ -57,6 +56,16 @@ fn water() -> [f32; 3] {
 
 pub const DEFAULT_UV_SIZE: [u32; 2] = [512, 512];
 
+/// What a run sets over a scene's `[emission]` (`settings::emission_overrides`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EmissionOverrides {
+    pub emitter: Option<EmitterKind>,
+    pub life_limit: Option<f32>,
+    pub rate: Option<f32>,
+    pub transfer: Option<f32>,
+    pub uv_size: Option<[u32; 2]>,
+}
+
 impl EmissionDesc {
     pub fn new(slots: u32) -> Self {
         Self {
@@ -72,13 +81,13 @@ impl EmissionDesc {
         }
     }
 
-    /// The effective settings: switches over the scene's values over the defaults.
-    pub fn resolve(&self, sw: &Switches) -> Result<(EmitterKind, EmitSettings, [u32; 2])> {
-        let e = &sw.emission;
+    /// The effective settings: the overrides (the switches') over the scene's values
+    /// over the defaults.
+    pub fn resolve(&self, e: &EmissionOverrides) -> Result<(EmitterKind, EmitSettings, [u32; 2])> {
         let d = EmitSettings::default();
         let s = EmitSettings {
             limit: e.life_limit.or(self.life_limit).unwrap_or(d.limit),
-            rate: e.emission_rate.or(self.rate),
+            rate: e.rate.or(self.rate),
             transfer: e.transfer.or(self.transfer).unwrap_or(d.transfer),
             dtau: d.dtau,
         };
@@ -94,7 +103,7 @@ impl EmissionDesc {
                 "scene {scene}: [emission] needs at least one slot (or recycle = true)"
             )));
         }
-        self.resolve(&Switches::default())
+        self.resolve(&EmissionOverrides::default())
             .map(|_| ())
             .map_err(|e| Error::Param(format!("scene {scene}: [emission] {e}")))
     }

@@ -1,12 +1,12 @@
 //! Scenes: the schema and its built-ins, and the parts a scene plays beside the fluid
-//! (characters, control targets, emission, the `orbits` test scene).
+//! (characters, control targets, emission). The `orbits` test scene is made in code
+//! (`crate::orbits`).
 pub mod around;
 pub mod builtin;
 pub mod character;
 pub mod emission;
 pub mod fit;
 pub mod load;
-pub mod orbits;
 pub mod particles;
 pub mod schema;
 pub mod targets;

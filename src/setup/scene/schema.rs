@@ -110,24 +110,6 @@ impl Look {
         self.material.get_or_insert(crate::render::Material::Tinted);
         self.tank.get_or_insert(false);
     }
-
-    /// `sw` with this look's values where the switches leave them unset.
-    pub fn apply(&self, sw: &crate::config::Switches) -> crate::config::Switches {
-        let mut sw = sw.clone();
-        if sw.metaball.material.is_none() {
-            sw.metaball.material = self.material;
-        }
-        if sw.metaball.surface.is_none()
-            && sw.view.render.or(self.render) != Some(crate::render::RenderKind::Points)
-        {
-            sw.metaball.surface = self.surface;
-        }
-        if let Some([w, h]) = self.size {
-            sw.frame.width = sw.frame.width.or(Some(w));
-            sw.frame.height = sw.frame.height.or(Some(h));
-        }
-        sw
-    }
 }
 
 impl Scene {

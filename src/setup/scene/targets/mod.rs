@@ -3,10 +3,9 @@
 //! and released by the timeline; each attached target's pose set before the frame's
 //! steps, its metrics read after them; the first shown mesh drawn by the view.
 use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
-use super::emission::{EmissionMetrics, EmissionStats, SceneEmission};
+use super::emission::{EmissionMetrics, EmissionOverrides, EmissionStats, SceneEmission};
 use crate::character::capsules::{self, BoneCapsule};
 use crate::character::Skinning;
-use crate::config::Switches;
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
@@ -55,6 +54,22 @@ struct Live {
     shared: std::sync::Arc<crate::character::Character>,
 }
 
+/// A control target's settings: the run's over the scene's (`settings::control_overrides`).
+pub type ControlOverrides = Box<dyn Fn(&ControlDesc) -> Result<ControlDesc>>;
+
+/// What the scene's characters and targets take from the run (`settings::target_options`).
+pub struct TargetOptions {
+    pub skinning: Skinning,
+    /// The characters' meshes; None: hidden under control, else shaded.
+    pub show_mesh: Option<ShowMesh>,
+    pub quiet: bool,
+    /// Scene time from which the fidelity metrics are summarised.
+    pub metrics_from: Option<f64>,
+    pub seed: u64,
+    pub emission: EmissionOverrides,
+    pub control: ControlOverrides,
+}
+
 /// The skin's speed is its motion over this many seconds before the frame.
 const SKIN_SPEED_DT: f64 = 1.0 / 240.0;
 
@@ -85,13 +100,13 @@ impl SceneTargets {
     pub fn new(
         ctx: &Context,
         scene: &Scene,
-        sw: &Switches,
+        opts: &TargetOptions,
         solver: &SphSolver,
         st: &mut SphState,
         initial: &[[f32; 4]],
         slots: usize,
     ) -> Result<Self> {
-        let method = sw.character.skinning.unwrap_or(Skinning::Lbs);
+        let method = opts.skinning;
         let mut descs: Vec<(String, &CharacterDesc, Option<&ControlDesc>)> = Vec::new();
         if let Some(c) = &scene.character {
             descs.push((MAIN_TARGET.into(), c, scene.control.as_ref()));
@@ -114,14 +129,14 @@ impl SceneTargets {
                 timeline: Timeline::default(),
                 fired: Vec::new(),
                 fading: Vec::new(),
-                quiet: sw.common.quiet,
+                quiet: opts.quiet,
                 floor: scene.domain.min[1],
-                metrics_from: sw.control.metrics_from,
+                metrics_from: opts.metrics_from,
             },
         );
         for (name, cdesc, control) in descs {
             // A liquid character hides its mesh unless asked.
-            let show = sw.character.show_mesh.unwrap_or(match control {
+            let show = opts.show_mesh.unwrap_or(match control {
                 Some(_) => ShowMesh::Off,
                 None => ShowMesh::Shaded,
             });
@@ -134,10 +149,10 @@ impl SceneTargets {
                         solver,
                         &character.ch,
                         &character.anim,
-                        &crate::settings::control_with_switches(d, sw)?,
+                        &(opts.control)(d)?,
                         &scene.fluid,
                         (scene.domain.min, scene.domain.max),
-                        (sw.common.seed, method),
+                        (opts.seed, method),
                     )?;
                     let m = ControlMetrics::new(ctx, st.n, t.count(), &name, slots)?;
                     let i = out.live.len();
@@ -162,7 +177,7 @@ impl SceneTargets {
             false => Timeline::new(&scene.name, &scene.timeline, &names)?,
         };
         if let Some(desc) = &scene.emission {
-            out.add_emission(ctx, scene, desc, sw, st, initial, slots)?;
+            out.add_emission(ctx, scene, desc, opts, st, initial, slots)?;
         }
         let mut t = out.take();
         t.fading = vec![None; t.controlled.len()];
@@ -182,13 +197,13 @@ impl SceneTargets {
         ctx: &Context,
         scene: &Scene,
         desc: &crate::scene::emission::EmissionDesc,
-        sw: &Switches,
+        opts: &TargetOptions,
         st: &mut SphState,
         initial: &[[f32; 4]],
         slots: usize,
     ) -> Result<()> {
         // validate() made sure of the [character]: the first character.
-        let (kind, settings, size) = desc.resolve(sw)?;
+        let (kind, settings, size) = desc.resolve(&opts.emission)?;
         let ch = &self.live[0].character.ch;
         let caps = capsules::of(ch);
         if desc.collide && caps.len() + self.colliders.len() > MAX_COLLIDERS {
@@ -212,7 +227,7 @@ impl SceneTargets {
             initial,
             source,
             (settings, desc.recycle),
-            sw.common.seed,
+            opts.seed,
         )?;
         if desc.collide {
             self.capsules = caps;

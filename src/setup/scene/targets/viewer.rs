@@ -1,22 +1,25 @@
 //! What the viewer reads and changes of a playing scene's targets: the timeline's events,
 //! the newest control metrics, and the control switches that can change mid-run.
 use super::SceneTargets;
-use crate::config::Switches;
 use crate::control::target::ControlDesc;
 use crate::error::Result;
 
 impl SceneTargets {
-    /// The control switches of `sw` for every control target from the next frame on,
+    /// The control `overrides` (the switches') for every control target from the next frame on,
     /// when they change only values each frame uploads (c_cp, the adaptive thresholds and
     /// factors, velocity, attraction, damping). False, changing nothing, when any other
     /// would change (they shape pipelines or buffers: the scene must be rebuilt).
-    pub fn set_control(&mut self, sw: &Switches, fluid: &crate::sph::FluidParams) -> Result<bool> {
+    pub fn set_control(
+        &mut self,
+        overrides: &super::ControlOverrides,
+        fluid: &crate::sph::FluidParams,
+    ) -> Result<bool> {
         let mut next = Vec::new();
         for l in &self.live {
             let (Some((c, _)), Some(d)) = (&l.control, &l.desc) else {
                 continue;
             };
-            let nd = crate::settings::control_with_switches(d, sw)?;
+            let nd = overrides(d)?;
             let s = nd.settings(fluid);
             s.validate()?;
             let (o, od) = (&c.force.settings, &c.desc);

@@ -1,4 +1,5 @@
-//! Test scene: particles orbiting an attractor inside a box, moved by one compute pass.
+//! The `orbits` test scene's simulation: particles orbiting an attractor inside a box,
+//! moved by one compute pass (its scene is made in code, `fluidform run --scene orbits`).
 use crate::error::Result;
 use crate::gpu::vk;
 use crate::gpu::{Buffer, ComputePipeline, Context, Guard};
@@ -58,7 +59,7 @@ pub fn initial_state(n: usize, seed: u64) -> OrbitsState {
     s
 }
 
-/// CPU reference of one step (the same f32 arithmetic as glsl/scene/orbits.comp).
+/// CPU reference of one step (the same f32 arithmetic as glsl/orbits/orbits.comp).
 pub fn step_cpu(pos: &mut [[f32; 4]], vel: &mut [[f32; 4]], push: &OrbitsPush) {
     for (p4, v4) in pos.iter_mut().zip(vel.iter_mut()) {
         let mut p = glam::Vec3::from_slice(&p4[..3]);
@@ -82,11 +83,11 @@ pub fn step_cpu(pos: &mut [[f32; 4]], vel: &mut [[f32; 4]], push: &OrbitsPush) {
 }
 
 crate::gpu_interface! {
-    /// glsl/scene/orbits.comp
+    /// glsl/orbits/orbits.comp
     pub OrbitsIo / OrbitsBufs: "ORB", push OrbitsPush { pos = 0, vel = 1 }
 }
 
-crate::gpu::compute_pass!(pub SIMULATE: OrbitsIo, () = "simulate", "scene/orbits.comp");
+crate::gpu::compute_pass!(pub SIMULATE: OrbitsIo, () = "simulate", "orbits/orbits.comp");
 
 /// The size-independent part: the step pipeline.
 pub struct OrbitsPass {
