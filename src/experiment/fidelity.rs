@@ -20,7 +20,7 @@ const PRESETS: [ControlPreset; 2] = [ControlPreset::Thesis, ControlPreset::Fidel
 
 /// One run's numbers.
 struct Outcome {
-    summary: serde_json::Value,
+    summary: crate::run::RunSummary,
     rows: Vec<ControlRow>,
     frame: Option<PathBuf>,
 }
@@ -44,9 +44,6 @@ fn play(
         switches: sw,
     };
     let r = crate::run::run(&opts)?;
-    let text = std::fs::read_to_string(out.join("summary.json")).map_err(|e| super::io(out, e))?;
-    let summary: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))?;
     let csv = out.join("control.csv");
     let mut rows = Vec::new();
     let mut rd = csv::Reader::from_path(&csv)
@@ -55,14 +52,14 @@ fn play(
         rows.push(row.map_err(|e| Error::Param(format!("{}: {e}", csv.display())))?);
     }
     Ok(Outcome {
-        summary,
+        summary: r.summary,
         rows,
         frame: r.pngs.last().cloned(),
     })
 }
 
-fn cell(v: &serde_json::Value, digits: usize) -> String {
-    v.as_f64().map_or("-".into(), |x| format!("{x:.digits$}"))
+fn cell(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".into(), |x| format!("{x:.digits$}"))
 }
 
 /// Every scene with each preset: the table, the CSV, the plots and the frames side by
@@ -194,10 +191,17 @@ fn plots(
 
 /// A run's row: metrics (mean, min in brackets), time to 90% and the control's share.
 fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> Result<[String; 11]> {
-    let t = &o.summary["stats"]["control"]["targets"][0];
-    let w = &t["fidelity"];
-    let m = |k: &str| (cell(&w[k]["mean"], 3), cell(&w[k]["min"], 3));
-    let median = |k| crate::report::pass_median(&o.summary, k);
+    let sph = o.summary.stats.sph();
+    let t = sph.and_then(|s| s.control.as_ref()?.targets.first());
+    let w = t.and_then(|t| t.fidelity.as_ref());
+    // A metric's (mean, min) as cells: `-` where the run has none.
+    type Pick = fn(&crate::control::metrics::Window) -> Option<crate::control::metrics::MeanMin>;
+    let m = |f: Pick| {
+        let v = w.and_then(f);
+        (cell(v.map(|v| v.mean), 3), cell(v.map(|v| v.min), 3))
+    };
+    let mean = |f: Pick, digits| cell(w.and_then(f).map(|v| v.mean), digits);
+    let median = |k| o.summary.pass_median(k);
     let share = match (
         median(crate::control::force::SCOPE)?,
         median(crate::sph::SCOPE)?,
@@ -205,18 +209,18 @@ fn row_cells(label: &str, preset: ControlPreset, o: &Outcome) -> Result<[String;
         (c, s) if s > 0.0 => format!("{:.2}", c / s),
         _ => "-".into(),
     };
-    let t90 = cell(&t["time_to_90"], 2);
+    let t90 = cell(t.and_then(|t| t.time_to_90), 2);
     let n = o.rows.len();
     let cells = [
         label.to_string(),
         preset.as_str().to_string(),
         n.to_string(),
-        format!("{} ({})", m("fill").0, m("fill").1),
-        format!("{} ({})", m("iou").0, m("iou").1),
-        cell(&w["spray"]["mean"], 4),
-        cell(&w["surface_p95"]["mean"], 2),
-        m("density_in_shape").0,
-        cell(&w["speed_excess"]["mean"], 2),
+        format!("{} ({})", m(|w| w.fill).0, m(|w| w.fill).1),
+        format!("{} ({})", m(|w| w.iou).0, m(|w| w.iou).1),
+        mean(|w| w.spray, 4),
+        mean(|w| w.surface_p95, 2),
+        m(|w| w.density_in_shape).0,
+        mean(|w| w.speed_excess, 2),
         t90,
         share,
     ];

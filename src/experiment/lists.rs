@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::gpu::Guard;
 use crate::render::metaball::MetaballSettings;
 use crate::render::{BuildKind, ListKind, MarchKind, Material, RenderKind};
-use serde_json::{json, Value};
+use serde_json::json;
 use std::path::PathBuf;
 
 pub const COMPUTE_BEATS_ABUFFER: &str =
@@ -227,12 +227,9 @@ fn character(env: &Env, steps: &mut Steps) -> Result<Vec<(Mode, f64)>> {
             save_every: frames - 1,
             switches: sw,
         };
-        crate::run::run(&opts)?;
-        let text =
-            std::fs::read_to_string(dir.join("summary.json")).map_err(|e| super::io(&dir, e))?;
-        let v: Value =
-            serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))?;
-        let ms = crate::report::pass_median(&v, crate::render::SCOPE)?;
+        let ms = crate::run::run(&opts)?
+            .summary
+            .pass_median(crate::render::SCOPE)?;
         out.push((*mode, ms));
         steps.tick();
     }

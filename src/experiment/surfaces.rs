@@ -8,8 +8,7 @@ use super::{write, Env, Experiment, Steps};
 use crate::error::{Error, Result};
 use crate::render::surface::cubes::{CELLS_SCOPE, DENSITY_SCOPE, RASTER_SCOPE};
 use crate::render::{RenderKind, SurfaceKind};
-use crate::report::pass_median;
-use serde_json::Value;
+use crate::run::RunSummary;
 use std::path::{Path, PathBuf};
 
 pub const SCREEN_FASTER: &str =
@@ -27,27 +26,11 @@ const SURFACES: [SurfaceKind; 3] = [
     SurfaceKind::ScreenSpace,
     SurfaceKind::Mesh,
 ];
-/// The renderer's buffers in summary.json's `memory_bytes` (by name).
-const RENDER_BUFFERS: &[&str] = &[
-    "render ",
-    "sbuffer",
-    "abuffer",
-    "metaball",
-    "bounds",
-    "scan chunk",
-    "surface ",
-    "density grid",
-    "case table",
-    "triangle soup",
-    "opaque layer",
-    "scene depth",
-    "sky image",
-];
 
 /// The surface, and for the mesh its cell and the particle count.
 type Look = (SurfaceKind, Option<f32>, Option<u32>);
 
-fn play(env: &Env, scene: &str, look: Look, frames: u64, out: &Path) -> Result<Value> {
+fn play(env: &Env, scene: &str, look: Look, frames: u64, out: &Path) -> Result<RunSummary> {
     let mut sw = env.switches.clone();
     sw.frame.width = Some(env.width);
     sw.frame.height = Some(env.width);
@@ -62,27 +45,18 @@ fn play(env: &Env, scene: &str, look: Look, frames: u64, out: &Path) -> Result<V
         save_every: frames.saturating_sub(1).max(1),
         switches: sw,
     };
-    crate::run::run(&opts)?;
-    let text = std::fs::read_to_string(out.join("summary.json")).map_err(|e| super::io(out, e))?;
-    serde_json::from_str(&text).map_err(|e| Error::Param(format!("summary.json: {e}")))
+    Ok(crate::run::run(&opts)?.summary)
 }
 
-/// The renderer's bytes: its buffers in `memory_bytes`.
-fn render_bytes(s: &Value) -> u64 {
-    let m = s["memory_bytes"].as_object();
-    m.into_iter()
-        .flatten()
-        .filter(|(k, _)| RENDER_BUFFERS.iter().any(|p| k.starts_with(p)))
-        .filter_map(|(_, v)| v.as_u64())
-        .sum()
+/// The renderer's bytes: the buffers it holds (summary.json's `renderer_bytes`).
+fn render_bytes(s: &RunSummary) -> u64 {
+    s.stats.render().map_or(0, |r| r.renderer_bytes)
 }
 
 /// The sub-scopes of `render` with their medians: "splat 1.2, smooth 0.8, ...".
-fn passes(s: &Value) -> String {
-    let obj = s["pass_ms"].as_object();
-    obj.into_iter()
-        .flatten()
-        .filter_map(|(k, v)| Some((k.strip_prefix("render/")?, v["median"].as_f64()?)))
+fn passes(s: &RunSummary) -> String {
+    let p = s.pass_ms.0.iter();
+    p.filter_map(|(k, v)| Some((k.strip_prefix("render/")?, v.median)))
         .map(|(k, v)| format!("{k} {v:.2}"))
         .collect::<Vec<_>>()
         .join(", ")
@@ -97,7 +71,7 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
          Each scene played once per surface (`fluidform run --scene S --surface K --width \
          {side} --height {side}`, the scene's material; metaballs with the S-buffer, sorted for glass and tinted as by default), the same \
          simulation each time. GPU medians per frame of the `render` scope and its passes; \
-         memory: the renderer's buffers (`memory_bytes` of summary.json); the last frame of \
+         memory: the buffers the renderer holds (`renderer_bytes` of summary.json); the last frame of \
          each, left to right in the table's order.\n\n\
          | scene | surface | frames | render ms | x metaballs | passes (ms) | renderer MiB | triangles |\n\
          |---|---|---|---|---|---|---|---|\n"
@@ -116,11 +90,10 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
             let out = env.runs(Experiment::Surfaces).join(&name);
             let s = play(env, scene, (kind, None, None), frames, &out)?;
             steps.tick();
-            let ms = pass_median(&s, crate::render::SCOPE)?;
+            let ms = s.pass_median(crate::render::SCOPE)?;
             let b = *base.get_or_insert(ms);
-            let tris = s["stats"]["render"]["last_frame"]["triangles"]
-                .as_u64()
-                .unwrap_or(0);
+            let last = s.stats.render().and_then(|r| r.last_frame.as_ref());
+            let tris = last.map_or(0, |f| f.triangles);
             let bytes = render_bytes(&s);
             md.push_str(&format!(
                 "| {label} | {} | {frames} | {ms:.2} | {:.1} | {} | {:.1} | {} |\n",
@@ -167,10 +140,10 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
     let s = play(env, "dam-break", look, frames, &out)?;
     steps.tick();
     steps.finish();
-    let cubes = pass_median(&s, DENSITY_SCOPE)? + pass_median(&s, CELLS_SCOPE)?;
-    let per_frame =
-        s["stats"]["steps"].as_f64().unwrap_or(f64::NAN) / s["frames"].as_f64().unwrap_or(f64::NAN);
-    let step = pass_median(&s, crate::sph::SCOPE)? / per_frame;
+    let cubes = s.pass_median(DENSITY_SCOPE)? + s.pass_median(CELLS_SCOPE)?;
+    let steps_run = s.stats.sph().map_or(f64::NAN, |p| p.steps as f64);
+    let per_frame = steps_run / s.frames as f64;
+    let step = s.pass_median(crate::sph::SCOPE)? / per_frame;
     let labels: Vec<&str> = SCENES.iter().map(|s| s.0).collect();
     md.push_str(&format!(
         "\nThe last frame of each: metaballs, screen-space, mesh (left to right); {} (top to \
@@ -182,9 +155,9 @@ pub fn surfaces(env: &mut Env) -> Result<(Vec<PathBuf>, Vec<Finding>)> {
          particles: density {:.2} ms + cells {:.2} ms = **{cubes:.2} ms** per frame against \
          **{step:.2} ms** per SPH step (the `sph` scope's median over {per_frame:.0} steps a \
          frame); drawing the soup (raster) {:.2} ms.\n",
-        pass_median(&s, DENSITY_SCOPE)?,
-        pass_median(&s, CELLS_SCOPE)?,
-        pass_median(&s, RASTER_SCOPE)?,
+        s.pass_median(DENSITY_SCOPE)?,
+        s.pass_median(CELLS_SCOPE)?,
+        s.pass_median(RASTER_SCOPE)?,
     ));
     csv.push_str(&format!(
         "dam break {n},cubes-vs-step,{frames},{cubes:.4},{:.3},,\n",

@@ -250,16 +250,13 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
 
 pub use fluidform_sim::non_finite_as_null;
 
-/// The median ms of timestamp scope `key` in a summary.json's `pass_ms`; a scope the run
-/// did not record is an error naming those it did.
-pub fn pass_median(summary: &serde_json::Value, key: crate::gpu::ScopeKey) -> Result<f64> {
-    let passes = &summary["pass_ms"];
-    passes[key.path()]["median"].as_f64().ok_or_else(|| {
-        let recorded = passes
-            .as_object()
-            .into_iter()
-            .flatten()
-            .map(|(k, _)| k.as_str());
-        key.missing(recorded)
-    })
+impl<C, S> Summary<C, S> {
+    /// The median milliseconds of the scope `key`; an error naming the scopes recorded
+    /// when it was not.
+    pub fn pass_median(&self, key: crate::gpu::ScopeKey) -> Result<f64> {
+        let p = &self.pass_ms;
+        p.get(key.path())
+            .map(|s| s.median)
+            .ok_or_else(|| key.missing(p.0.iter().map(|(k, _)| k.as_str())))
+    }
 }

@@ -61,22 +61,19 @@ pub struct RunConfig {
     pub switches: Switches,
 }
 
-/// `stats` of the orbits scene (strict, so an SPH block never reads back as this).
+/// `stats` of the orbits scene.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
 pub struct OrbitsStats {
     pub particles: u32,
 }
 
 /// `stats` of a scene with a character and no fluid.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
 pub struct CharacterRunStats {
     pub character: CharacterStats,
     pub render: crate::run::view::RenderSummary,
 }
 
-/// `stats` of a run, by scene kind.
 /// `stats` of an SPH run.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct SphRunStats {
@@ -102,8 +99,9 @@ pub struct SphRunStats {
     pub particle_systems: Vec<crate::run::particles::SystemStats>,
 }
 
+/// `stats` of a run, tagged by its scene kind (`kind`).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(untagged)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum RunStats {
     Sph(Box<SphRunStats>),
     Character(Box<CharacterRunStats>),
@@ -112,6 +110,25 @@ pub enum RunStats {
 }
 
 pub type RunSummary = Summary<RunConfig, RunStats>;
+
+impl RunStats {
+    /// The renderer's block, where the scene renders a fluid or a character.
+    pub fn render(&self) -> Option<&crate::run::view::RenderSummary> {
+        match self {
+            RunStats::Sph(s) => Some(&s.render),
+            RunStats::Character(c) => Some(&c.render),
+            _ => None,
+        }
+    }
+
+    /// The SPH run's block.
+    pub fn sph(&self) -> Option<&SphRunStats> {
+        match self {
+            RunStats::Sph(s) => Some(s),
+            _ => None,
+        }
+    }
+}
 
 /// The run's outcome: the summary written and the frames saved.
 pub struct RunResult {

@@ -95,6 +95,9 @@ pub struct RenderSummary {
     pub last_frame: Option<FrameStats>,
     pub max_fragments: u64,
     pub max_list_bytes: u64,
+    /// Bytes of the renderer's buffers at the end of the run (by ownership).
+    #[serde(default)]
+    pub renderer_bytes: u64,
     pub longest_list: u32,
     pub overflow_redos: u32,
     /// Frames with rays cut short by llvmpipe's loop budget (wrong pixels).
@@ -437,7 +440,10 @@ impl FluidView for MetaballViewer {
     }
 
     fn stats(&self) -> RenderSummary {
-        self.totals.clone()
+        RenderSummary {
+            renderer_bytes: self.buffers.bytes(),
+            ..self.totals.clone()
+        }
     }
 
     fn set_camera(&mut self, cam: &Camera) {

@@ -40,6 +40,11 @@ pub struct BoundsBuffers {
 }
 
 impl BoundsBuffers {
+    /// Bytes of its buffers.
+    pub fn bytes(&self) -> u64 {
+        self.partials.size + self.result.size
+    }
+
     pub fn new(ctx: &Context, capacity: u64) -> Result<Self> {
         let partials = Guard::new(
             ctx,

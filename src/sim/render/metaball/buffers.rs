@@ -91,6 +91,30 @@ fn load_sky(path: &str) -> Result<(u32, u32, Vec<u32>)> {
 }
 
 impl MetaballBuffers {
+    /// Bytes of every buffer the renderer holds for its frames (lists, picture, sky,
+    /// layers, readbacks, the per-tile lists and another surface's): its memory by
+    /// ownership, not by buffer names.
+    pub fn bytes(&self) -> u64 {
+        let own = [
+            &self.params,
+            &self.offsets,
+            &self.list,
+            &self.heads,
+            &self.nodes,
+            &self.stats,
+            &self.pixels,
+            &self.debug,
+            &self.sky,
+            &self.depths,
+            &self.opaque,
+            &self.scene_depth,
+        ];
+        let readbacks = self.stats_readback.iter().chain(&self.pixels_readback);
+        let buffers: u64 = own.into_iter().chain(readbacks).map(|b| b.size).sum();
+        let surface = self.surface.as_ref().map_or(0, |s| s.bytes());
+        buffers + self.bounds.bytes() + self.scan.bytes() + self.tiles.held_bytes() + surface
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         for b in [
             &mut self.params,

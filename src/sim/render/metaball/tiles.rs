@@ -47,6 +47,21 @@ pub struct TileBuffers {
 }
 
 impl TileBuffers {
+    /// Bytes of its buffers now.
+    pub fn held_bytes(&self) -> u64 {
+        let b = [
+            &self.rects,
+            &self.ball_keys,
+            &self.ball_ids,
+            &self.pair_counts,
+            &self.pair_keys,
+            &self.pair_ids,
+            &self.tile_balls,
+            &self.tile_ranges,
+        ];
+        b.iter().map(|b| b.size).sum::<u64>() + self.scan.bytes()
+    }
+
     pub fn new(
         ctx: &Context,
         s: &MetaballSettings,

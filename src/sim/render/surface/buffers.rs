@@ -85,6 +85,21 @@ fn case_table() -> Vec<u32> {
 const VERTEX_BYTES: u64 = 32;
 
 impl SurfaceBuffers {
+    /// Bytes of its buffers now.
+    pub fn bytes(&self) -> u64 {
+        let b = [
+            &self.zbits,
+            &self.thick,
+            &self.gbuf,
+            &self.smoothed,
+            &self.grid,
+            &self.cases,
+            &self.verts,
+            &self.args,
+        ];
+        b.iter().map(|b| b.size).sum()
+    }
+
     /// Buffers for a `size` frame of `n` particles; `cell` is the marching cubes'
     /// cell in rest spacings.
     pub fn new(
