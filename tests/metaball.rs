@@ -3,17 +3,10 @@ use fluidform::render::metaball::reference::{field, march, MarchParams};
 use fluidform::render::DensityFn;
 use glam::Vec3;
 
-const ALL: [DensityFn; 4] = [
-    DensityFn::Blinn,
-    DensityFn::Wyvill,
-    DensityFn::Nishimura,
-    DensityFn::Murakami,
-];
-
 #[test]
 fn density_functions_are_normalised_continuous_and_decreasing() {
     let r = 0.04;
-    for f in ALL {
+    for f in DensityFn::all().iter().copied() {
         assert!((f.value(0.0, r) - 1.0).abs() < 1e-6, "{f:?}: D(0)");
         assert!(
             f.value(r * 0.99999, r).abs() < 1e-3,
@@ -47,7 +40,7 @@ fn density_functions_are_normalised_continuous_and_decreasing() {
 #[test]
 fn reference_marcher_hits_a_single_ball_where_expected() {
     // One metaball: the surface is the sphere where D(r) = T.
-    for f in ALL {
+    for f in DensityFn::all().iter().copied() {
         let p = MarchParams {
             density: f,
             radius: 0.04,

@@ -133,12 +133,7 @@ fn write_diff(name: &str, a: &[u8], b: &[u8]) -> std::path::PathBuf {
 fn every_list_gives_the_same_image() {
     let ctx = common::ctx();
     let sc = scene();
-    let densities = [
-        DensityFn::Blinn,
-        DensityFn::Wyvill,
-        DensityFn::Nishimura,
-        DensityFn::Murakami,
-    ];
+    let densities = DensityFn::all().iter().copied();
     let materials = [
         Material::Phong,
         Material::Glass,
@@ -173,12 +168,7 @@ fn primary_hits_match_the_cpu_reference() {
     let ctx = common::ctx();
     let sc = scene();
     let centers: Vec<Vec3> = sc.pts.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    for d in [
-        DensityFn::Wyvill,
-        DensityFn::Nishimura,
-        DensityFn::Blinn,
-        DensityFn::Murakami,
-    ] {
+    for d in DensityFn::all().iter().copied() {
         let mut s = settings(ListKind::Sbuffer, d, Material::Phong);
         s.refine = 20;
         let p = MarchParams {

@@ -1,13 +1,14 @@
 //! The switches turned into the lower crates' own settings, at the application's edge:
 //! the simulation crate takes `MetaballSettings` and `ControlDesc`, never `Switches`.
+use crate::character::Skinning;
 use crate::config::Switches;
 use crate::control::target::ControlDesc;
 use crate::error::{Error, Result};
 use crate::render::metaball::MetaballSettings;
+use crate::render::ShowMesh;
 use crate::render::{BuildKind, ListKind, Material, SurfaceKind};
 use crate::scene::emission::EmissionOverrides;
 use crate::scene::schema::Look;
-use crate::scene::targets::{ControlOverrides, TargetOptions};
 
 /// The metaball settings: the thesis's (`MetaballSettings::thesis`), overridden by the
 /// switches that are set.
@@ -157,6 +158,22 @@ fn pair(name: &str, v: &Option<Vec<f32>>) -> Result<Option<[f32; 2]>> {
             v.len()
         ))),
     }
+}
+
+/// A control target's settings: the run's over the scene's (`settings::control_overrides`).
+pub type ControlOverrides = Box<dyn Fn(&ControlDesc) -> Result<ControlDesc>>;
+
+/// What the scene's characters and targets take from the run (`settings::target_options`).
+pub struct TargetOptions {
+    pub skinning: Skinning,
+    /// The characters' meshes; None: hidden under control, else shaded.
+    pub show_mesh: Option<ShowMesh>,
+    pub quiet: bool,
+    /// Scene time from which the fidelity metrics are summarised.
+    pub metrics_from: Option<f64>,
+    pub seed: u64,
+    pub emission: EmissionOverrides,
+    pub control: ControlOverrides,
 }
 
 /// The control switches over a target's own settings, for every target of the run.

@@ -3,7 +3,7 @@
 // (MB_B_* defines); RenderParams and RenderStats mirror src/sim/render/metaball/settings.rs
 // and stats.rs (field offsets tested). Defines from Rust: LIST (LIST_NONE | LIST_ABUFFER |
 // LIST_SBUFFER | LIST_TILES), SORTED (1: S-buffer ranges sorted by depth), DENSITY (DENSITY_BLINN |
-// _WYVILL | _NISHIMURA | _MURAKAMI), MATERIAL (MATERIAL_PHONG | _GLASS | _TINTED | _METAL).
+// _WYVILL | _NISHIMURA | _MURAKAMI | _WENDLAND), MATERIAL (MATERIAL_PHONG | _GLASS | _TINTED | _METAL).
 #ifndef METABALL_COMMON_GLSL
 #define METABALL_COMMON_GLSL
 
@@ -69,6 +69,9 @@ float density2(float r2) {
     return q <= 1.0 / 3.0 ? 1.0 - 3.0 * q2 : 1.5 * (1.0 - q) * (1.0 - q);
 #elif DENSITY == DENSITY_MURAKAMI
     return (1.0 - q2) * (1.0 - q2);
+#elif DENSITY == DENSITY_WENDLAND
+    float q = sqrt(q2), u = 1.0 - q;
+    return u * u * u * u * (4.0 * q + 1.0);
 #else
 #error "DENSITY names no density function"
 #endif
@@ -91,6 +94,9 @@ float density_grad_over_r(float r2) {
     return q > 1e-12 ? -3.0 * (1.0 - q) / q * inv : 0.0;
 #elif DENSITY == DENSITY_MURAKAMI
     return -4.0 * (1.0 - q2) * inv;
+#elif DENSITY == DENSITY_WENDLAND
+    float u = 1.0 - sqrt(q2);
+    return -20.0 * u * u * u * inv;
 #else
 #error "DENSITY names no density function"
 #endif

@@ -10,7 +10,7 @@ pub(super) struct SphWork {
     view: Box<dyn crate::run::view::FluidView>,
     pub(super) frames: Frames,
     export: Option<crate::export::ParticleExport>,
-    targets: crate::scene::targets::SceneTargets,
+    targets: crate::run::targets::SceneTargets,
     /// The scene's particle systems, stepped once per frame after the fluid.
     systems: Option<crate::run::particles::SceneSystems>,
     /// The viewer's switches of the next frame: simulate it (false: paused, the picture
@@ -384,7 +384,7 @@ impl SphWork {
         let mut st = Guard::new(ctx, solver.state(ctx, scene, &parts)?);
         let cam = scene_camera(scene, sw);
         let opts = crate::settings::target_options(sw);
-        let targets = crate::scene::targets::SceneTargets::new(
+        let targets = crate::run::targets::SceneTargets::new(
             ctx, scene, &opts, &solver, &mut st, &parts.pos, SLOTS,
         )?;
         let targets = Guard::new(ctx, targets);

@@ -1,5 +1,5 @@
-//! Scenes: the schema and its built-ins, and the parts a scene plays beside the fluid
-//! (characters, control targets, emission). The `orbits` test scene is made in code
+//! Scenes: the schema and its built-ins, and the descriptions of the parts a scene plays
+//! beside the fluid (characters, control targets, emission); they play in `run`. The `orbits` test scene is made in code
 //! (`crate::orbits`).
 pub mod around;
 pub mod builtin;
@@ -9,6 +9,5 @@ pub mod fit;
 pub mod load;
 pub mod particles;
 pub mod schema;
-pub mod targets;
 
 pub use schema::Scene;

@@ -20,12 +20,18 @@ switch_enum!(
         Compute
     }
 );
-switch_enum!(DensityFn {
-    Blinn,
-    Wyvill,
-    Nishimura,
-    Murakami
-});
+switch_enum!(
+    /// The metaball density functions D(q), q = r / R: the thesis's four (Blinn's
+    /// truncated Gaussian, Wyvill, Nishimura, Murakami) and Wendland's C2,
+    /// (1 - q)^4 (4q + 1).
+    DensityFn {
+        Blinn,
+        Wyvill,
+        Nishimura,
+        Murakami,
+        Wendland
+    }
+);
 switch_enum!(Material {
     Phong,
     Glass,

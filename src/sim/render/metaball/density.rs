@@ -32,6 +32,7 @@ impl DensityFn {
                 }
             }
             DensityFn::Murakami => (1.0 - q2) * (1.0 - q2),
+            DensityFn::Wendland => (1.0 - q).powi(4) * (4.0 * q + 1.0),
         }
     }
 
@@ -57,6 +58,7 @@ impl DensityFn {
                 }
             }
             DensityFn::Murakami => -4.0 * q * (1.0 - q2),
+            DensityFn::Wendland => -20.0 * q * (1.0 - q).powi(3),
         };
         d_dq * dq
     }

@@ -48,6 +48,7 @@ pub fn iso_radius(density: DensityFn, r: f64, t: f64, k: f64) -> Option<f64> {
             DensityFn::Nishimura if q <= 1.0 / 3.0 => 1.0 - 3.0 * q2,
             DensityFn::Nishimura => 1.5 * (1.0 - q).powi(2),
             DensityFn::Murakami => (1.0 - q2).powi(2),
+            DensityFn::Wendland => (1.0 - q).powi(4) * (4.0 * q + 1.0),
             // The thesis leaves Blinn's a and b open: not a reference.
             DensityFn::Blinn => f64::NAN,
         }

@@ -2,10 +2,7 @@
 //! `[control]`, the target "character") and the `[[targets]]`, attached, switched, united
 //! and released by the timeline; each attached target's pose set before the frame's
 //! steps, its metrics read after them; the first shown mesh drawn by the view.
-use super::character::{CharacterDesc, CharacterStats, SceneCharacter};
-use super::emission::{EmissionMetrics, EmissionOverrides, EmissionStats, SceneEmission};
 use crate::character::capsules::{self, BoneCapsule};
-use crate::character::Skinning;
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
@@ -18,8 +15,12 @@ use crate::gpu::Open;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
 use crate::render::ShowMesh;
+use crate::run::scene_character::{CharacterStats, SceneCharacter};
+use crate::run::scene_emission::{EmissionMetrics, EmissionStats, SceneEmission};
+use crate::scene::character::CharacterDesc;
 use crate::scene::schema::MAIN_TARGET;
 use crate::scene::Scene;
+use crate::settings::TargetOptions;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::{SphSolver, SphState};
@@ -52,22 +53,6 @@ struct Live {
     poses: Vec<Option<FramePose>>,
     /// The character, shared with the metrics' worker threads (which skin it).
     shared: std::sync::Arc<crate::character::Character>,
-}
-
-/// A control target's settings: the run's over the scene's (`settings::control_overrides`).
-pub type ControlOverrides = Box<dyn Fn(&ControlDesc) -> Result<ControlDesc>>;
-
-/// What the scene's characters and targets take from the run (`settings::target_options`).
-pub struct TargetOptions {
-    pub skinning: Skinning,
-    /// The characters' meshes; None: hidden under control, else shaded.
-    pub show_mesh: Option<ShowMesh>,
-    pub quiet: bool,
-    /// Scene time from which the fidelity metrics are summarised.
-    pub metrics_from: Option<f64>,
-    pub seed: u64,
-    pub emission: EmissionOverrides,
-    pub control: ControlOverrides,
 }
 
 /// The skin's speed is its motion over this many seconds before the frame.

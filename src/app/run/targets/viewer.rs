@@ -11,7 +11,7 @@ impl SceneTargets {
     /// would change (they shape pipelines or buffers: the scene must be rebuilt).
     pub fn set_control(
         &mut self,
-        overrides: &super::ControlOverrides,
+        overrides: &crate::settings::ControlOverrides,
         fluid: &crate::sph::FluidParams,
     ) -> Result<bool> {
         let mut next = Vec::new();
