@@ -7,7 +7,6 @@
 pub mod bench;
 pub mod experiment;
 pub mod inspect;
-pub mod provenance;
 
 pub use fluidform_app::{run, window};
 pub use fluidform_gpu as gpu;

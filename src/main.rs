@@ -154,7 +154,7 @@ enum SceneWhat {
 
 /// Errors print as one line: the error and any cause its message does not already hold.
 fn main() -> std::process::ExitCode {
-    fluidform::provenance::init();
+    fluidform::bench::provenance::init();
     match real_main() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

@@ -11,7 +11,7 @@ use fluidform::emission::layout::UvLayout;
 use fluidform::emission::EmitterKind;
 use fluidform::gpu::{sync, Buffer, Context, Labels};
 use fluidform::kinds::{Neighbors, SortAlgo};
-use fluidform::run::scene_emission::{births_per_triangle, uniformity, BUCKETS};
+use fluidform::run::targets::emission::{births_per_triangle, uniformity, BUCKETS};
 use fluidform::sph::SphSolver;
 use glam::Vec3;
 

@@ -11,6 +11,7 @@ pub mod particles;
 pub mod plot;
 pub mod primitives;
 pub mod protocol;
+pub mod provenance;
 pub mod render;
 pub mod skin;
 pub mod solvers;
@@ -355,7 +356,7 @@ fn sweep_tables(rows: &[Row]) -> (String, String) {
 
 /// The protocol and provenance in one paragraph, for every table page.
 pub fn protocol_text(opts: &BenchOptions) -> String {
-    let p = crate::provenance::measured(opts.frames, opts.warmup);
+    let p = crate::bench::provenance::measured(opts.frames, opts.warmup);
     format!(
         "Protocol: every configuration built first; a sentinel warm-up (up to {} s); then \
          {} shuffled rounds (seed {}) sharing up to {} timed frames per configuration (at \

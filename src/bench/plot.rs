@@ -45,7 +45,7 @@ pub(crate) fn font() -> Result<()> {
 
 /// Today's date (UTC) as YYYY-MM-DD.
 pub fn today() -> String {
-    crate::provenance::today()
+    crate::bench::provenance::today()
 }
 
 const PALETTE: [RGBColor; 8] = [

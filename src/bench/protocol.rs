@@ -554,7 +554,7 @@ fn write_protocol(
     let json = serde_json::json!({
         "rounds": rounds, "seed": opts.switches.common.seed, "drift": DRIFT,
         "warmup": warm, "sentinel_median_ms": sentinel,
-        "provenance": crate::provenance::measured(opts.frames, opts.warmup),
+        "provenance": crate::bench::provenance::measured(opts.frames, opts.warmup),
     });
     let p = opts.out.join("protocol.json");
     let text = serde_json::to_string_pretty(&json).unwrap_or_default();

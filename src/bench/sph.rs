@@ -112,7 +112,7 @@ pub struct StabilitySummary {
     pub unstable: Option<String>,
     /// The build and the time it was measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub provenance: Option<crate::provenance::Provenance>,
+    pub provenance: Option<crate::bench::provenance::Provenance>,
 }
 
 /// Simulated seconds of the stability run unless --seconds.
@@ -176,7 +176,7 @@ pub fn stability(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let density_ok = (ratio - 1.0).abs() <= 0.05;
     let gpu_ms: f64 = timings.iter().map(|t| t.frame_ms).sum();
     let summary = StabilitySummary {
-        provenance: Some(crate::provenance::measured(steps, 0)),
+        provenance: Some(crate::bench::provenance::measured(steps, 0)),
         scene: scene.name.clone(),
         neighbors: strategy,
         sort,

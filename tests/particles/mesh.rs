@@ -8,7 +8,7 @@ fn mesh_emitter_births_lie_on_the_skin_and_the_body_collides() {
     use fluidform::character::Skinning;
     use fluidform::psys::character::CharacterLink;
     use fluidform::render::ShowMesh;
-    use fluidform::run::scene_character::SceneCharacter;
+    use fluidform::run::targets::character::SceneCharacter;
     use fluidform::scene::character::CharacterDesc;
     let ctx = common::ctx();
     let passes = Passes::new(&ctx).unwrap();

@@ -13,7 +13,7 @@ use crate::render::{RenderKind, ShowMesh};
 use crate::report::{Report, Summary};
 pub use crate::run::common::{camera_with_switches, check_validation, SLOTS};
 use crate::run::common::{open, play};
-use crate::run::scene_character::{CharacterStats, SceneCharacter};
+use crate::run::targets::character::{CharacterStats, SceneCharacter};
 use crate::run::view::{FluidView, Picture, PointsViewer};
 use crate::sph::FluidParams;
 use serde::{Deserialize, Serialize};
@@ -24,8 +24,6 @@ pub mod common;
 pub mod live;
 mod orbits;
 pub mod particles;
-pub mod scene_character;
-pub mod scene_emission;
 mod sph;
 pub mod targets;
 pub mod view;
@@ -86,11 +84,11 @@ pub struct SphRunStats {
     pub simulated_seconds: f64,
     pub render: crate::run::view::RenderSummary,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub character: Option<crate::run::scene_character::CharacterStats>,
+    pub character: Option<crate::run::targets::character::CharacterStats>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<crate::run::targets::ControlSummary>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emission: Option<crate::run::scene_emission::EmissionStats>,
+    pub emission: Option<crate::run::targets::emission::EmissionStats>,
     /// The density error of every step (per step in steps.csv).
     #[serde(default)]
     pub density_error: crate::sph::errors::DensityErrorStats,

@@ -16,7 +16,7 @@ use crate::render::mesh::MeshView;
 use crate::render::Camera;
 use crate::render::ShowMesh;
 use crate::run::common::{camera_with_switches, open, play, SLOTS};
-use crate::run::scene_character::SceneCharacter;
+use crate::run::targets::character::SceneCharacter;
 use crate::run::view::Picture;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
 use crate::scene::particles::ParticleScene;

@@ -15,8 +15,6 @@ use crate::gpu::Open;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
 use crate::render::ShowMesh;
-use crate::run::scene_character::{CharacterStats, SceneCharacter};
-use crate::run::scene_emission::{EmissionMetrics, EmissionStats, SceneEmission};
 use crate::scene::character::CharacterDesc;
 use crate::scene::schema::MAIN_TARGET;
 use crate::scene::Scene;
@@ -24,12 +22,16 @@ use crate::settings::TargetOptions;
 use crate::sph::hooks::Hooks;
 use crate::sph::params::{Collider, GpuCollider, MAX_COLLIDERS};
 use crate::sph::{SphSolver, SphState};
+use character::{CharacterStats, SceneCharacter};
+use emission::{EmissionMetrics, EmissionStats, SceneEmission};
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
 const CONTROL_METRICS_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("control-metrics");
 const EMISSION_SCOPE: crate::gpu::ScopeName = crate::gpu::ScopeName::new("emission");
 
+pub mod character;
+pub mod emission;
 mod viewer;
 
 /// `stats.control` of summary.json: each control target's metrics and the fired events.
