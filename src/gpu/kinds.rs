@@ -1,7 +1,7 @@
 //! Closed sets of choices (`Kind`, declared with `switch_enum!`): each parses and prints as
 //! its switch spells it, and gives its shader defines. This layer declares only its own
 //! (the primitives' sorts and neighbour searches); each domain declares its choices beside
-//! it (`sph::Solver`, `render::ListKind`, ...), and the command line offers them as switches.
+//! it (the solvers in sph, the list modes in render, ...), and the command line offers them.
 /// A closed set of choices: every value, and each one's name as its switch spells it
 /// (kebab case). The command line offers them through `Kind`, so no layer below it needs
 /// the command-line parser.
