@@ -89,3 +89,49 @@ fn a_stale_cache_is_ignored_with_one_line_and_replaced() {
     let log = scan(&cache, &out);
     assert!(log.contains("scan"), "{log}");
 }
+
+/// The context's keyed pipelines (gpu/pipelines.rs): one key is one Vulkan pipeline, shared
+/// by every holder and destroyed with its last; another workgroup size is another key.
+#[test]
+fn one_key_is_one_pipeline_until_its_last_holder_goes() {
+    use fluidform::primitives::bounds::{BoundsBuffers, BoundsPass, BOUNDS};
+    let ctx = common::ctx();
+    let mut a = BOUNDS.pipeline(&ctx, &(), 256, &[8]).unwrap();
+    let mut other = BOUNDS.pipeline(&ctx, &(), 128, &[8]).unwrap();
+    let mut pass = BoundsPass::new(&ctx).unwrap(); // 256 wide, 8 per invocation: a's key
+    assert_ne!(
+        a.pipeline, other.pipeline,
+        "another workgroup size, another pipeline"
+    );
+    assert_eq!(ctx.live_objects().get("pipeline"), Some(&2));
+    assert_eq!(ctx.pipelines.len(), 2);
+    a.destroy(&ctx);
+    assert_eq!(ctx.pipelines.len(), 2, "the pass still holds a's pipeline");
+    // The pass's pipeline still runs: the box of known positions.
+    let pos: Vec<[f32; 4]> = (0..5000)
+        .map(|i| {
+            let t = i as f32 * 0.01;
+            [t.sin() * 2.0, t.cos() - 3.0, t * 0.1, 1.0]
+        })
+        .collect();
+    let mut buf = ctx
+        .storage_buffer("positions", pos.len() as u64 * 16)
+        .unwrap();
+    ctx.upload(&mut buf, 0, &pos).unwrap();
+    let mut b = BoundsBuffers::new(&ctx, pos.len() as u64).unwrap();
+    ctx.one_shot(|cmd| pass.record(&ctx, cmd, &buf, pos.len() as u64, &b))
+        .unwrap()
+        .unwrap();
+    let got: Vec<[f32; 4]> = ctx.read_all(&b.result).unwrap();
+    for k in 0..3 {
+        let lo = pos.iter().map(|p| p[k]).fold(f32::INFINITY, f32::min);
+        let hi = pos.iter().map(|p| p[k]).fold(f32::NEG_INFINITY, f32::max);
+        assert_eq!((got[0][k], got[1][k]), (lo, hi), "axis {k}");
+    }
+    pass.destroy(&ctx);
+    other.destroy(&ctx);
+    assert!(ctx.pipelines.is_empty());
+    b.destroy(&ctx);
+    ctx.destroy_buffer(&mut buf);
+    common::finish(&ctx);
+}

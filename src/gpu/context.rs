@@ -79,6 +79,8 @@ pub struct Context {
     pub shaders: ShaderCompiler,
     /// The driver's pipeline cache, kept between processes (gpu/cache.rs).
     pub pipeline_cache: vk::PipelineCache,
+    /// Pipelines keyed by what builds them, shared by their holders (gpu/pipelines.rs).
+    pub pipelines: super::pipelines::Pipelines,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -230,6 +232,7 @@ impl Context {
             push_descriptor,
             shaders,
             pipeline_cache,
+            pipelines: Default::default(),
             debug_instance,
             debug_device,
             messenger,

@@ -5,8 +5,9 @@
 //! the shader test compiles exactly what the passes build: every declaration, every key
 //! value (`registered()`). Declared with `compute_pass!` / `graphics_pass!` beside the pass.
 use crate::error::Result;
+use crate::graphics::{GraphicsDesc, GraphicsPipeline};
 use crate::interface::Interface;
-use crate::pipeline::{ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline};
+use crate::pipeline::{ComputeDesc, ComputePipeline};
 use crate::Context;
 use ash::vk;
 use std::marker::PhantomData;

@@ -5,6 +5,7 @@
 //! constants 1.. are the pass's own.
 use super::access::{buffer_uses, Use};
 use super::interface::{check, BindingDecl, Interface, Reflected};
+use super::pipelines::{Built, PipelineKey};
 use super::track::BufferUse;
 use super::{Buffer, Context};
 use crate::error::{Error, Result, VkContext};
@@ -14,7 +15,7 @@ use std::marker::PhantomData;
 
 /// The tracker's view of a dispatch's or draw's bound buffers: each binding the stage's
 /// SPIR-V touches, over the bytes its descriptor views.
-fn bound_uses<'a>(
+pub(crate) fn bound_uses<'a>(
     buffers: &'a [(u32, vk::DescriptorBufferInfo)],
     uses: &'a BTreeMap<u32, Use>,
     stage: vk::PipelineStageFlags2,
@@ -33,7 +34,7 @@ fn bound_uses<'a>(
 /// Most workgroups one dimension of a dispatch may have on every Vulkan device.
 pub const MAX_GROUPS_X: u32 = 65535;
 
-fn shader_module(ctx: &Context, spv: &[u32], name: &str) -> Result<vk::ShaderModule> {
+pub(crate) fn shader_module(ctx: &Context, spv: &[u32], name: &str) -> Result<vk::ShaderModule> {
     let info = vk::ShaderModuleCreateInfo::default().code(spv);
     let m = unsafe { ctx.device.create_shader_module(&info, None) }
         .ctx(&format!("shader module {name}"))?;
@@ -43,7 +44,7 @@ fn shader_module(ctx: &Context, spv: &[u32], name: &str) -> Result<vk::ShaderMod
 
 /// Set layout of the interface's storage buffers for push descriptors, and a pipeline
 /// layout with `push_size` bytes of push constants.
-fn layouts(
+pub(crate) fn layouts(
     ctx: &Context,
     decls: &[BindingDecl],
     push_size: u32,
@@ -87,7 +88,7 @@ fn layouts(
     Ok((set_layout, layout))
 }
 
-fn push_buffers(
+pub(crate) fn push_buffers(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     bind: vk::PipelineBindPoint,
@@ -112,7 +113,7 @@ fn push_buffers(
 }
 
 /// The interface's binding defines followed by the pass's own.
-fn all_defines<I: Interface>(own: &[(&str, String)]) -> Vec<(String, String)> {
+pub(crate) fn all_defines<I: Interface>(own: &[(&str, String)]) -> Vec<(String, String)> {
     let mut d = I::defines();
     d.extend(own.iter().map(|(k, v)| (k.to_string(), v.clone())));
     d
@@ -124,7 +125,7 @@ pub fn as_refs(d: &[(String, String)]) -> Vec<(&str, String)> {
 }
 
 /// Compile `files` with `defines` and check what they declare against `I`.
-fn checked_stages<I: Interface>(
+pub(crate) fn checked_stages<I: Interface>(
     ctx: &Context,
     pass: &str,
     files: &[&str],
@@ -197,6 +198,20 @@ impl<I: Interface> ComputePipeline<I> {
             )));
         }
         let defines = all_defines::<I>(d.defines);
+        let mut fixed = vec![d.local_size as i64];
+        fixed.extend(d.spec.iter().map(|v| *v as i64));
+        let key = PipelineKey::new(std::any::type_name::<I>(), &[d.shader], &defines, fixed);
+        if let Some(b) = ctx.pipelines.acquire(&key) {
+            return Ok(Self {
+                pipeline: b.pipeline,
+                layout: b.layout,
+                set_layout: b.set_layout,
+                local_size: d.local_size,
+                name: d.name.to_string(),
+                uses: b.uses[0].1.clone(),
+                interface: PhantomData,
+            });
+        }
         let spv = checked_stages::<I>(ctx, d.name, &[d.shader], &as_refs(&defines))?;
         let push_size = std::mem::size_of::<I::Push>() as u32;
         let (set_layout, layout) = layouts(
@@ -247,13 +262,22 @@ impl<I: Interface> ComputePipeline<I> {
         };
         ctx.set_name(pipeline, d.name);
         ctx.count_object("pipeline", 1);
+        let uses = buffer_uses(&spv[0]);
+        let stage = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        let built = Built {
+            pipeline,
+            layout,
+            set_layout,
+            uses: vec![(stage, uses.clone())],
+        };
+        ctx.pipelines.insert(key, built);
         Ok(Self {
             pipeline,
             layout,
             set_layout,
             local_size: d.local_size,
             name: d.name.to_string(),
-            uses: buffer_uses(&spv[0]),
+            uses,
             interface: PhantomData,
         })
     }
@@ -350,235 +374,43 @@ impl<I: Interface> ComputePipeline<I> {
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
     }
 
+    /// Give up this holder's share: the last holder destroys the pipeline and layouts.
     pub fn destroy(&mut self, ctx: &Context) {
-        if self.pipeline != vk::Pipeline::null() {
-            unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
-            ctx.count_object("pipeline", -1);
-        }
-        destroy_layouts(ctx, self.layout, self.set_layout);
+        release(ctx, self.pipeline, self.layout, self.set_layout);
         self.pipeline = vk::Pipeline::null();
         self.layout = vk::PipelineLayout::null();
         self.set_layout = vk::DescriptorSetLayout::null();
     }
 }
 
-fn destroy_layouts(ctx: &Context, layout: vk::PipelineLayout, set: vk::DescriptorSetLayout) {
+/// One holder fewer of `pipeline`; the last destroys it and its layouts.
+pub(crate) fn release(
+    ctx: &Context,
+    pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+) {
+    if pipeline == vk::Pipeline::null() || ctx.pipelines.release(pipeline).is_none() {
+        return;
+    }
+    unsafe { ctx.device.destroy_pipeline(pipeline, None) };
+    ctx.count_object("pipeline", -1);
+    destroy_layouts(ctx, layout, set_layout);
+}
+
+pub(crate) fn destroy_layouts(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    set: vk::DescriptorSetLayout,
+) {
     unsafe {
         ctx.device.destroy_pipeline_layout(layout, None);
         ctx.device.destroy_descriptor_set_layout(set, None);
     }
 }
 
-/// A graphics pipeline for dynamic rendering with storage buffers read by its shaders.
-pub struct GraphicsDesc<'a> {
-    pub name: &'a str,
-    pub vertex: &'a str,
-    pub fragment: &'a str,
-    pub defines: &'a [(&'a str, String)],
-    /// None: no colour attachment (passes that only write storage buffers).
-    pub color_format: Option<vk::Format>,
-    pub depth_format: Option<vk::Format>,
-    /// Alpha blending (src alpha, one minus src alpha): drawn back to front, so depth is
-    /// tested but not written.
-    pub blend: bool,
-    pub topology: vk::PrimitiveTopology,
-}
-
-/// A graphics pipeline of interface `I` (both stages checked against it).
-pub struct GraphicsPipeline<I: Interface> {
-    pub pipeline: vk::Pipeline,
-    pub layout: vk::PipelineLayout,
-    pub set_layout: vk::DescriptorSetLayout,
-    pub name: String,
-    /// What each stage does with each binding (from the SPIR-V), for the barrier tracker.
-    uses: Vec<(vk::PipelineStageFlags2, BTreeMap<u32, Use>)>,
-    interface: PhantomData<I>,
-}
-
-/// The graphics pipeline of `d`'s states (dynamic rendering, dynamic viewport and
-/// scissor) over the two shader modules.
-fn fixed_function(
-    ctx: &Context,
-    d: &GraphicsDesc,
-    (vsm, fsm): (vk::ShaderModule, vk::ShaderModule),
-    layout: vk::PipelineLayout,
-) -> std::result::Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)> {
-    let stages = [
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
-            .module(vsm)
-            .name(c"main"),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(fsm)
-            .name(c"main"),
-    ];
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-    let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(d.topology);
-    let viewport = vk::PipelineViewportStateCreateInfo::default()
-        .viewport_count(1)
-        .scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
-        .line_width(1.0);
-    let ms = vk::PipelineMultisampleStateCreateInfo::default()
-        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(d.depth_format.is_some())
-        .depth_write_enable(d.depth_format.is_some() && !d.blend)
-        .depth_compare_op(vk::CompareOp::LESS);
-    let attachment = [vk::PipelineColorBlendAttachmentState::default()
-        .blend_enable(d.blend)
-        .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
-        .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-        .color_blend_op(vk::BlendOp::ADD)
-        .src_alpha_blend_factor(vk::BlendFactor::ONE)
-        .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-        .alpha_blend_op(vk::BlendOp::ADD)
-        .color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let blend =
-        vk::PipelineColorBlendStateCreateInfo::default().attachments(if d.color_format.is_some() {
-            &attachment[..]
-        } else {
-            &[]
-        });
-    let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
-    let formats: Vec<vk::Format> = d.color_format.into_iter().collect();
-    let mut rendering =
-        vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
-    if let Some(df) = d.depth_format {
-        rendering = rendering.depth_attachment_format(df);
-    }
-    let info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&ia)
-        .viewport_state(&viewport)
-        .rasterization_state(&raster)
-        .multisample_state(&ms)
-        .depth_stencil_state(&depth)
-        .color_blend_state(&blend)
-        .dynamic_state(&dynamic)
-        .layout(layout)
-        .push_next(&mut rendering);
-    unsafe {
-        ctx.device
-            .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
-    }
-}
-
-impl<I: Interface> GraphicsPipeline<I> {
-    pub fn new(ctx: &Context, d: &GraphicsDesc) -> Result<Self> {
-        let defines = all_defines::<I>(d.defines);
-        let spv = checked_stages::<I>(ctx, d.name, &[d.vertex, d.fragment], &as_refs(&defines))?;
-        let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let push_size = std::mem::size_of::<I::Push>() as u32;
-        let (set_layout, layout) = layouts(ctx, I::BINDINGS, push_size, stages_flags, d.name)?;
-        let modules = shader_module(ctx, &spv[0], d.vertex).and_then(|v| {
-            shader_module(ctx, &spv[1], d.fragment)
-                .inspect_err(|_| unsafe { ctx.device.destroy_shader_module(v, None) })
-                .map(|f| (v, f))
-        });
-        let (vsm, fsm) = match modules {
-            Ok(m) => m,
-            Err(e) => {
-                destroy_layouts(ctx, layout, set_layout);
-                return Err(e);
-            }
-        };
-        let r = fixed_function(ctx, d, (vsm, fsm), layout);
-        unsafe {
-            ctx.device.destroy_shader_module(vsm, None);
-            ctx.device.destroy_shader_module(fsm, None);
-        }
-        let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
-            Ok(p) => p[0],
-            Err(e) => {
-                destroy_layouts(ctx, layout, set_layout);
-                return Err(e);
-            }
-        };
-        ctx.set_name(pipeline, d.name);
-        ctx.count_object("pipeline", 1);
-        Ok(Self {
-            pipeline,
-            layout,
-            set_layout,
-            name: d.name.to_string(),
-            uses: vec![
-                (vk::PipelineStageFlags2::VERTEX_SHADER, buffer_uses(&spv[0])),
-                (
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                    buffer_uses(&spv[1]),
-                ),
-            ],
-            interface: PhantomData,
-        })
-    }
-
-    /// Declare that the next rendering scope draws this pipeline with `bufs` (call before
-    /// it begins): the tracker places the barriers the draws need now.
-    pub fn prepare(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>) {
-        ctx.prepare_draws(cmd, &self.draw_uses(bufs));
-    }
-
-    fn draw_uses(&self, bufs: &I::Bufs<'_>) -> Vec<BufferUse> {
-        let buffers = I::buffers(bufs);
-        self.uses
-            .iter()
-            .flat_map(|(stage, map)| bound_uses(&buffers, map, *stage))
-            .collect()
-    }
-
-    /// Bind the pipeline, its buffers and push constants (inside a rendering scope: uses
-    /// not declared by `prepare` are counted as hazards where no barrier can be placed).
-    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, bufs: &I::Bufs<'_>, push: &I::Push) {
-        ctx.track(cmd, &self.draw_uses(bufs), false);
-        unsafe {
-            ctx.device
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            push_buffers(
-                ctx,
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.layout,
-                &I::buffers(bufs),
-            );
-            let bytes = bytemuck::bytes_of(push);
-            if !bytes.is_empty() {
-                ctx.device.cmd_push_constants(
-                    cmd,
-                    self.layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytes,
-                );
-            }
-        }
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        if self.pipeline != vk::Pipeline::null() {
-            unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
-            ctx.count_object("pipeline", -1);
-        }
-        destroy_layouts(ctx, self.layout, self.set_layout);
-        self.pipeline = vk::Pipeline::null();
-        self.layout = vk::PipelineLayout::null();
-        self.set_layout = vk::DescriptorSetLayout::null();
-    }
-}
-
 impl<I: Interface> super::Destroy for ComputePipeline<I> {
     fn destroy(&mut self, ctx: &Context) {
         ComputePipeline::destroy(self, ctx)
-    }
-}
-
-impl<I: Interface> super::Destroy for GraphicsPipeline<I> {
-    fn destroy(&mut self, ctx: &Context) {
-        GraphicsPipeline::destroy(self, ctx)
     }
 }
