@@ -163,7 +163,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             origin_cell, dims, radius, n, max_neighbors, pad),
         ),
         (
-            "scene/orbits.comp",
+            "orbits/orbits.comp",
             "Push",
             fields!(fluidform::orbits::OrbitsPush; dt, strength, eps, n),
         ),

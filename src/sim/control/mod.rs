@@ -18,3 +18,4 @@ pub mod rays;
 pub mod settings;
 pub mod target;
 pub mod timeline;
+pub mod winding;
