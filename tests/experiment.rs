@@ -72,10 +72,9 @@ fn thesis_table_files(dir: &std::path::Path, name: Experiment) {
             _ => assert!(num(r, "list_mb") > 0.0 && num(r, "fragments") > 0.0),
         }
         // Every S-buffer number the thesis printed is carried (a row of ours has none).
-        let d = (def.rows.iter())
-            .find(|d| d.label == r["row"])
-            .unwrap_or_else(|| panic!("{name}: row {} is defined nowhere", r["row"]));
-        let printed = d.thesis.iter().any(|t| !t.k2.is_empty());
+        // (Quick runs relabel the particle-count rows: those are the thesis's.)
+        let d = def.rows.iter().find(|d| d.label == r["row"]);
+        let printed = d.is_none_or(|d| d.thesis.iter().any(|t| !t.k2.is_empty()));
         if r["list"] == "sbuffer" && printed {
             assert!(!r["thesis_k2_fps"].is_empty(), "{name} {r:?}");
         }
