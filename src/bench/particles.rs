@@ -154,7 +154,7 @@ pub fn particles(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                     k += 1;
                     record_simulation(ctx, cmd, prof, passes, std::slice::from_mut(s), &f)?;
                     {
-                        let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::DRAW));
+                        let _scope = prof.open(ctx, cmd, Passes::DRAW);
                         s.prepare_draw(ctx, cmd, passes, &f);
                         target.begin_rendering(ctx, cmd, [0.0, 0.0, 0.0, 1.0]);
                         s.record_draw(ctx, cmd, passes, &f);

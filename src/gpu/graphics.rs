@@ -3,13 +3,13 @@
 use super::access::{buffer_uses, Use};
 use super::interface::Interface;
 use super::pipeline::{
-    all_defines, as_refs, bound_uses, checked_stages, destroy_layouts, layouts, push_buffers,
+    all_defines, as_refs, bound_uses, checked_stages, destroy_layouts, keep, layouts, push_buffers,
     release, shader_module,
 };
 use super::pipelines::{Built, PipelineKey};
 use super::track::BufferUse;
 use super::Context;
-use crate::error::{Result, VkContext};
+use crate::error::Result;
 use ash::vk;
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
@@ -126,17 +126,29 @@ impl<I: Interface> GraphicsPipeline<I> {
         ];
         let shaders = [d.vertex, d.fragment];
         let key = PipelineKey::new(std::any::type_name::<I>(), &shaders, &defines, fixed);
-        if let Some(b) = ctx.pipelines.acquire(&key) {
-            return Ok(Self {
-                pipeline: b.pipeline,
-                layout: b.layout,
-                set_layout: b.set_layout,
-                name: d.name.to_string(),
-                uses: b.uses,
-                interface: PhantomData,
-            });
-        }
-        let spv = checked_stages::<I>(ctx, d.name, &shaders, &as_refs(&defines))?;
+        let b = match ctx.pipelines.acquire(&key) {
+            Some(b) => b,
+            None => Self::build(ctx, d, &defines, key)?,
+        };
+        Ok(Self {
+            pipeline: b.pipeline,
+            layout: b.layout,
+            set_layout: b.set_layout,
+            name: d.name.to_string(),
+            uses: b.uses,
+            interface: PhantomData,
+        })
+    }
+
+    /// A new pipeline of `d`, kept under `key`.
+    fn build(
+        ctx: &Context,
+        d: &GraphicsDesc,
+        defines: &[(String, String)],
+        key: PipelineKey,
+    ) -> Result<Built> {
+        let shaders = [d.vertex, d.fragment];
+        let spv = checked_stages::<I>(ctx, d.name, &shaders, &as_refs(defines))?;
         let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let push_size = std::mem::size_of::<I::Push>() as u32;
         let (set_layout, layout) = layouts(ctx, I::BINDINGS, push_size, stages_flags, d.name)?;
@@ -157,15 +169,6 @@ impl<I: Interface> GraphicsPipeline<I> {
             ctx.device.destroy_shader_module(vsm, None);
             ctx.device.destroy_shader_module(fsm, None);
         }
-        let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
-            Ok(p) => p[0],
-            Err(e) => {
-                destroy_layouts(ctx, layout, set_layout);
-                return Err(e);
-            }
-        };
-        ctx.set_name(pipeline, d.name);
-        ctx.count_object("pipeline", 1);
         let uses = vec![
             (vk::PipelineStageFlags2::VERTEX_SHADER, buffer_uses(&spv[0])),
             (
@@ -173,21 +176,7 @@ impl<I: Interface> GraphicsPipeline<I> {
                 buffer_uses(&spv[1]),
             ),
         ];
-        let built = Built {
-            pipeline,
-            layout,
-            set_layout,
-            uses: uses.clone(),
-        };
-        ctx.pipelines.insert(key, built);
-        Ok(Self {
-            pipeline,
-            layout,
-            set_layout,
-            name: d.name.to_string(),
-            uses,
-            interface: PhantomData,
-        })
+        keep(ctx, key, d.name, r, (layout, set_layout), uses)
     }
 
     /// Declare that the next rendering scope draws this pipeline with `bufs` (call before

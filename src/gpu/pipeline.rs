@@ -201,18 +201,29 @@ impl<I: Interface> ComputePipeline<I> {
         let mut fixed = vec![d.local_size as i64];
         fixed.extend(d.spec.iter().map(|v| *v as i64));
         let key = PipelineKey::new(std::any::type_name::<I>(), &[d.shader], &defines, fixed);
-        if let Some(b) = ctx.pipelines.acquire(&key) {
-            return Ok(Self {
-                pipeline: b.pipeline,
-                layout: b.layout,
-                set_layout: b.set_layout,
-                local_size: d.local_size,
-                name: d.name.to_string(),
-                uses: b.uses[0].1.clone(),
-                interface: PhantomData,
-            });
-        }
-        let spv = checked_stages::<I>(ctx, d.name, &[d.shader], &as_refs(&defines))?;
+        let b = match ctx.pipelines.acquire(&key) {
+            Some(b) => b,
+            None => Self::build(ctx, d, &defines, key)?,
+        };
+        Ok(Self {
+            pipeline: b.pipeline,
+            layout: b.layout,
+            set_layout: b.set_layout,
+            local_size: d.local_size,
+            name: d.name.to_string(),
+            uses: b.uses[0].1.clone(),
+            interface: PhantomData,
+        })
+    }
+
+    /// A new pipeline of `d`, kept under `key`.
+    fn build(
+        ctx: &Context,
+        d: &ComputeDesc,
+        defines: &[(String, String)],
+        key: PipelineKey,
+    ) -> Result<Built> {
+        let spv = checked_stages::<I>(ctx, d.name, &[d.shader], &as_refs(defines))?;
         let push_size = std::mem::size_of::<I::Push>() as u32;
         let (set_layout, layout) = layouts(
             ctx,
@@ -253,33 +264,11 @@ impl<I: Interface> ComputePipeline<I> {
                 .create_compute_pipelines(ctx.pipeline_cache, &[info], None)
         };
         unsafe { ctx.device.destroy_shader_module(module, None) };
-        let pipeline = match r.map_err(|(_, e)| e).ctx(&format!("{} pipeline", d.name)) {
-            Ok(p) => p[0],
-            Err(e) => {
-                destroy_layouts(ctx, layout, set_layout);
-                return Err(e);
-            }
-        };
-        ctx.set_name(pipeline, d.name);
-        ctx.count_object("pipeline", 1);
-        let uses = buffer_uses(&spv[0]);
-        let stage = vk::PipelineStageFlags2::COMPUTE_SHADER;
-        let built = Built {
-            pipeline,
-            layout,
-            set_layout,
-            uses: vec![(stage, uses.clone())],
-        };
-        ctx.pipelines.insert(key, built);
-        Ok(Self {
-            pipeline,
-            layout,
-            set_layout,
-            local_size: d.local_size,
-            name: d.name.to_string(),
-            uses,
-            interface: PhantomData,
-        })
+        let uses = vec![(
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            buffer_uses(&spv[0]),
+        )];
+        keep(ctx, key, d.name, r, (layout, set_layout), uses)
     }
 
     /// Bind the pipeline, push its descriptors and constants, after the barrier its buffers'
@@ -383,6 +372,35 @@ impl<I: Interface> ComputePipeline<I> {
     }
 }
 
+/// The driver's answer `created` named, counted and kept under `key` with its layouts and
+/// the stages' binding uses; on an error the layouts are destroyed.
+pub(crate) fn keep(
+    ctx: &Context,
+    key: PipelineKey,
+    name: &str,
+    created: std::result::Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)>,
+    (layout, set_layout): (vk::PipelineLayout, vk::DescriptorSetLayout),
+    uses: Vec<(vk::PipelineStageFlags2, BTreeMap<u32, Use>)>,
+) -> Result<Built> {
+    let pipeline = match created.map_err(|(_, e)| e).ctx(&format!("{name} pipeline")) {
+        Ok(p) => p[0],
+        Err(e) => {
+            destroy_layouts(ctx, layout, set_layout);
+            return Err(e);
+        }
+    };
+    ctx.set_name(pipeline, name);
+    ctx.count_object("pipeline", 1);
+    let built = Built {
+        pipeline,
+        layout,
+        set_layout,
+        uses,
+    };
+    ctx.pipelines.insert(key, built.clone());
+    Ok(built)
+}
+
 /// One holder fewer of `pipeline`; the last destroys it and its layouts.
 pub(crate) fn release(
     ctx: &Context,
@@ -390,7 +408,7 @@ pub(crate) fn release(
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
 ) {
-    if pipeline == vk::Pipeline::null() || ctx.pipelines.release(pipeline).is_none() {
+    if pipeline == vk::Pipeline::null() || !ctx.pipelines.release(pipeline) {
         return;
     }
     unsafe { ctx.device.destroy_pipeline(pipeline, None) };

@@ -79,21 +79,21 @@ impl Pipelines {
         g.0.insert(key, Held { built, holders: 1 });
     }
 
-    /// One holder fewer of `pipeline`: its handles when it was the last (for the caller to
-    /// destroy), else None. A pipeline never inserted is returned at once.
-    pub fn release(&self, pipeline: vk::Pipeline) -> Option<()> {
+    /// One holder fewer of `pipeline`: true when it was the last (the caller destroys it),
+    /// and for a pipeline never kept here.
+    pub fn release(&self, pipeline: vk::Pipeline) -> bool {
         let mut g = self.held.lock().unwrap();
         let Some(key) = g.1.get(&pipeline).cloned() else {
-            return Some(());
+            return true;
         };
         let h = g.0.get_mut(&key).expect("a held pipeline has its key");
         h.holders -= 1;
         if h.holders > 0 {
-            return None;
+            return false;
         }
         g.0.remove(&key);
         g.1.remove(&pipeline);
-        Some(())
+        true
     }
 
     /// Pipelines held now.

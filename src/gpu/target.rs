@@ -334,28 +334,6 @@ impl ColorTarget {
     }
 }
 
-impl<'a> super::GraphicsDesc<'a> {
-    /// Triangles into no attachment: the fragment shader only writes storage buffers
-    /// (per-pixel lists, splats, G-buffers), drawn in `begin_empty_rendering`.
-    pub fn storage_only(
-        name: &'a str,
-        vertex: &'a str,
-        fragment: &'a str,
-        defines: &'a [(&'a str, String)],
-    ) -> Self {
-        Self {
-            name,
-            vertex,
-            fragment,
-            defines,
-            color_format: None,
-            depth_format: None,
-            blend: false,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-        }
-    }
-}
-
 /// Begin dynamic rendering with no attachments over width x height (fragment passes that
 /// only write storage buffers), with the viewport and scissor set.
 pub fn begin_empty_rendering(ctx: &Context, cmd: vk::CommandBuffer, width: u32, height: u32) {

@@ -259,7 +259,7 @@ impl FrameWork for ParticleWork {
         let bufs = self.body.as_ref().map(|b| b.link.bufs(b.ch.surface()));
         self.scene.record_simulation(ctx, cmd, prof, frame, bufs)?;
         {
-            let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::DRAW));
+            let _scope = prof.open(ctx, cmd, Passes::DRAW);
             let mesh = match &self.body {
                 Some(Body {
                     ch, view: Some(v), ..

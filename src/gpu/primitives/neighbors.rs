@@ -309,11 +309,6 @@ impl NeighborSearch {
         }
     }
 
-    /// Defines for shaders that include neighbors.glsl.
-    pub fn defines(&self) -> Vec<(&'static str, String)> {
-        Self::defines_for(self.strategy, self.sort)
-    }
-
     pub fn buffers(
         &self,
         ctx: &Context,

@@ -117,7 +117,7 @@ crate::gpu::compute_pass!(pub RAYS_SORT: RaysIo, () = "rays sort", "control/rays
 crate::gpu::compute_pass!(pub RAYS_EMIT: RaysIo, () = "rays emit", "control/rays_emit.comp");
 
 impl RaysPlacer {
-    pub const NAME: &'static str = "place";
+    pub const NAME: crate::gpu::ScopeName = crate::gpu::ScopeName::new("place");
 
     pub fn new(ctx: &Context, grid: RaysGrid, capacity: u32, park: f32) -> Result<Self> {
         let storage = GraphicsStates::STORAGE_ONLY;
@@ -192,7 +192,7 @@ impl RaysPlacer {
             stats: &self.stats,
         };
         {
-            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Self::NAME));
+            let _scope = scopes.open(ctx, cmd, Self::NAME);
             ctx.fill(cmd, &self.offsets, 0);
             ctx.fill(cmd, &self.out, self.park.to_bits());
             let [w, h, _] = self.grid.dims;

@@ -132,7 +132,6 @@ pub struct EmitPass {
 }
 
 impl EmitPass {
-    pub const NAME: &'static str = "emit";
     /// Byte offset of the alive count in `counts`.
     pub const ALIVE_OFFSET: u64 = 4;
 

@@ -304,7 +304,7 @@ impl Emitter {
 /// and lends it to each frame's steps.
 impl SphHook for Emitter {
     fn scope(&self) -> crate::gpu::ScopeName {
-        crate::gpu::ScopeName::new(EmitPass::NAME)
+        super::emit::EMIT.scope()
     }
 
     fn record(

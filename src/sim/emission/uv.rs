@@ -91,7 +91,7 @@ crate::gpu::compute_pass!(pub UV_FLAGS: UvIo, () = "uv flags", "emission/uv_flag
 crate::gpu::compute_pass!(pub UV_COMPACT: UvIo, () = "uv compact", "emission/uv_compact.comp");
 
 impl UvSurface {
-    pub const NAME: &'static str = "uv";
+    pub const NAME: crate::gpu::ScopeName = UV.scope();
 
     /// For `layout` at `size` texels (the layout packed for that size); lists the texels
     /// covered with the mesh at `rest` (its vertex positions). Long because each pass and
@@ -198,7 +198,7 @@ impl UvSurface {
     ) -> Result<()> {
         let next = 1 - self.current;
         {
-            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Self::NAME));
+            let _scope = scopes.open(ctx, cmd, Self::NAME);
             ctx.fill(cmd, &self.pos[next], 0);
             self.raster_into(ctx, cmd, verts, &self.pos[next], 0);
         }

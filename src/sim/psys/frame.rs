@@ -70,7 +70,7 @@ fn record_events(
         return Ok(());
     }
     {
-        let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::EVENTS));
+        let _scope = prof.open(ctx, cmd, Passes::EVENTS);
         for (i, s) in systems.iter().enumerate() {
             if links.iter().any(|l| l.0 == i) {
                 s.record_event_args(ctx, cmd, passes, f);

@@ -9,7 +9,9 @@ use crate::error::Result;
 use crate::gpu::pass::{Defines, PassKey};
 use crate::gpu::target::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::vk;
-use crate::gpu::{Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard};
+use crate::gpu::{
+    Buffer, ComputePipeline, Context, GraphicsPipeline, GraphicsStates, Guard, ScopeName,
+};
 use crate::kinds::Neighbors;
 use crate::kinds::SortAlgo;
 use crate::primitives::counting::CountingSort;
@@ -382,12 +384,12 @@ pub struct Passes {
 }
 
 impl Passes {
-    pub const EMIT: &'static str = "emit";
-    pub const UPDATE: &'static str = "update";
-    pub const EVENTS: &'static str = "events";
-    pub const BOIDS: &'static str = "boids";
-    pub const SORT: &'static str = "sort";
-    pub const DRAW: &'static str = "draw";
+    pub const EMIT: ScopeName = ScopeName::new("emit");
+    pub const UPDATE: ScopeName = ScopeName::new("update");
+    pub const EVENTS: ScopeName = ScopeName::new("events");
+    pub const BOIDS: ScopeName = ScopeName::new("boids");
+    pub const SORT: ScopeName = ScopeName::new("sort");
+    pub const DRAW: ScopeName = ScopeName::new("draw");
 
     pub fn new(ctx: &Context) -> Result<Self> {
         Self::with_subgroups(ctx, ctx.info.subgroup_arithmetic)

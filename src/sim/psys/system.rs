@@ -417,7 +417,7 @@ impl ParticleSystem {
         let push = self.push(f, f.time, births);
         let bufs = self.bufs(passes, f);
         {
-            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::EMIT));
+            let _scope = scopes.open(ctx, cmd, Passes::EMIT);
             passes.emit.dispatch(ctx, cmd, &bufs, &push, births as u64);
         }
         if self.closed() {
@@ -425,13 +425,12 @@ impl ParticleSystem {
             return;
         }
         {
-            let mut scopes = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::UPDATE));
+            let mut scopes = scopes.open(ctx, cmd, Passes::UPDATE);
             passes.args.dispatch_groups(ctx, cmd, &bufs, &push, 1);
             if let (Some(nb), Some(b)) = (&self.flock, &self.spec.boids) {
                 // The grid over every slot (dead ones sort last), then each boid's steering.
                 {
-                    let mut scopes =
-                        scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::BOIDS));
+                    let mut scopes = scopes.open(ctx, cmd, Passes::BOIDS);
                     let r = passes.grid.record_build(
                         ctx,
                         cmd,

@@ -118,7 +118,7 @@ pub struct StepErrors {
 crate::gpu::compute_pass!(pub STEP_ERROR: StepErrorIo, () = "sph/errors", "sph/step_error.comp");
 
 impl StepErrors {
-    pub const NAME: &'static str = "sph/errors";
+    pub const NAME: crate::gpu::ScopeName = STEP_ERROR.scope();
 
     /// For up to `capacity` particles and `max_steps` steps per frame in each of `slots`.
     pub fn new(ctx: &Context, capacity: u64, slots: usize, max_steps: u32) -> Result<Self> {

@@ -181,11 +181,6 @@ fn registered(kind: Solver) -> (&'static [PassDecl], Make) {
     }
 }
 
-/// The passes of each solver (the every-shader-compiles registry reads them too).
-pub fn passes(solver: Solver) -> Vec<PassDecl> {
-    registered(solver).0.to_vec()
-}
-
 /// Build `kind`'s passes for the SPH variant `key`.
 pub fn build(ctx: &Context, kind: Solver, key: &SphKey) -> Result<Box<dyn PressureSolver>> {
     (registered(kind).1)(ctx, key)

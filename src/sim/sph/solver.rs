@@ -99,8 +99,6 @@ pub struct SphSolver {
     cfl: super::cfl::CflPass,
     /// The pressure solvers built so far (`state` builds its fluid's).
     pressure: Vec<Box<dyn PressureSolver>>,
-    /// The SPH variant its pressure solvers' passes are built as.
-    key: SphKey,
 }
 
 /// Particle state and scratch for up to `particles.capacity` particles.
@@ -308,7 +306,6 @@ impl SphSolver {
             gather,
             search: search.take(),
             pressure: Vec::new(),
-            key,
         })
     }
 
@@ -317,8 +314,11 @@ impl SphSolver {
         let k = match self.pressure.iter().position(|p| p.kind() == solver) {
             Some(k) => k,
             None => {
-                self.pressure
-                    .push(super::pressure::build(ctx, solver, &self.key)?);
+                self.pressure.push(super::pressure::build(
+                    ctx,
+                    solver,
+                    &SphKey(self.search.key()),
+                )?);
                 self.pressure.len() - 1
             }
         };

@@ -157,7 +157,7 @@ impl Stepper {
             solver.record_hooked_step(ctx, cmd, prof, st, hooks)?;
             self.recorded[slot].push(st.commands);
             {
-                let _scope = prof.open(ctx, cmd, crate::gpu::ScopeName::new(StepErrors::NAME));
+                let _scope = prof.open(ctx, cmd, StepErrors::NAME);
                 self.errors.record(ctx, cmd, st, slot, k)?;
             }
         }

@@ -56,7 +56,7 @@ impl ParticleSystem {
         let bufs = self.bufs(passes, f);
         let cap = self.capacity as u64;
         {
-            let _scope = scopes.open(ctx, cmd, crate::gpu::ScopeName::new(Passes::SORT));
+            let _scope = scopes.open(ctx, cmd, Passes::SORT);
             if self.closed() {
                 let zero = StepPush { mode: 2, ..push };
                 passes.args.dispatch_groups(ctx, cmd, &bufs, &zero, 1);

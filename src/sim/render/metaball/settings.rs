@@ -276,14 +276,11 @@ impl MetaballSettings {
         }
     }
 
-    /// LIST, DENSITY, MATERIAL and SORTED with the named values the shaders compare
-    /// against (`LIST_SBUFFER`, ...), all from here.
+    /// Every define the frame's shaders can read: its march's (the lists', the look's, the
+    /// step's, the counters', the lanes' and the stack's; `passes::MarchKey`).
     pub fn shader_defines(&self) -> Vec<(String, String)> {
-        let mut d = Self::defines_for(self.list, self.density, self.material, self.sorts_lists());
-        d.extend(Self::march_defines(self.march));
-        d.extend(Self::lane_defines(self.counters, self.lanes));
-        d.extend(Self::stack_defines(self.depth));
-        d
+        use crate::gpu::pass::PassKey;
+        super::passes::MarchKey::of(self).defines()
     }
 
     /// march.comp's path stack for recursion depth `depth`: STACK, its slots (depth + 1,
