@@ -536,11 +536,30 @@ fn bad_files_are_one_line_errors_naming_the_file() {
         .unwrap_err()
         .to_string();
     one_line(&e, &["giraffe.obj", "no skin"]);
-    let e = load("SimpleSkin.gltf")
-        .require_closed("placement")
-        .unwrap_err()
-        .to_string();
-    one_line(&e, &["SimpleSkin.gltf", "10 boundary", "not closed"]);
+    // An open mesh is accepted, with its counts; a sheet has no inside and is refused
+    // (and the GPU's ray placement still asks for a closed one).
+    let sheet = load("SimpleSkin.gltf");
+    assert!(
+        sheet
+            .warnings
+            .iter()
+            .any(|w| w.contains("open (10 boundary")),
+        "{:?}",
+        sheet.warnings
+    );
+    let rest = sheet.rest_positions().unwrap();
+    let e = sheet.require_solid(&rest).unwrap_err().to_string();
+    one_line(&e, &["SimpleSkin.gltf", "nowhere above 1/2", "10 boundary"]);
+    let e = sheet.require_closed("--placement rays").unwrap_err();
+    one_line(&e.to_string(), &["SimpleSkin.gltf", "not closed"]);
+    let e = fluidform::control::placement::place(
+        &sheet,
+        &rest,
+        fluidform::control::Placement::Random,
+        0.05,
+        1,
+    );
+    one_line(&e.unwrap_err().to_string(), &["no inside"]);
 }
 
 #[test]

@@ -12,7 +12,7 @@ use rand::{Rng, SeedableRng};
 /// Skin on the GPU; the largest position error relative to the mesh size, and the largest
 /// normal error, against the CPU reference. Each vertex carries a tag in its rest position's
 /// w (the control particles' fill of the shape), which must come out unchanged.
-fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
+pub fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
     let anim = Animator {
         clip: (!ch.clips.is_empty()).then_some(0),
         looping: true,
@@ -20,6 +20,7 @@ fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32
     };
     let mats = anim.joint_matrices(ch, t);
     let joints = ch.gpu_joints(&mats, method).unwrap();
+    let weights = anim.morph_weights(ch, t);
     let tags: Vec<f32> = (0..ch.mesh.vertices())
         .map(|v| 0.5 + (v % 7) as f32 / 16.0)
         .collect();
@@ -32,7 +33,7 @@ fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32
     let mut unused = plain.mesh;
     unused.destroy(ctx);
     ctx.one_shot(|cmd| {
-        sk.record(ctx, cmd, &joints).unwrap();
+        sk.record(ctx, cmd, &joints, &weights).unwrap();
         ctx.barrier(
             cmd,
             sync::COMPUTE_WRITE,
@@ -46,7 +47,7 @@ fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32
     for (v, p) in pos.iter().enumerate() {
         assert_eq!(p[3], tags[v], "{method:?}: vertex {v}'s tag");
     }
-    let (cp, cn) = ch.skinned_at(&mats, method).unwrap();
+    let (cp, cn) = ch.skinned_with(&mats, &weights, method).unwrap();
     let (lo, hi) = character::check::bounds(&cp);
     let size = (hi - lo).length();
     let mut e = (0f32, 0f32);

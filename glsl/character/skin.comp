@@ -19,6 +19,12 @@ layout(std430, binding = SKIN_B_JOINT_IDS) readonly buffer JointIds { uvec2 join
 layout(std430, binding = SKIN_B_WEIGHTS) readonly buffer Weights { vec4 weights[]; };
 layout(std430, binding = SKIN_B_OUT_POS) writeonly buffer OutPos { vec4 out_pos[]; };
 layout(std430, binding = SKIN_B_OUT_NRM) writeonly buffer OutNrm { vec4 out_nrm[]; };
+// Morph targets, added before skinning: vertex v's offsets are entries
+// morph_start[v] .. morph_start[v + 1], each a position offset (its target's index in w,
+// as bits) and a normal offset; every vertex's range is empty without targets.
+layout(std430, binding = SKIN_B_MORPH_START) readonly buffer MorphStart { uint morph_start[]; };
+layout(std430, binding = SKIN_B_MORPH_DELTAS) readonly buffer MorphDeltas { vec4 morph_deltas[]; };
+layout(std430, binding = SKIN_B_MORPH_WEIGHTS) readonly buffer MorphWeights { float morph_weights[]; };
 layout(push_constant) uniform Push { uint n; } pc;
 
 mat3 cofactor(mat3 a) { return mat3(cross(a[1], a[2]), cross(a[2], a[0]), cross(a[0], a[1])); }
@@ -30,6 +36,12 @@ void main() {
     if (v >= pc.n) return;
     vec3 p = rest_pos[v].xyz;
     vec3 n = rest_nrm[v].xyz;
+    for (uint e = morph_start[v]; e < morph_start[v + 1u]; ++e) {
+        vec4 dp = morph_deltas[2u * e];
+        float w = morph_weights[floatBitsToUint(dp.w)];
+        p += w * dp.xyz;
+        n += w * morph_deltas[2u * e + 1u].xyz;
+    }
 #if SKIN_METHOD == 0
     mat3 a = mat3(0.0);
     vec3 t = vec3(0.0);

@@ -68,6 +68,7 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
         };
         for &method in &methods {
             let joints = c.gpu_joints(&anim.joint_matrices(c, 0.4), method)?;
+            let weights = anim.morph_weights(c, 0.4);
             let sk = Guard::new(ctx, Skinner::new(ctx, c, method)?);
             let variant = format!("{}-{}", method.as_str(), short(name));
             let n = c.mesh.vertices() as u64;
@@ -78,7 +79,7 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             cases.push(Case::new(variant, n, SKIN, detail, move |prof, cmd| {
                 {
                     let _scope = prof.open(ctx, cmd, SKIN.scope());
-                    sk.record(ctx, cmd, &joints)?;
+                    sk.record(ctx, cmd, &joints, &weights)?;
                 }
                 Ok(())
             }));

@@ -64,11 +64,13 @@ pub struct Fitted {
     pub pool: Option<(Block, u64)>,
     /// The parts the chosen spacing leaves under [`WANT`] spacings across, in one line.
     pub thin: Option<String>,
+    /// An open mesh's counts and how its volume was measured, in one line.
+    pub open: Option<String>,
 }
 
 impl Fitted {
     pub fn describe(&self) -> Vec<String> {
-        let mut out = Vec::new();
+        let mut out: Vec<String> = self.open.iter().cloned().collect();
         if let Some((s, why)) = &self.spacing {
             out.push(format!(
                 "spacing {s:.4} m ({why}; --fluid spacing=S overrides)"
@@ -93,6 +95,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         spacing: None,
         pool: None,
         thin: None,
+        open: None,
     };
     let Some(desc) = scene.character.clone() else {
         if scene.pool.is_some() {
@@ -110,7 +113,21 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let (lo, hi) = placed_rest_bounds(&ch, &anim)?;
     let scale = anim.placement.x_axis.truncate().length();
     let height = hi.y - lo.y;
-    let volume = (ch.check.signed_volume.abs() as f32) * scale.powi(3);
+    // An open mesh's volume: its winding number's voxels at the finest spacing the fit
+    // may choose (a closed one's signed volume, exact, as always).
+    let started = std::time::Instant::now();
+    let rest = ch.rest_positions()?;
+    let side = height / scale / FINEST;
+    let (volume, voxels) = crate::character::inside::volume(&rest, &ch.mesh.indices, side);
+    let volume = volume as f32 * scale.powi(3);
+    out.open = voxels.map(|n| {
+        format!(
+            "open mesh ({}): volume {volume:.4} m^3 from {n} voxels of {:.4} m inside by the winding number, in {:.0} ms",
+            ch.check.describe(),
+            side * scale,
+            started.elapsed().as_secs_f64() * 1e3
+        )
+    });
     // The placed skin at scene time 0 (the path's start included).
     let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), 0.0);
     let first = ch.skinned_at(&mats, crate::character::Skinning::Lbs)?.0;

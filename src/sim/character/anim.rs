@@ -86,9 +86,27 @@ impl Clip {
                 Property::Translation => l.t = v.truncate(),
                 Property::Rotation => l.r = Quat::from_vec4(v),
                 Property::Scale => l.s = v.truncate(),
+                Property::Weight(_) => {}
             }
         }
         locals
+    }
+
+    /// Every morph target's weight at time `t`: its channel's, else its default.
+    pub fn morph_weights(&self, morphs: &super::Morphs, t: f32, looping: bool) -> Vec<f32> {
+        let t = clip_time(t, self.duration, looping);
+        let mut w = morphs.defaults();
+        for c in &self.channels {
+            let Property::Weight(k) = c.property else {
+                continue;
+            };
+            let slot =
+                (morphs.targets.iter()).position(|m| m.node == c.node && m.index == k as usize);
+            if let Some(slot) = slot {
+                w[slot] = c.sample(t).x;
+            }
+        }
+        w
     }
 }
 
@@ -102,6 +120,14 @@ pub struct Animator {
 }
 
 impl Animator {
+    /// Morph target weights at time `t` (the defaults without a clip).
+    pub fn morph_weights(&self, ch: &super::Character, t: f32) -> Vec<f32> {
+        match self.clip {
+            Some(c) => ch.clips[c].morph_weights(&ch.mesh.morphs, t, self.looping),
+            None => ch.mesh.morphs.defaults(),
+        }
+    }
+
     /// Joint matrices at time `t`, with the placement applied.
     pub fn joint_matrices(&self, ch: &super::Character, t: f32) -> Vec<Mat4> {
         let locals = match self.clip {

@@ -70,16 +70,24 @@ pub fn skin_vertex(
     }
 }
 
-/// Skin every vertex of `mesh` with `joints`.
-pub fn skin(method: Skinning, joints: &[GpuJoint], mesh: &super::Mesh) -> (Vec<Vec3>, Vec<Vec3>) {
+/// Skin every vertex of `mesh` with `joints`, its morph targets first at `weights`.
+pub fn skin(
+    method: Skinning,
+    joints: &[GpuJoint],
+    mesh: &super::Mesh,
+    weights: &[f32],
+) -> (Vec<Vec3>, Vec<Vec3>) {
     let k = 4 * mesh.influence_sets;
     (0..mesh.vertices())
         .map(|v| {
+            let (p, n) = mesh
+                .morphs
+                .apply(v, mesh.positions[v], mesh.normals[v], weights);
             skin_vertex(
                 method,
                 joints,
-                mesh.positions[v],
-                mesh.normals[v],
+                p,
+                n,
                 &mesh.joints[v][..k],
                 &mesh.weights[v][..k],
             )

@@ -1,5 +1,5 @@
 //! glTF animations -> `Clip`s: translation, rotation and scale channels with their
-//! interpolation; morph-weight channels are ignored with a warning.
+//! interpolation, and morph-weight channels split into one scalar channel per target.
 use super::gltf_load::{check_accessor, err};
 use super::model::*;
 use crate::error::Result;
@@ -23,7 +23,7 @@ pub(super) fn read_clips(
         let mut channels = Vec::new();
         let mut duration = 0f32;
         for c in a.channels() {
-            if let Some(ch) = read_channel(path, &name, &c, buffers, warnings)? {
+            for ch in read_channel(path, &name, &c, buffers, warnings)? {
                 duration = duration.max(*ch.times.last().unwrap());
                 channels.push(ch);
             }
@@ -37,15 +37,16 @@ pub(super) fn read_clips(
     Ok(clips)
 }
 
-/// One channel, checked: accessor types, key and value counts, finite rising times.
-/// None for a morph-weight channel (warned about).
+/// One channel, checked: accessor types, key and value counts, finite rising times; a
+/// morph-weight channel as one channel per target of its node's mesh (none, warned about,
+/// when the node has no morph targets).
 fn read_channel(
     path: &Path,
     name: &str,
     c: &gltf::animation::Channel,
     buffers: &[gltf::buffer::Data],
     warnings: &mut Vec<String>,
-) -> Result<Option<Channel>> {
+) -> Result<Vec<Channel>> {
     use gltf::animation::util::ReadOutputs;
     use gltf::animation::Property as P;
     use DataType::{F32, I16, I8, U16, U8};
@@ -75,11 +76,24 @@ fn read_channel(
         Some(ReadOutputs::Rotations(it)) => {
             (Property::Rotation, it.into_f32().map(Vec4::from).collect())
         }
-        Some(ReadOutputs::MorphTargetWeights(_)) => {
-            warnings.push(format!(
-                "animation '{name}': a morph-weight channel is ignored"
-            ));
-            return Ok(None);
+        Some(ReadOutputs::MorphTargetWeights(it)) => {
+            let node = c.target().node();
+            let targets = (node.mesh().and_then(|m| m.primitives().next()))
+                .map_or(0, |p| p.morph_targets().count());
+            if targets == 0 {
+                warnings.push(format!(
+                    "animation '{name}': a morph-weight channel of node {} (no morph targets) is ignored",
+                    node.index()
+                ));
+                return Ok(Vec::new());
+            }
+            let flat: Vec<f32> = it.into_f32().collect();
+            (
+                Property::Weight(targets.min(u16::MAX as usize) as u16),
+                flat.into_iter()
+                    .map(|w| Vec4::new(w, 0.0, 0.0, 0.0))
+                    .collect(),
+            )
         }
         None => {
             return Err(err(
@@ -94,14 +108,21 @@ fn read_channel(
         gltf::animation::Interpolation::CubicSpline => Interp::CubicSpline,
     };
     let per_key = if interp == Interp::CubicSpline { 3 } else { 1 };
-    if times.is_empty() || values.len() != per_key * times.len() {
+    // A weights channel holds every target's value per key (its Weight carries the count
+    // until it is split).
+    let width = match property {
+        Property::Weight(n) => n as usize,
+        _ => 1,
+    };
+    if times.is_empty() || values.len() != width * per_key * times.len() {
         return Err(err(
             path,
             format!(
-            "animation '{name}': a channel has {} keys and {} values ({per_key} per key expected)",
-            times.len(),
-            values.len()
-        ),
+                "animation '{name}': a channel has {} keys and {} values ({} per key expected)",
+                times.len(),
+                values.len(),
+                width * per_key
+            ),
         ));
     }
     if times.iter().any(|t| !t.is_finite()) {
@@ -113,11 +134,21 @@ fn read_channel(
     if times.windows(2).any(|w| w[1] < w[0]) {
         return Err(err(path, format!("animation '{name}': key times decrease")));
     }
-    Ok(Some(Channel {
-        node: c.target().node().index(),
+    let node = c.target().node().index();
+    let one = |property, values| Channel {
+        node,
         property,
         interp,
-        times,
+        times: times.clone(),
         values,
-    }))
+    };
+    Ok(match property {
+        Property::Weight(_) => (0..width)
+            .map(|k| {
+                let v = values.iter().skip(k).step_by(width).copied().collect();
+                one(Property::Weight(k as u16), v)
+            })
+            .collect(),
+        _ => vec![one(property, values)],
+    })
 }

@@ -105,6 +105,8 @@ struct Part {
     influences: Vec<Vec<(u16, f32)>>,
     /// The joint a vertex with all-zero weights is bound to (its skin's first, or its node).
     fallback: u16,
+    /// Its morph targets: weight slot, position and normal offsets per vertex.
+    morphs: Vec<super::gltf_morphs::PartTarget>,
 }
 
 pub fn load(path: &Path) -> Result<Character> {
@@ -124,13 +126,17 @@ pub fn load(path: &Path) -> Result<Character> {
     let mut joints = Joints::default();
     let mut parts = Vec::new();
     let mut skinned = false;
-    let mut morph_warned = false;
+    let mut targets: Vec<MorphTarget> = Vec::new();
+    let mut infos = Vec::new();
     let mut computed_normals = false;
     for ni in scene_nodes(doc, &nodes) {
         let node = doc.nodes().nth(ni).unwrap();
         let Some(mesh) = node.mesh() else { continue };
         let (offset, skin_joints) = joints.of_node(path, &node, &buffers)?;
         skinned |= skin_joints.is_some();
+        let slots = targets.len() as u32;
+        targets.extend(super::gltf_morphs::targets(&node, &mesh));
+        let first_part = parts.len();
         for prim in mesh.primitives() {
             let what = format!(
                 "mesh {} ('{}') primitive {}",
@@ -138,11 +144,7 @@ pub fn load(path: &Path) -> Result<Character> {
                 mesh.name().unwrap_or(""),
                 prim.index()
             );
-            if prim.morph_targets().next().is_some() && !morph_warned {
-                warnings.push("morph targets are ignored (the rest shape is used)".to_string());
-                morph_warned = true;
-            }
-            let (part, computed) = read_part(
+            let (mut part, computed) = read_part(
                 path,
                 &what,
                 &prim,
@@ -152,8 +154,18 @@ pub fn load(path: &Path) -> Result<Character> {
                 &mut warnings,
             )?;
             computed_normals |= computed;
+            part.morphs = super::gltf_morphs::read(path, &what, &prim, &buffers, slots)?;
+            for (slot, _, n) in &part.morphs {
+                targets[*slot as usize].normals |= n.iter().any(|v| *v != Vec3::ZERO);
+            }
             parts.push(part);
         }
+        infos.push(part_info(
+            &node,
+            &mesh,
+            &parts[first_part..],
+            skin_joints.is_some(),
+        ));
     }
     if parts.is_empty() {
         return Err(err(path, "has no mesh in its scene"));
@@ -168,14 +180,49 @@ pub fn load(path: &Path) -> Result<Character> {
     };
     let mut ch = super::assemble(
         path.display().to_string(),
-        merge(parts, &mut warnings),
+        merge(parts, targets, &mut warnings),
         skeleton,
         clips,
         skinned,
         warnings,
     )?;
     ch.normals_computed |= computed_normals;
+    ch.parts = infos;
     Ok(ch)
+}
+
+/// What `inspect` and the run's report say of one mesh node: its primitives checked
+/// together (in the mesh's own space: welding and edges do not depend on the pose).
+fn part_info(node: &gltf::Node, mesh: &gltf::Mesh, parts: &[Part], skinned: bool) -> MeshPart {
+    let (mut pos, mut idx) = (Vec::new(), Vec::new());
+    for p in parts {
+        let base = pos.len() as u32;
+        pos.extend(&p.positions);
+        idx.extend(p.indices.iter().map(|i| i + base));
+    }
+    let c = super::check::check(&pos, &idx);
+    let name = |n: Option<&str>, what: &str, i: usize| {
+        n.map_or_else(|| format!("{what}{i}"), str::to_string)
+    };
+    MeshPart {
+        node: name(node.name(), "node", node.index()),
+        mesh: name(mesh.name(), "mesh", mesh.index()),
+        primitives: parts.len(),
+        triangles: idx.len() / 3,
+        placed_by: match (skinned, node.skin()) {
+            (true, Some(s)) => format!(
+                "skin {} '{}' ({} joints)",
+                s.index(),
+                s.name().unwrap_or(""),
+                s.joints().count()
+            ),
+            _ => "rigid, follows its node".into(),
+        },
+        morph_targets: parts.iter().map(|p| p.morphs.len()).max().unwrap_or(0),
+        boundary_edges: c.boundary_edges,
+        nonmanifold_edges: c.nonmanifold_edges,
+        components: c.components,
+    }
 }
 
 /// The file's buffers; a missing external buffer file is named before the reader fails.
@@ -371,6 +418,7 @@ fn read_part(
         indices,
         influences,
         fallback: offset as u16,
+        morphs: Vec::new(),
     };
     Ok((part, computed))
 }
@@ -443,11 +491,19 @@ fn triangles(mode: Mode, list: &[u32]) -> Option<Vec<u32>> {
 }
 
 /// One mesh of all parts: influences renormalised and sorted, normals where parts have them.
-fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
+fn merge(
+    parts: Vec<Part>,
+    targets: Vec<MorphTarget>,
+    warnings: &mut Vec<String>,
+) -> (Mesh, Vec<bool>) {
     let mut m = Mesh {
         influence_sets: 1,
         ..Default::default()
     };
+    if !targets.is_empty() {
+        m.morphs.targets = targets;
+        m.morphs.start.push(0);
+    }
     let mut has_normal = Vec::new();
     let any_uv = parts.iter().any(|p| p.uvs.is_some());
     let mut zero = 0;
@@ -463,6 +519,9 @@ fn merge(parts: Vec<Part>, warnings: &mut Vec<String>) -> (Mesh, Vec<bool>) {
             });
         }
         m.indices.extend(p.indices.iter().map(|i| i + base));
+        if !m.morphs.targets.is_empty() {
+            super::gltf_morphs::append(&mut m.morphs, &p.morphs, n);
+        }
         m.positions.extend(&p.positions);
         has_normal.extend(std::iter::repeat_n(true, n));
         m.normals.extend(p.normals);

@@ -42,7 +42,40 @@ pub struct Inspection {
     pub thinnest: Option<Thinnest>,
     /// The thinnest regions (at most [`REGIONS`]), thinnest first.
     pub regions: Vec<Region>,
+    /// The file's mesh nodes (empty: one part, the whole mesh).
+    pub parts: Vec<super::MeshPart>,
+    pub morph_targets: Vec<MorphInfo>,
     pub warnings: Vec<String>,
+}
+
+/// A morph target: its node, default weight, whether normals follow, the clips driving it.
+#[derive(Clone, Debug, Serialize)]
+pub struct MorphInfo {
+    pub name: String,
+    pub node: String,
+    pub default: f32,
+    pub normals: bool,
+    pub clips: Vec<String>,
+}
+
+/// Every morph target of `ch` with the clips that animate its weight.
+pub fn morphs(ch: &Character) -> Vec<MorphInfo> {
+    use super::model::Property;
+    (ch.mesh.morphs.targets.iter())
+        .map(|t| MorphInfo {
+            name: t.name.clone(),
+            node: ch.skeleton.nodes[t.node].name.clone(),
+            default: t.default,
+            normals: t.normals,
+            clips: (ch.clips.iter())
+                .filter(|c| {
+                    (c.channels.iter())
+                        .any(|k| k.node == t.node && k.property == Property::Weight(t.index as u16))
+                })
+                .map(|c| c.name.clone())
+                .collect(),
+        })
+        .collect()
 }
 
 /// Regions listed by `inspect`.
@@ -130,6 +163,8 @@ pub fn inspect(ch: &Character, up: Up, up_given: bool) -> Result<Inspection> {
         up_note,
         thinnest: regions.first().map(Thinnest::of),
         regions: regions.into_iter().take(REGIONS).collect(),
+        parts: ch.parts.clone(),
+        morph_targets: morphs(ch),
         warnings: ch.warnings.clone(),
     })
 }
@@ -215,6 +250,42 @@ impl Inspection {
                     r.thickness,
                     r.vertices,
                     100.0 * super::thickness::PERCENTILE
+                ),
+            );
+        }
+        for (i, p) in self.parts.iter().enumerate() {
+            let closed = match p.closed() {
+                true => format!("closed, {} components", p.components),
+                false => format!(
+                    "open: {} boundary, {} non-manifold edges, {} components",
+                    p.boundary_edges, p.nonmanifold_edges, p.components
+                ),
+            };
+            let morphs = match p.morph_targets {
+                0 => String::new(),
+                n => format!(", {n} morph targets"),
+            };
+            line(
+                if i == 0 { "parts" } else { "" },
+                format!(
+                    "'{}' (mesh '{}'): {} primitives, {} triangles, {}{morphs}; {closed}",
+                    p.node, p.mesh, p.primitives, p.triangles, p.placed_by
+                ),
+            );
+        }
+        for (i, m) in self.morph_targets.iter().enumerate() {
+            let clips = match m.clips.is_empty() {
+                true => "no clip".to_string(),
+                false => m.clips.join(", "),
+            };
+            line(
+                if i == 0 { "morph targets" } else { "" },
+                format!(
+                    "'{}' of node '{}', default {}, normals {}; driven by {clips}",
+                    m.name,
+                    m.node,
+                    m.default,
+                    if m.normals { "follow" } else { "kept" }
                 ),
             );
         }

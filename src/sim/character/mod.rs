@@ -9,6 +9,8 @@ pub mod check;
 pub mod cpu;
 mod gltf_clips;
 pub mod gltf_load;
+mod gltf_morphs;
+pub mod inside;
 pub mod inspect;
 pub mod model;
 pub mod obj_load;
@@ -17,6 +19,7 @@ pub mod pose;
 pub mod procedural;
 pub mod skin;
 pub mod thickness;
+pub mod winding;
 
 pub use anim::Animator;
 pub use check::MeshCheck;
@@ -71,6 +74,7 @@ pub(crate) fn assemble(
         check: MeshCheck::default(),
         flipped: false,
         warnings: Vec::new(),
+        parts: Vec::new(),
         capsules: Vec::new(),
     };
     // Normals first (the rest pose skins them too); given ones kept, zero ones replaced.
@@ -83,13 +87,21 @@ pub(crate) fn assemble(
     ch.mesh = mesh;
     let rest = ch.rest_positions()?;
     ch.check = check::check(&rest, &ch.mesh.indices);
-    if ch.check.closed() && ch.check.signed_volume < 0.0 {
+    if !ch.check.closed() {
+        warnings.push(format!(
+            "the mesh is open ({}): inside is where its generalized winding number is above 1/2",
+            ch.check.describe()
+        ));
+    }
+    // An open mesh's signed volume still says which way most of it faces.
+    if ch.check.signed_volume < 0.0 {
         check::flip(&mut ch.mesh.indices);
         for n in &mut ch.mesh.normals {
             *n = -*n;
         }
+        let closed = if ch.check.closed() { "closed" } else { "open" };
         warnings.push(format!(
-            "the closed mesh faced inward (signed volume {:.6}); its triangles and normals were flipped",
+            "the {closed} mesh faced inward (signed volume {:.6}); its triangles and normals were flipped",
             ch.check.signed_volume
         ));
         ch.check.signed_volume = -ch.check.signed_volume;
@@ -121,10 +133,21 @@ impl Character {
         pose::gpu_joints(mats, method, &|j| self.joint_name(j))
     }
 
-    /// CPU-skinned positions and normals for joint matrices `mats`.
+    /// CPU-skinned positions and normals for joint matrices `mats`, morph targets at
+    /// their default weights.
     pub fn skinned_at(&self, mats: &[Mat4], method: Skinning) -> Result<(Vec<Vec3>, Vec<Vec3>)> {
+        self.skinned_with(mats, &self.mesh.morphs.defaults(), method)
+    }
+
+    /// The same with morph target weights `weights`.
+    pub fn skinned_with(
+        &self,
+        mats: &[Mat4],
+        weights: &[f32],
+        method: Skinning,
+    ) -> Result<(Vec<Vec3>, Vec<Vec3>)> {
         let joints = self.gpu_joints(mats, method)?;
-        Ok(cpu::skin(method, &joints, &self.mesh))
+        Ok(cpu::skin(method, &joints, &self.mesh, weights))
     }
 
     /// The rest pose's bounding box.
@@ -168,14 +191,44 @@ impl Character {
         }
     }
 
-    /// Refuse an open mesh where an inside test is needed, with the counts.
+    /// Refuse an open mesh where only a closed one will do, with the counts.
     pub fn require_closed(&self, why: &str) -> Result<()> {
         match self.check.closed() {
             true => Ok(()),
             false => Err(Error::Model {
                 path: self.source.clone(),
                 message: format!(
-                    "is not closed ({}), and {why} needs an inside test",
+                    "is not closed ({}), which {why} needs",
+                    self.check.describe()
+                ),
+            }),
+        }
+    }
+
+    /// Refuse a mesh with no inside (`rest`: its rest positions): an open one whose
+    /// generalized winding number is nowhere above 1/2 (a sheet). Probed just behind the
+    /// surface of up to 512 of its triangles: a solid's is about 1 there, a sheet's at most
+    /// 1/2.
+    pub fn require_solid(&self, rest: &[Vec3]) -> Result<()> {
+        if self.check.closed() {
+            return Ok(());
+        }
+        let idx = &self.mesh.indices;
+        let w = winding::FastWinding::new(rest, idx);
+        let (lo, hi) = check::bounds(rest);
+        let step = (idx.len() / 3).div_ceil(512).max(1);
+        let depth = 1e-3 * (hi - lo).length();
+        let solid = idx.chunks_exact(3).step_by(step).any(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| rest[t[k] as usize]);
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            n != Vec3::ZERO && w.inside((a + b + c) / 3.0 - n * depth)
+        });
+        match solid {
+            true => Ok(()),
+            false => Err(Error::Model {
+                path: self.source.clone(),
+                message: format!(
+                    "has no inside: its generalized winding number is nowhere above 1/2 (an open sheet, {}), so no fluid can fill it",
                     self.check.describe()
                 ),
             }),

@@ -25,6 +25,60 @@ pub struct Mesh {
     /// Triangle ranges with UVs of their own (a file's primitives), packed apart in the
     /// emission atlas; empty: the whole mesh is one UV set.
     pub uv_parts: Vec<UvPart>,
+    /// Morph targets, added to the rest vertices before skinning.
+    pub morphs: Morphs,
+}
+
+/// Morph targets: each a weight slot (one per target of each mesh node that has some), and
+/// per vertex its nonzero offsets, by vertex (CSR) so skinning reads only its own.
+#[derive(Clone, Debug, Default)]
+pub struct Morphs {
+    pub targets: Vec<MorphTarget>,
+    /// Vertex v's offsets are `deltas[start[v]..start[v + 1]]`; empty without targets.
+    pub start: Vec<u32>,
+    pub deltas: Vec<MorphDelta>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct MorphTarget {
+    /// The file's target name (the mesh's `extras.targetNames`), else "target K".
+    pub name: String,
+    /// The mesh node whose `weights` drive it, and its index among that mesh's targets.
+    pub node: usize,
+    pub index: usize,
+    /// The node's (else the mesh's, else 0) default weight.
+    pub default: f32,
+    /// Whether the file gave normal offsets (else normals do not follow).
+    pub normals: bool,
+}
+
+/// One vertex's offsets in one target.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MorphDelta {
+    pub target: u32,
+    pub position: Vec3,
+    pub normal: Vec3,
+}
+
+impl Morphs {
+    /// The default weight of every target.
+    pub fn defaults(&self) -> Vec<f32> {
+        self.targets.iter().map(|t| t.default).collect()
+    }
+
+    /// Vertex `v`'s position and normal with the targets at `weights`.
+    pub fn apply(&self, v: usize, p: Vec3, n: Vec3, weights: &[f32]) -> (Vec3, Vec3) {
+        let Some(range) = self.start.get(v..v + 2) else {
+            return (p, n);
+        };
+        let (mut p, mut n) = (p, n);
+        for d in &self.deltas[range[0] as usize..range[1] as usize] {
+            let w = weights.get(d.target as usize).copied().unwrap_or(0.0);
+            p += d.position * w;
+            n += d.normal * w;
+        }
+        (p, n)
+    }
 }
 
 /// `count` triangles from `first` sharing one UV set.
@@ -172,6 +226,8 @@ pub enum Property {
     Translation,
     Rotation,
     Scale,
+    /// The node's morph target K (a glTF `weights` channel, split per target; value in x).
+    Weight(u16),
 }
 
 /// One animated property of one node. Values are xyz(w); CUBICSPLINE stores three per key
@@ -193,6 +249,28 @@ pub struct Clip {
     pub channels: Vec<Channel>,
 }
 
+/// One mesh node of a file, as `inspect` and a run's report list it: its primitives'
+/// triangles, what places it, its morph targets and whether it is closed by itself.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeshPart {
+    pub node: String,
+    pub mesh: String,
+    pub primitives: usize,
+    pub triangles: usize,
+    /// "skin K 'name' (N joints)", or "rigid, follows its node".
+    pub placed_by: String,
+    pub morph_targets: usize,
+    pub boundary_edges: usize,
+    pub nonmanifold_edges: usize,
+    pub components: usize,
+}
+
+impl MeshPart {
+    pub fn closed(&self) -> bool {
+        self.boundary_edges == 0 && self.nonmanifold_edges == 0
+    }
+}
+
 /// Everything `inspect` reports and the scene needs.
 #[derive(Clone, Debug)]
 pub struct Character {
@@ -210,6 +288,8 @@ pub struct Character {
     /// The mesh faced inward and was flipped.
     pub flipped: bool,
     pub warnings: Vec<String>,
+    /// The file's mesh nodes (glTF; empty for OBJ and built-in shapes: one part).
+    pub parts: Vec<MeshPart>,
     /// The built-in characters' capsules (empty for loaded ones: capsules::of fits them).
     pub capsules: Vec<super::capsules::BoneCapsule>,
 }

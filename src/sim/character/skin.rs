@@ -19,6 +19,7 @@ crate::gpu_interface! {
     /// glsl/character/skin.comp
     pub SkinIo / SkinBufs: "SKIN", push SkinPush {
         joints = 0, rest_pos = 1, rest_nrm = 2, joint_ids = 3, weights = 4, out_pos = 5, out_nrm = 6,
+        morph_start = 7, morph_deltas = 8, morph_weights = 9,
     }
 }
 
@@ -87,6 +88,9 @@ impl SkinPass {
             weights: &m.weights,
             out_pos: &m.pos,
             out_nrm: &m.nrm,
+            morph_start: &m.morph_start,
+            morph_deltas: &m.morph_deltas,
+            morph_weights: &m.morph_weights,
         };
         self.pipeline.dispatch(
             ctx,
@@ -104,10 +108,16 @@ impl SkinPass {
 }
 crate::impl_destroy!(SkinPass);
 
-/// A mesh on the GPU: rest vertices and influences, the joints, the skinned output
-/// (vec4 positions and normals) and the triangle indices for drawing.
+/// A mesh on the GPU: rest vertices and influences, morph targets (each vertex's offsets,
+/// by vertex), the joints and target weights, the skinned output (vec4 positions and
+/// normals) and the triangle indices for drawing.
 pub struct SkinnedMesh {
     pub joints: Buffer,
+    morph_start: Buffer,
+    morph_deltas: Buffer,
+    morph_weights: Buffer,
+    /// Morph targets (weights `set_weights` takes).
+    pub targets: usize,
     rest_pos: Buffer,
     rest_nrm: Buffer,
     joint_ids: Buffer,
@@ -173,6 +183,30 @@ impl SkinnedMesh {
         let out_pos = buf("skinned positions", vb)?;
         let out_nrm = buf("skinned normals", vb)?;
         let mut indices = buf("mesh indices", mesh.indices.len() as u64 * 4)?;
+        // Morph offsets: per vertex a range of (position, target bits) and normal pairs.
+        let m = &mesh.morphs;
+        let start = match m.start.len() == n + 1 {
+            true => m.start.clone(),
+            false => vec![0u32; n + 1],
+        };
+        let deltas: Vec<[f32; 4]> = (m.deltas.iter())
+            .flat_map(|d| {
+                let t = f32::from_bits(d.target);
+                [
+                    d.position.extend(t).to_array(),
+                    d.normal.extend(0.0).to_array(),
+                ]
+            })
+            .collect();
+        let targets = m.targets.len();
+        let mut morph_start = buf("morph starts", start.len() as u64 * 4)?;
+        let mut morph_deltas = buf("morph offsets", (deltas.len() as u64 * 16).max(32))?;
+        let mut morph_weights = buf("morph weights", (targets as u64 * 4).max(4))?;
+        ctx.upload(&mut morph_start, 0, &start)?;
+        if !deltas.is_empty() {
+            ctx.upload(&mut morph_deltas, 0, &deltas)?;
+            ctx.upload(&mut morph_weights, 0, &m.defaults())?;
+        }
         ctx.upload(&mut rest_pos, 0, &pos)?;
         ctx.upload(&mut rest_nrm, 0, &nrm)?;
         ctx.upload(&mut joint_ids, 0, &ids)?;
@@ -180,6 +214,10 @@ impl SkinnedMesh {
         ctx.upload(&mut indices, 0, &mesh.indices)?;
         Ok(Self {
             joints: joints.take(),
+            morph_start: morph_start.take(),
+            morph_deltas: morph_deltas.take(),
+            morph_weights: morph_weights.take(),
+            targets,
             rest_pos: rest_pos.take(),
             rest_nrm: rest_nrm.take(),
             joint_ids: joint_ids.take(),
@@ -222,9 +260,32 @@ impl SkinnedMesh {
         Ok(())
     }
 
+    /// Record the upload of this frame's morph target weights (tracked like the joints').
+    pub fn set_weights(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        weights: &[f32],
+    ) -> Result<()> {
+        if weights.len() != self.targets {
+            return Err(Error::Param(format!(
+                "{} morph weights for a mesh with {} targets",
+                weights.len(),
+                self.targets
+            )));
+        }
+        for (k, chunk) in weights.chunks(16384).enumerate() {
+            ctx.update(cmd, &self.morph_weights, (k * 16384 * 4) as u64, chunk);
+        }
+        Ok(())
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         for b in [
             &mut self.joints,
+            &mut self.morph_start,
+            &mut self.morph_deltas,
+            &mut self.morph_weights,
             &mut self.rest_pos,
             &mut self.rest_nrm,
             &mut self.joint_ids,
@@ -255,10 +316,17 @@ impl Skinner {
         })
     }
 
-    /// Record the joints' upload and the skinning; the caller makes `mesh.pos`/`mesh.nrm`
-    /// visible to what reads them.
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, joints: &[GpuJoint]) -> Result<()> {
+    /// Record the joints' and morph weights' upload and the skinning; the caller makes
+    /// `mesh.pos`/`mesh.nrm` visible to what reads them.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        joints: &[GpuJoint],
+        weights: &[f32],
+    ) -> Result<()> {
         self.mesh.set_pose(ctx, cmd, joints)?;
+        self.mesh.set_weights(ctx, cmd, weights)?;
         self.pass.record(ctx, cmd, &self.mesh)
     }
 

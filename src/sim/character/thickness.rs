@@ -6,6 +6,7 @@
 //! joint, so its regions are the cells of a coarse grid over its placed rest pose, named
 //! by where they lie (+Y up, +Z the front, +X the character's left).
 use super::model::Character;
+use super::winding::FastWinding;
 use crate::error::Result;
 use glam::{Mat3, Vec3};
 
@@ -28,7 +29,9 @@ pub struct Region {
 /// up axis and rotation; only names the static mesh's cells), thinnest first.
 pub fn regions(ch: &Character, orient: Mat3) -> Result<Vec<Region>> {
     let (pos, nrm) = ch.skinned_at(&ch.rest_matrices(), crate::character::Skinning::Lbs)?;
-    let t = per_vertex(&pos, &nrm, &ch.mesh.indices);
+    // An open mesh's rays start on the side its winding number calls inside.
+    let open = (!ch.check.closed()).then(|| FastWinding::new(&pos, &ch.mesh.indices));
+    let t = per_vertex(&pos, &nrm, &ch.mesh.indices, open.as_ref());
     let joints = ch.skeleton.joints.len();
     let (keys, names): (Vec<usize>, Vec<String>) = match joints > 1 {
         true => (
@@ -90,14 +93,29 @@ fn cells(pos: &[Vec3], orient: Mat3) -> (Vec<usize>, Vec<String>) {
 }
 
 /// Each vertex's thickness: the distance along -normal to the nearest other triangle
-/// (None where the ray leaves the mesh without a hit: an open part).
-pub fn per_vertex(pos: &[Vec3], nrm: &[Vec3], idx: &[u32]) -> Vec<Option<f32>> {
+/// (None where the ray leaves the mesh without a hit: an open part). With `open` (an open
+/// mesh's winding number), the ray goes to whichever side of the vertex is inside, and a
+/// vertex with neither side inside (a sheet) has none.
+pub fn per_vertex(
+    pos: &[Vec3],
+    nrm: &[Vec3],
+    idx: &[u32],
+    open: Option<&FastWinding>,
+) -> Vec<Option<f32>> {
     let grid = Grid::new(pos, idx);
     let eps = 1e-4 * grid.diag;
+    let probe = 1e-3 * grid.diag;
     pos.iter()
         .zip(nrm)
         .map(|(p, n)| {
-            let d = -n.normalize_or_zero();
+            let mut d = -n.normalize_or_zero();
+            if let Some(w) = open {
+                d = match (w.inside(*p + d * probe), w.inside(*p - d * probe)) {
+                    (true, _) => d,
+                    (false, true) => -d,
+                    (false, false) => Vec3::ZERO,
+                };
+            }
             (d != Vec3::ZERO)
                 .then(|| grid.cast(pos, idx, *p, d, eps))
                 .flatten()

@@ -72,20 +72,21 @@ fn voxels(
 ) -> Voxels {
     let (mut interior, mut filled, mut occupied_out) = (0usize, 0usize, 0usize);
     let mut interior_set = HashSet::new();
-    for z in 0..dims.z {
-        for y in 0..dims.y {
-            for x in 0..dims.x {
-                let v = IVec3::new(x, y, z);
-                let c = lo + (v.as_vec3() + 0.5) * s;
-                let occupied = occupied(c);
-                if inside.inside(c) {
-                    interior += 1;
-                    interior_set.insert(v);
-                    filled += occupied as usize;
-                } else {
-                    occupied_out += occupied as usize;
-                }
-            }
+    let (centres, ins) = inside.voxels(lo, dims.as_uvec3(), s);
+    let (dx, dy) = (dims.x as usize, dims.y as usize);
+    for (i, (c, is_in)) in centres.into_iter().zip(ins).enumerate() {
+        let v = IVec3::new(
+            (i % dx) as i32,
+            (i / dx % dy) as i32,
+            (i / (dx * dy)) as i32,
+        );
+        let occupied = occupied(c);
+        if is_in {
+            interior += 1;
+            interior_set.insert(v);
+            filled += occupied as usize;
+        } else {
+            occupied_out += occupied as usize;
         }
     }
     Voxels {

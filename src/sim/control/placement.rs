@@ -27,18 +27,17 @@ pub fn lattice(mesh: RestMesh, spacing: f32) -> Vec<Vec3> {
     let inside = InsideTest::new(mesh.0, mesh.1);
     let (lo, hi) = check::bounds(mesh.0);
     let dims = ((hi - lo) / spacing).ceil().as_uvec3();
-    let mut out = Vec::new();
-    for k in 0..dims.z {
-        for j in 0..dims.y {
-            for i in 0..dims.x {
-                let p = lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * spacing;
-                if inside.inside(p) {
-                    out.push(p);
-                }
-            }
-        }
-    }
-    out
+    let (centres, kept) = inside.voxels(lo, dims, spacing);
+    keep(centres, &kept)
+}
+
+fn keep(points: Vec<Vec3>, kept: &[bool]) -> Vec<Vec3> {
+    points
+        .into_iter()
+        .zip(kept)
+        .filter(|(_, k)| **k)
+        .map(|(p, _)| p)
+        .collect()
 }
 
 /// Ratio of the Poisson-disk radius to the spacing: a maximal Poisson-disk set of radius r
@@ -108,7 +107,8 @@ pub fn random(mesh: RestMesh, spacing: f32, seed: u64) -> Vec<Vec3> {
             active.swap_remove(k);
         }
     }
-    pts.into_iter().filter(|p| inside.inside(*p)).collect()
+    let kept = inside.inside_all(&pts);
+    keep(pts, &kept)
 }
 
 /// Control particles of `ch` (rest positions `rest`, placed) by `how` at `spacing`.
@@ -128,13 +128,15 @@ pub fn place(
     let pts = match how {
         Placement::Vertices => vertices(rest),
         Placement::Random => {
-            ch.require_closed("--placement random")?;
+            ch.require_solid(rest)?;
             random(mesh, spacing, seed)
         }
         // Placed on the GPU every frame (control::rays); here the rest pose's lattice,
         // which sizes its buffers.
         Placement::Rays => {
-            ch.require_closed("--placement rays")?;
+            ch.require_closed(
+                "--placement rays (GPU ray crossings; --placement random takes open meshes)",
+            )?;
             lattice(mesh, spacing)
         }
     };

@@ -304,12 +304,15 @@ impl ControlTarget {
             weights,
             influence_sets: sets.min(MAX_INFLUENCES / 4),
             uv_parts: Vec::new(),
+            morphs: Default::default(),
         };
         let rest_inv = rest_inverses(ch, &placed_rest)?;
         let settings = desc.settings(fluid);
         let fill = match desc.deficit()? {
             Deficit::Shape => {
-                let volume = check::signed_volume(&rest_mesh, &ch.mesh.indices).abs() as f32;
+                let idx = &ch.mesh.indices;
+                let volume = crate::character::inside::volume(&rest_mesh, idx, spacing).0;
+                let volume = volume as f32;
                 Some(placement::fill(&mesh.positions, volume, fluid.h))
             }
             Deficit::Rest => None,

@@ -80,6 +80,12 @@ impl SceneCharacter {
         placed_matrices(&self.ch, &self.anim, self.speed, self.path.as_ref(), t)
     }
 
+    /// The morph target weights at scene time `t` (the clip's time, as `matrices`).
+    pub fn morph_weights(&self, t: f64) -> Vec<f32> {
+        self.anim
+            .morph_weights(&self.ch, (t * self.speed as f64) as f32)
+    }
+
     /// The skinned positions (vec4 per vertex) of the last `record`.
     pub fn skinned(&self) -> &crate::gpu::Buffer {
         &self.skinner.mesh.pos
@@ -96,9 +102,10 @@ impl SceneCharacter {
     ) -> Result<()> {
         let mats = self.matrices(t);
         let joints = self.ch.gpu_joints(&mats, self.method)?;
+        let weights = self.morph_weights(t);
         {
             let _scope = prof.open(ctx, cmd, crate::character::skin::SKIN.scope());
-            self.skinner.record(ctx, cmd, &joints)?;
+            self.skinner.record(ctx, cmd, &joints, &weights)?;
         }
         Ok(())
     }
