@@ -47,6 +47,19 @@ pub enum BenchWhat {
     /// each at its own stable step and at mean density error <= 1% and <= 0.1%; times
     /// --frames frames of 20 ms after --warmup frames
     Solvers(SphBench),
+    /// The inside test (crossings on a closed mesh, the winding number on an open one)
+    /// voxelising a character at the fit's finest spacing, as loaded and refined to about
+    /// --triangles triangles with holes cut (CPU; --frames timed rounds)
+    Inside {
+        #[command(flatten)]
+        common: CommonArgs,
+        /// Character file (.glb, .gltf, .obj) or builtin:walker (the default)
+        #[arg(long = "character", value_name = "FILE")]
+        file: Option<String>,
+        /// Triangles of the refined, open copy (default 50000)
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=(1 << 24)))]
+        triangles: Option<u32>,
+    },
     /// GPU skinning per method (or --skinning) on a character and on a generated mesh
     Skin {
         #[command(flatten)]
@@ -168,6 +181,14 @@ impl BenchWhat {
     fn into_parts(self) -> (Bench, Switches, Option<String>, Option<u32>, Vec<f32>) {
         let d = Switches::default;
         let (what, sw) = match self {
+            BenchWhat::Inside {
+                common,
+                file,
+                triangles,
+            } => {
+                let sw = Switches { common, ..d() };
+                return (Bench::Inside, sw, file, triangles, Vec::new());
+            }
             BenchWhat::Skin {
                 common,
                 character,

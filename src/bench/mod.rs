@@ -5,6 +5,7 @@ pub mod args;
 pub mod control;
 pub mod emission;
 pub mod floor;
+pub mod inside;
 pub mod interval;
 pub mod march;
 pub mod particles;
@@ -36,6 +37,7 @@ fluidform_gpu::switch_enum!(
         Render,
         March,
         Skin,
+        Inside,
         Control,
         Emission,
         Particles
@@ -77,7 +79,8 @@ pub struct BenchOptions {
     /// bench skin: the character file (default builtin:walker); bench control: the scene
     /// (default giraffe).
     pub character: Option<String>,
-    /// bench skin: vertices of the generated mesh (default 1M).
+    /// bench skin: vertices of the generated mesh (default 1M); bench inside: triangles of
+    /// the refined, open copy (default 50K).
     pub vertices: Option<u32>,
     /// bench control: velocity-term gains to sweep (empty: --control-velocity or 0).
     pub velocities: Vec<f32>,
@@ -211,6 +214,10 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         Bench::Skin => {
             sw.reject_unused("bench skin", &[Group::Character])?;
             skin::skin(&ctx, opts)?
+        }
+        Bench::Inside => {
+            sw.reject_unused("bench inside", &[])?;
+            inside::inside(opts)?
         }
         Bench::Control => {
             sw.reject_unused(

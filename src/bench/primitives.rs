@@ -326,6 +326,7 @@ pub fn notes(what: super::Bench, rows: &[Row]) -> Vec<String> {
         Bench::Render => render_notes(rows),
         Bench::March => super::march::notes(rows),
         Bench::Scan => scan_notes(rows),
+        Bench::Inside => super::inside::notes(rows),
         Bench::Stability | Bench::Skin | Bench::Control => Vec::new(),
     }
 }

@@ -80,7 +80,7 @@ pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Re
     let cam = match &scene.camera {
         Some(c) => Camera::look_at(c.eye.into(), c.target.into(), c.fov, aspect),
         None => {
-            let st = character.stats()?;
+            let st = character.stats(None)?;
             let h = st.height.max(1e-3);
             let base = character.anim.placement.w_axis.truncate();
             let c = base + glam::Vec3::Y * 0.5 * h;
@@ -101,7 +101,7 @@ pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Re
     };
     let memory = ctx.memory_bytes();
     let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
-    let stats = work.character.stats();
+    let stats = work.character.stats(None);
     let render = work.view.stats();
     work.character.destroy(&ctx);
     work.view.destroy(&ctx);

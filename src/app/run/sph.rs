@@ -446,7 +446,7 @@ impl SphWork {
         let density_error = self.stepper.error_stats(&self.st);
         let steps_csv = self.stepper.write_csv(&opts.out.join("steps.csv"));
         let render_stats = self.view.stats();
-        let character_stats = self.targets.character_stats();
+        let character_stats = (self.targets).character_stats(scene.fluid.spacing());
         let control_stats = self.targets.control_summary(&opts.out);
         let emission_stats = match ok {
             true => self

@@ -66,11 +66,14 @@ pub struct Fitted {
     pub thin: Option<String>,
     /// An open mesh's counts and how its volume was measured, in one line.
     pub open: Option<String>,
+    /// The clip that plays and the parts that are open, in one line.
+    pub character: Option<String>,
 }
 
 impl Fitted {
     pub fn describe(&self) -> Vec<String> {
-        let mut out: Vec<String> = self.open.iter().cloned().collect();
+        let mut out: Vec<String> = self.character.iter().cloned().collect();
+        out.extend(self.open.clone());
         if let Some((s, why)) = &self.spacing {
             out.push(format!(
                 "spacing {s:.4} m ({why}; --fluid spacing=S overrides)"
@@ -96,6 +99,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         pool: None,
         thin: None,
         open: None,
+        character: None,
     };
     let Some(desc) = scene.character.clone() else {
         if scene.pool.is_some() {
@@ -110,6 +114,7 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
         return Ok(out);
     }
     let (ch, anim) = desc.load()?;
+    out.character = Some(plays(&ch, &anim));
     let (lo, hi) = placed_rest_bounds(&ch, &anim)?;
     let scale = anim.placement.x_axis.truncate().length();
     let height = hi.y - lo.y;
@@ -235,6 +240,33 @@ fn thin(parts: &[Region], scale: f32, s: f32, water: f32) -> Option<String> {
         )
     })
 }
+
+/// Which clip plays and which parts are open (the first few named).
+fn plays(ch: &crate::character::Character, anim: &crate::character::Animator) -> String {
+    let clip = match anim.clip {
+        Some(c) => format!("clip '{}'", ch.clips[c].name),
+        None => "no clip (the rest pose)".into(),
+    };
+    let open = ch.open_parts();
+    let parts = ch.parts.len().max(1);
+    let named: Vec<&str> = open.iter().take(SHOWN_OPEN).map(String::as_str).collect();
+    let more = match open.len().saturating_sub(SHOWN_OPEN) {
+        0 => String::new(),
+        k => format!(" and {k} more (inspect FILE lists them)"),
+    };
+    match open.is_empty() {
+        true => format!("{} plays {clip}; closed ({parts} parts)", ch.source),
+        false => format!(
+            "{} plays {clip}; {} of {parts} parts open: {}{more}",
+            ch.source,
+            open.len(),
+            named.join(", ")
+        ),
+    }
+}
+
+/// Open parts named by the fit's line.
+const SHOWN_OPEN: usize = 4;
 
 /// Parts named by the fit's line on thin parts.
 const SHOWN: usize = 3;

@@ -180,6 +180,26 @@ impl Character {
         })
     }
 
+    /// The parts that are open, each with its counts (the whole mesh when the file has no
+    /// parts of its own).
+    pub fn open_parts(&self) -> Vec<String> {
+        if self.parts.is_empty() {
+            return match self.check.closed() {
+                true => Vec::new(),
+                false => vec![format!("the mesh ({})", self.check.describe())],
+            };
+        }
+        (self.parts.iter())
+            .filter(|p| !p.closed())
+            .map(|p| {
+                format!(
+                    "'{}' ({} boundary, {} non-manifold edges)",
+                    p.node, p.boundary_edges, p.nonmanifold_edges
+                )
+            })
+            .collect()
+    }
+
     /// Refuse a static mesh where a skin is needed.
     pub fn require_skin(&self, why: &str) -> Result<()> {
         match self.skinned {

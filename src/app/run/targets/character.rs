@@ -24,6 +24,19 @@ pub struct CharacterStats {
     pub show_mesh: ShowMesh,
     /// Rest height after placement (metres).
     pub height: f32,
+    /// The file's parts that are open, with their counts (filled by the winding number).
+    pub open_parts: Vec<String>,
+    /// The surface's regions under `WANT` (3) particle spacings across at the run's
+    /// spacing, thinnest first (empty without fluid).
+    pub thin_parts: Vec<ThinPart>,
+}
+
+/// A region thinner than the fluid resolves well.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ThinPart {
+    pub region: String,
+    /// Its thickness in particle spacings.
+    pub spacings: f32,
 }
 
 /// A placed character skinned each frame.
@@ -132,7 +145,8 @@ impl SceneCharacter {
         }
     }
 
-    pub fn stats(&self) -> Result<CharacterStats> {
+    /// The stats, with the parts thinner than three spacings at `spacing` (the fluid's).
+    pub fn stats(&self, spacing: Option<f32>) -> Result<CharacterStats> {
         let rest = self.ch.rest_matrices();
         let placed: Vec<Mat4> = rest.iter().map(|m| self.anim.placement * *m).collect();
         let (p, _) = self.ch.skinned_at(&placed, Skinning::Lbs)?;
@@ -146,7 +160,26 @@ impl SceneCharacter {
             skinning: self.method,
             show_mesh: self.show,
             height: hi.y - lo.y,
+            open_parts: self.ch.open_parts(),
+            thin_parts: match spacing {
+                Some(s) => self.thin_parts(s)?,
+                None => Vec::new(),
+            },
         })
+    }
+
+    /// Regions under `WANT` spacings across at spacing `s` (metres), in the placed scale.
+    fn thin_parts(&self, s: f32) -> Result<Vec<ThinPart>> {
+        let m = glam::Mat3::from_mat4(self.anim.placement);
+        let scale = m.x_axis.length();
+        let regions = character::thickness::regions(&self.ch, m * (1.0 / scale.max(1e-12)))?;
+        Ok((regions.into_iter())
+            .map(|r| ThinPart {
+                region: r.name,
+                spacings: r.thickness * scale / s,
+            })
+            .filter(|t| t.spacings < crate::scene::fit::WANT)
+            .collect())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -444,9 +444,10 @@ impl SceneTargets {
         Ok(())
     }
 
-    /// `stats.character`: the first character's.
-    pub fn character_stats(&self) -> Result<Option<CharacterStats>> {
-        self.live.first().map(|l| l.character.stats()).transpose()
+    /// `stats.character`: the first character's (thin parts at the fluid's `spacing`).
+    pub fn character_stats(&self, spacing: f32) -> Result<Option<CharacterStats>> {
+        let first = self.live.first();
+        first.map(|l| l.character.stats(Some(spacing))).transpose()
     }
 
     /// `stats.control` (None without control targets), and control.csv in `out`: every
