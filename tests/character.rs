@@ -399,7 +399,7 @@ fn triangle_gltf(mode: u32, extra_accessor: Option<serde_json::Value>) -> serde_
     for c in [2f32, 0.0, 0.0] {
         buf.extend(c.to_le_bytes());
     }
-    let b64 = encode(&buf);
+    let b64 = common::gltf::encode(&buf);
     let mut acc = serde_json::json!({
         "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
         "min": [0, 0, 0], "max": [2, 1, 0]
@@ -424,28 +424,8 @@ fn triangle_gltf(mode: u32, extra_accessor: Option<serde_json::Value>) -> serde_
     })
 }
 
-fn encode(b: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in b.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                s.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
-}
-
 fn write_json(dir: &std::path::Path, name: &str, v: &serde_json::Value) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, serde_json::to_string(v).unwrap()).unwrap();
-    p.display().to_string()
+    common::gltf::write(dir, name, v)
 }
 
 #[test]

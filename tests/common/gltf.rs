@@ -97,7 +97,7 @@ pub fn write(dir: &std::path::Path, name: &str, doc: &Value) -> String {
     p.display().to_string()
 }
 
-fn encode(b: &[u8]) -> String {
+pub fn encode(b: &[u8]) -> String {
     const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::new();
     for c in b.chunks(3) {
