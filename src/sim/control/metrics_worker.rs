@@ -31,12 +31,12 @@ pub(super) struct Job {
     pub live: u32,
 }
 
-/// The target's character posed by the frame's joint matrices and by those `dt` seconds
-/// before (its skin speed).
+/// The target's character posed by the frame's joint matrices and morph weights, and by
+/// those `dt` seconds before (its skin speed).
 pub struct Skin {
     pub ch: Arc<Character>,
-    pub mats: Vec<Mat4>,
-    pub before: Vec<Mat4>,
+    pub mats: (Vec<Mat4>, Vec<f32>),
+    pub before: (Vec<Mat4>, Vec<f32>),
     pub method: Skinning,
     pub dt: f64,
 }
@@ -45,8 +45,8 @@ pub struct Skin {
 /// particles and the density error.
 pub(super) fn compute(j: &Job) -> Result<ControlRow> {
     let k = &j.skin;
-    let (posed, _) = k.ch.skinned_at(&k.mats, k.method)?;
-    let (prev, _) = k.ch.skinned_at(&k.before, k.method)?;
+    let (posed, _) = k.ch.skinned_with(&k.mats.0, &k.mats.1, k.method)?;
+    let (prev, _) = k.ch.skinned_with(&k.before.0, &k.before.1, k.method)?;
     let skin_speed = (posed.iter().zip(&prev))
         .map(|(a, b)| (*a - *b).length())
         .fold(0.0, f32::max)

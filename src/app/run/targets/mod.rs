@@ -42,7 +42,8 @@ pub struct ControlSummary {
 }
 
 /// A frame's placed joint matrices, those a moment before, and the scene time.
-type FramePose = (Vec<Mat4>, Vec<Mat4>, f64);
+/// The frame's joint matrices and morph weights, those a moment before, and its time.
+type FramePose = ((Vec<Mat4>, Vec<f32>), (Vec<Mat4>, Vec<f32>), f64);
 
 struct Live {
     name: String,
@@ -295,8 +296,8 @@ impl SceneTargets {
                 true => t - SKIN_SPEED_DT,
                 false => t + SKIN_SPEED_DT,
             };
-            let before = ch.matrices(moment);
-            l.poses[slot] = Some((mats, before, t));
+            let before = (ch.matrices(moment), ch.morph_weights(moment));
+            l.poses[slot] = Some(((mats, ch.morph_weights(t)), before, t));
         }
         Ok(())
     }
