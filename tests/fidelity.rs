@@ -3,6 +3,7 @@
 //! spray, density in the shape, speed excess and the surface distance.
 use fluidform::character::procedural::polygonise;
 use fluidform::control::fidelity::{measure, Fluid, Frame};
+use fluidform::control::inside::InsideTest;
 use fluidform::control::mesh_distance::{tri_distance, SurfaceDistance};
 use glam::Vec3;
 
@@ -55,7 +56,8 @@ fn run(
         rho: &rho,
         controlled: &controlled,
     };
-    measure(&frame, (&mesh.0, &mesh.1), 0.5, &fluid())
+    let inside = InsideTest::new(&mesh.0, &mesh.1);
+    measure(&frame, ((&mesh.0, &mesh.1), &inside), 0.5, &fluid())
 }
 
 #[test]

@@ -18,7 +18,13 @@ const BLINK: [f32; 3] = [0.0, 0.0, 0.25];
 /// 90 degrees about y and takes the weights from (0, 0) to (1, 0.5) over a second.
 /// `blink_count`: the vertices 'Blink's POSITION accessor claims (8 is right).
 fn morph_cube(blink_count: usize) -> serde_json::Value {
-    let (p, idx) = cube();
+    morph_cube_with(blink_count, |_| {})
+}
+
+/// The same with its triangle list changed by `edit` (reversed, a face removed).
+fn morph_cube_with(blink_count: usize, edit: impl Fn(&mut Vec<u16>)) -> serde_json::Value {
+    let (p, mut idx) = cube();
+    edit(&mut idx);
     let top = |v: &[f32; 3]| v[1] > 0.5;
     let mut d = Doc::default();
     let pos = d.vec3(&p);
@@ -316,5 +322,51 @@ fn two_skins_place_their_own_parts() {
         "'hat' (mesh 'mesh1')",
     ] {
         assert!(text.contains(needle), "'{needle}' in:\n{text}");
+    }
+}
+
+#[test]
+fn an_inward_cube_is_flipped_with_its_morph_normals_closed_or_open() {
+    let dir = tempfile::tempdir().unwrap();
+    let load = |name: &str, doc: serde_json::Value| {
+        character::load(&write(dir.path(), name, &doc)).unwrap()
+    };
+    let plain = load("plain.gltf", morph_cube(8));
+    let reverse = |i: &mut Vec<u16>| i.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+    // Inward and closed (by its signed volume), and inward with one face missing (open: by
+    // its winding number behind its triangles).
+    let closed = load("inward.gltf", morph_cube_with(8, reverse));
+    let open = load(
+        "inward_open.gltf",
+        morph_cube_with(8, |i| {
+            reverse(i);
+            i.truncate(i.len() - 6);
+        }),
+    );
+    let flags = (plain.flipped, closed.flipped, open.flipped);
+    assert_eq!(
+        flags,
+        (false, true, true),
+        "{:?} {:?}",
+        closed.warnings,
+        open.warnings
+    );
+    assert!(!open.check.closed(), "{:?}", open.check);
+    assert!(
+        open.warnings
+            .iter()
+            .any(|w| w.contains("open mesh faced inward")),
+        "{:?}",
+        open.warnings
+    );
+    // Flipped normals are the plain file's turned around, morph offsets included.
+    let a = anim(&plain);
+    let (mats, w) = (a.joint_matrices(&plain, 0.5), a.morph_weights(&plain, 0.5));
+    let (_, n0) = plain.skinned_with(&mats, &w, Skinning::Lbs).unwrap();
+    for ch in [&closed, &open] {
+        let (_, n1) = ch.skinned_with(&mats, &w, Skinning::Lbs).unwrap();
+        for (v, (a, b)) in n0.iter().zip(&n1).enumerate() {
+            assert!((*a + *b).length() < 1e-5, "normal {v}: {a} vs {b}");
+        }
     }
 }

@@ -75,7 +75,7 @@ fn an_open_many_part_robot_is_filled_by_the_winding_number() {
     }
     // Its volume by voxels is within a tenth of the lattice count's (the same test, two
     // resolutions), and not the signed volume, which counts the overlapping parts twice.
-    let (v, voxels) = character::inside::volume(&rest, idx, spacing / 2.0);
+    let (v, voxels) = character::inside::volume(&rest, idx, spacing / 2.0, false);
     assert!(voxels.is_some());
     let lattice = placement::lattice((&rest, idx), spacing).len() as f64 * (spacing as f64).powi(3);
     assert!(
@@ -104,7 +104,7 @@ fn a_closed_character_keeps_its_crossing_answers() {
     }
     assert!(all.iter().filter(|a| **a).count() > 40);
     // Its volume is its signed volume, exactly.
-    let (v, voxels) = character::inside::volume(&rest, idx, 0.01);
+    let (v, voxels) = character::inside::volume(&rest, idx, 0.01, true);
     assert!(voxels.is_none());
     assert_eq!(v, check::signed_volume(&rest, idx).abs());
 }

@@ -21,7 +21,8 @@ layout(std430, binding = SKIN_B_OUT_POS) writeonly buffer OutPos { vec4 out_pos[
 layout(std430, binding = SKIN_B_OUT_NRM) writeonly buffer OutNrm { vec4 out_nrm[]; };
 // Morph targets, added before skinning: vertex v's offsets are entries
 // morph_start[v] .. morph_start[v + 1], each a position offset (its target's index in w,
-// as bits) and a normal offset; every vertex's range is empty without targets.
+// a float holding an integer) and a normal offset; every vertex's range is empty without
+// targets.
 layout(std430, binding = SKIN_B_MORPH_START) readonly buffer MorphStart { uint morph_start[]; };
 layout(std430, binding = SKIN_B_MORPH_DELTAS) readonly buffer MorphDeltas { vec4 morph_deltas[]; };
 layout(std430, binding = SKIN_B_MORPH_WEIGHTS) readonly buffer MorphWeights { float morph_weights[]; };
@@ -38,7 +39,7 @@ void main() {
     vec3 n = rest_nrm[v].xyz;
     for (uint e = morph_start[v]; e < morph_start[v + 1u]; ++e) {
         vec4 dp = morph_deltas[2u * e];
-        float w = morph_weights[floatBitsToUint(dp.w)];
+        float w = morph_weights[uint(dp.w)];
         p += w * dp.xyz;
         n += w * morph_deltas[2u * e + 1u].xyz;
     }

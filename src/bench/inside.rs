@@ -41,6 +41,12 @@ pub fn inside(opts: &BenchOptions) -> Result<Vec<Row>> {
     let (lo, hi) = check::bounds(&rest);
     let side = (hi - lo).max_element() / FINEST;
     let want = opts.vertices.unwrap_or(TRIANGLES) as usize;
+    if ch.mesh.indices.is_empty() {
+        return Err(crate::Error::Model {
+            path: file,
+            message: "has no triangles to voxelise".into(),
+        });
+    }
     let (mut pos, mut idx) = (rest.clone(), ch.mesh.indices.clone());
     while idx.len() / 3 < want {
         idx = refine(&mut pos, &idx);
@@ -84,7 +90,10 @@ pub fn inside(opts: &BenchOptions) -> Result<Vec<Row>> {
             reps: ms.len() as u64,
             extra: vec![
                 ("test".into(), test_kind.into()),
-                ("voxels".into(), (dims.x * dims.y * dims.z).to_string()),
+                (
+                    "voxels".into(),
+                    dims.as_u64vec3().element_product().to_string(),
+                ),
                 ("inside".into(), inside.to_string()),
                 ("threads".into(), threads.to_string()),
             ],

@@ -123,13 +123,14 @@ pub fn fit(scene: &mut Scene) -> Result<Fitted> {
     let started = std::time::Instant::now();
     let rest = ch.rest_positions()?;
     let side = height / scale / FINEST;
-    let (volume, voxels) = crate::character::inside::volume(&rest, &ch.mesh.indices, side);
+    let closed = ch.check.closed();
+    let (volume, voxels) = crate::character::inside::volume(&rest, &ch.mesh.indices, side, closed);
     let volume = volume as f32 * scale.powi(3);
-    out.open = voxels.map(|n| {
+    out.open = voxels.map(|(n, side)| {
         format!(
             "open mesh ({}): volume {volume:.4} m^3 from {n} voxels of {:.4} m inside by the winding number, in {:.0} ms",
             ch.check.describe(),
-            side * scale,
+            side as f32 * scale,
             started.elapsed().as_secs_f64() * 1e3
         )
     });

@@ -23,7 +23,15 @@ pub enum InsideTest {
 impl InsideTest {
     /// Crossings when the mesh is closed (after welding), else the winding number.
     pub fn new(positions: &[Vec3], indices: &[u32]) -> Self {
-        match super::check::check(positions, indices).closed() {
+        let closed = super::check::check(positions, indices).closed();
+        Self::of(positions, indices, closed)
+    }
+
+    /// Crossings when `closed`, else the winding number: a character's test, decided once
+    /// by its own check at the rest pose (welding posed vertices could decide otherwise on
+    /// some frame).
+    pub fn of(positions: &[Vec3], indices: &[u32], closed: bool) -> Self {
+        match closed {
             true => Self::Closed(Crossings::new(positions, indices)),
             false => Self::Open(FastWinding::new(positions, indices)),
         }
@@ -60,7 +68,7 @@ impl InsideTest {
 
     /// The centres of `dims` voxels of side `s` from `lo` (x fastest) and which are inside.
     pub fn voxels(&self, lo: Vec3, dims: glam::UVec3, s: f32) -> (Vec<Vec3>, Vec<bool>) {
-        let mut centres = Vec::with_capacity((dims.x * dims.y * dims.z) as usize);
+        let mut centres = Vec::with_capacity(dims.x as usize * dims.y as usize * dims.z as usize);
         for k in 0..dims.z {
             for j in 0..dims.y {
                 for i in 0..dims.x {
@@ -186,16 +194,39 @@ pub fn winding_number(positions: &[Vec3], indices: &[u32], p: Vec3) -> f64 {
     sum / (4.0 * std::f64::consts::PI)
 }
 
+/// Voxels a volume may take: a finer side is coarsened to hold it.
+const MAX_VOXELS: f64 = 16.0 * 1024.0 * 1024.0;
+
 /// The volume a mesh holds: a closed one's signed volume (exact); an open one's voxels of
-/// side `side` inside by the winding number, with the voxel count.
-pub fn volume(positions: &[Vec3], indices: &[u32], side: f32) -> (f64, Option<usize>) {
-    match InsideTest::new(positions, indices) {
-        InsideTest::Closed(_) => (super::check::signed_volume(positions, indices).abs(), None),
-        open => {
-            let (lo, hi) = super::check::bounds(positions);
-            let dims = ((hi - lo) / side).ceil().as_uvec3().max(glam::UVec3::ONE);
-            let n = open.voxels(lo, dims, side).1.iter().filter(|i| **i).count();
-            (n as f64 * (side as f64).powi(3), Some(n))
-        }
+/// side `side` (coarsened to at most `MAX_VOXELS`) inside by the winding number, with the
+/// voxel count and side. `closed` is the mesh's own check.
+pub fn volume(
+    positions: &[Vec3],
+    indices: &[u32],
+    side: f32,
+    closed: bool,
+) -> (f64, Option<(usize, f64)>) {
+    if closed {
+        return (super::check::signed_volume(positions, indices).abs(), None);
     }
+    let (lo, hi) = super::check::bounds(positions);
+    let size = (hi - lo).as_dvec3();
+    if !(size.max_element() > 0.0 && size.is_finite()) {
+        return (0.0, Some((0, side as f64)));
+    }
+    let at = |s: f64| (size / s).ceil().max(DVec3::ONE);
+    let mut s = (side as f64).max(size.max_element() * 1e-6);
+    let n = at(s);
+    if n.x * n.y * n.z > MAX_VOXELS {
+        s *= (n.x * n.y * n.z / MAX_VOXELS).cbrt() * 1.01;
+    }
+    let dims = at(s).as_uvec3();
+    let open = InsideTest::of(positions, indices, false);
+    let n = open
+        .voxels(lo, dims, s as f32)
+        .1
+        .iter()
+        .filter(|i| **i)
+        .count();
+    (n as f64 * s.powi(3), Some((n, s)))
 }

@@ -93,16 +93,32 @@ pub(crate) fn assemble(
             ch.check.describe()
         ));
     }
-    // An open mesh's signed volume still says which way most of it faces.
-    if ch.check.signed_volume < 0.0 {
+    // A closed mesh's signed volume says which way it faces; an open one's depends on where
+    // its origin is, so its winding number just behind its triangles says instead.
+    let (inward, why) = match ch.check.closed() {
+        true => (
+            ch.check.signed_volume < 0.0,
+            format!("signed volume {:.6}", ch.check.signed_volume),
+        ),
+        false => {
+            let (outward, inward) = winding::facing(&rest, &ch.mesh.indices);
+            (
+                inward > outward,
+                format!("its winding number is below -1/2 behind {inward} probed triangles, above 1/2 behind {outward}"),
+            )
+        }
+    };
+    if inward {
         check::flip(&mut ch.mesh.indices);
         for n in &mut ch.mesh.normals {
             *n = -*n;
         }
+        for d in &mut ch.mesh.morphs.deltas {
+            d.normal = -d.normal;
+        }
         let closed = if ch.check.closed() { "closed" } else { "open" };
         warnings.push(format!(
-            "the {closed} mesh faced inward (signed volume {:.6}); its triangles and normals were flipped",
-            ch.check.signed_volume
+            "the {closed} mesh faced inward ({why}); its triangles and normals were flipped"
         ));
         ch.check.signed_volume = -ch.check.signed_volume;
         ch.flipped = true;
@@ -226,32 +242,19 @@ impl Character {
     }
 
     /// Refuse a mesh with no inside (`rest`: its rest positions): an open one whose
-    /// generalized winding number is nowhere above 1/2 (a sheet). Probed just behind the
-    /// surface of up to 512 of its triangles: a solid's is about 1 there, a sheet's at most
-    /// 1/2.
+    /// generalized winding number is nowhere above 1/2 (a sheet), probed just behind up to
+    /// 512 of its triangles (`winding::facing`): a solid's is about 1 there, a sheet's at
+    /// most 1/2.
     pub fn require_solid(&self, rest: &[Vec3]) -> Result<()> {
-        if self.check.closed() {
+        if self.check.closed() || winding::facing(rest, &self.mesh.indices).0 > 0 {
             return Ok(());
         }
-        let idx = &self.mesh.indices;
-        let w = winding::FastWinding::new(rest, idx);
-        let (lo, hi) = check::bounds(rest);
-        let step = (idx.len() / 3).div_ceil(512).max(1);
-        let depth = 1e-3 * (hi - lo).length();
-        let solid = idx.chunks_exact(3).step_by(step).any(|t| {
-            let [a, b, c] = [0, 1, 2].map(|k| rest[t[k] as usize]);
-            let n = (b - a).cross(c - a).normalize_or_zero();
-            n != Vec3::ZERO && w.inside((a + b + c) / 3.0 - n * depth)
-        });
-        match solid {
-            true => Ok(()),
-            false => Err(Error::Model {
-                path: self.source.clone(),
-                message: format!(
-                    "has no inside: its generalized winding number is nowhere above 1/2 (an open sheet, {}), so no fluid can fill it",
-                    self.check.describe()
-                ),
-            }),
-        }
+        Err(Error::Model {
+            path: self.source.clone(),
+            message: format!(
+                "has no inside: its generalized winding number is nowhere above 1/2 (an open sheet, {}), so no fluid can fill it",
+                self.check.describe()
+            ),
+        })
     }
 }

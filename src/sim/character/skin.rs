@@ -191,7 +191,9 @@ impl SkinnedMesh {
         };
         let deltas: Vec<[f32; 4]> = (m.deltas.iter())
             .flat_map(|d| {
-                let t = f32::from_bits(d.target);
+                // The target's index as a float's value (exact below 2^24; not its bits,
+                // which would be a denormal a device may flush).
+                let t = d.target as f32;
                 [
                     d.position.extend(t).to_array(),
                     d.normal.extend(0.0).to_array(),

@@ -112,6 +112,33 @@ impl FastWinding {
     }
 }
 
+/// Which way an open mesh faces: at up to 512 of its triangles, spread evenly, how many
+/// have a winding number above 1/2 just behind them (they face outward) and how many below
+/// -1/2 just in front (they face inward). A sheet has neither.
+pub fn facing(positions: &[Vec3], indices: &[u32]) -> (usize, usize) {
+    let w = FastWinding::new(positions, indices);
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let depth = 1e-3 * (hi - lo).length();
+    let step = (indices.len() / 3).div_ceil(512).max(1);
+    let (mut outward, mut inward) = (0, 0);
+    for t in indices.chunks_exact(3).step_by(step) {
+        let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        if n == Vec3::ZERO {
+            continue;
+        }
+        // Facing out, the inside is behind it (winding number near 1); facing in, the
+        // inside is in front of it (near -1).
+        let c = (a + b + c) / 3.0;
+        outward += (w.winding(c - n * depth) > 0.5) as usize;
+        inward += (w.winding(c + n * depth) < -0.5) as usize;
+    }
+    (outward, inward)
+}
+
 /// The node over `tris[start..end]` (reordered in place by a median split along the
 /// centroids' longest axis) and its subtree; its index.
 fn build(tris: &mut [[DVec3; 3]], start: usize, end: usize, nodes: &mut Vec<Node>) -> usize {

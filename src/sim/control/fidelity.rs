@@ -97,9 +97,14 @@ fn voxels(
     }
 }
 
-/// The metrics of `frame` against the target `mesh` (positions, triangles), whose skin
-/// points move at most `skin_speed` m/s.
-pub fn measure(frame: &Frame, mesh: (&[Vec3], &[u32]), skin_speed: f32, f: &Fluid) -> Fidelity {
+/// The metrics of `frame` against the target `mesh` (positions, triangles; `inside` its
+/// inside test), whose skin points move at most `skin_speed` m/s.
+pub fn measure(
+    frame: &Frame,
+    (mesh, inside): ((&[Vec3], &[u32]), &InsideTest),
+    skin_speed: f32,
+    f: &Fluid,
+) -> Fidelity {
     let (h, s) = (f.h, f.spacing);
     let h2 = h * h;
     let poly6 = 315.0 / (64.0 * std::f32::consts::PI * h.powi(9));
@@ -114,7 +119,6 @@ pub fn measure(frame: &Frame, mesh: (&[Vec3], &[u32]), skin_speed: f32, f: &Flui
             .sum();
         f.mass * poly6 * sum
     };
-    let inside = InsideTest::new(mesh.0, mesh.1);
     let (mlo, mhi) = check::bounds(mesh.0);
     let (lo, hi) = (mlo - Vec3::splat(2.0 * h), mhi + Vec3::splat(2.0 * h));
     let in_box = |p: Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
@@ -126,7 +130,7 @@ pub fn measure(frame: &Frame, mesh: (&[Vec3], &[u32]), skin_speed: f32, f: &Flui
         filled,
         occupied_out,
         interior_set,
-    } = voxels(&inside, occupied, lo, dims, s);
+    } = voxels(inside, occupied, lo, dims, s);
     let fill = filled as f64 / interior.max(1) as f64;
     let iou = filled as f64 / (interior + occupied_out).max(1) as f64;
     // Neighbour counts within h over every live particle (spray counts all the fluid).

@@ -52,6 +52,8 @@ pub(super) fn compute(j: &Job) -> Result<ControlRow> {
         .fold(0.0, f32::max)
         / k.dt as f32;
     let mesh = (posed.as_slice(), k.ch.mesh.indices.as_slice());
+    // One test for the frame, by the character's own closedness.
+    let inside = InsideTest::of(mesh.0, mesh.1, k.ch.check.closed());
     let fid: Fidelity = fidelity::measure(
         &fidelity::Frame {
             pos: &j.pos,
@@ -59,12 +61,11 @@ pub(super) fn compute(j: &Job) -> Result<ControlRow> {
             rho: &j.rho,
             controlled: &j.controlled,
         },
-        mesh,
+        (mesh, &inside),
         skin_speed,
         &j.fluid,
     );
     let rest_density = j.fluid.rest_density;
-    let inside = InsideTest::new(mesh.0, mesh.1);
     let ours: Vec<Vec3> = (j.pos.iter().zip(&j.controlled))
         .filter(|(_, c)| **c)
         .map(|(p, _)| *p)

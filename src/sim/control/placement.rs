@@ -24,8 +24,12 @@ pub fn vertices(positions: &[Vec3]) -> Vec<Vec3> {
 
 /// Lattice points at `spacing` inside the mesh (the reference for uniformity).
 pub fn lattice(mesh: RestMesh, spacing: f32) -> Vec<Vec3> {
-    let inside = InsideTest::new(mesh.0, mesh.1);
-    let (lo, hi) = check::bounds(mesh.0);
+    lattice_in(&InsideTest::new(mesh.0, mesh.1), mesh.0, spacing)
+}
+
+/// Lattice points at `spacing` in the box of `positions` that `inside` keeps.
+fn lattice_in(inside: &InsideTest, positions: &[Vec3], spacing: f32) -> Vec<Vec3> {
+    let (lo, hi) = check::bounds(positions);
     let dims = ((hi - lo) / spacing).ceil().as_uvec3();
     let (centres, kept) = inside.voxels(lo, dims, spacing);
     keep(centres, &kept)
@@ -48,8 +52,12 @@ const DISK: f32 = 0.84;
 /// Bridson's Poisson-disk sampling (2007) in the mesh's box, kept inside: no two points
 /// closer than `DISK * spacing`, the box filled (30 tries per active point).
 pub fn random(mesh: RestMesh, spacing: f32, seed: u64) -> Vec<Vec3> {
-    let inside = InsideTest::new(mesh.0, mesh.1);
-    let (lo, hi) = check::bounds(mesh.0);
+    random_in(&InsideTest::new(mesh.0, mesh.1), mesh.0, spacing, seed)
+}
+
+/// Poisson-disk points in the box of `positions` that `inside` keeps.
+fn random_in(inside: &InsideTest, positions: &[Vec3], spacing: f32, seed: u64) -> Vec<Vec3> {
+    let (lo, hi) = check::bounds(positions);
     let r = DISK * spacing;
     let cell = r / 3f32.sqrt();
     let dims = ((hi - lo) / cell).ceil().as_uvec3().max(glam::UVec3::ONE);
@@ -124,12 +132,13 @@ pub fn place(
             "--control-spacing must be positive, got {spacing}"
         )));
     }
-    let mesh = (rest, ch.mesh.indices.as_slice());
+    // The character's own closedness picks the test (decided once, at its rest pose).
+    let inside = || InsideTest::of(rest, &ch.mesh.indices, ch.check.closed());
     let pts = match how {
         Placement::Vertices => vertices(rest),
         Placement::Random => {
             ch.require_solid(rest)?;
-            random(mesh, spacing, seed)
+            random_in(&inside(), rest, spacing, seed)
         }
         // Placed on the GPU every frame (control::rays); here the rest pose's lattice,
         // which sizes its buffers.
@@ -137,7 +146,7 @@ pub fn place(
             ch.require_closed(
                 "--placement rays (GPU ray crossings; --placement random takes open meshes)",
             )?;
-            lattice(mesh, spacing)
+            lattice_in(&inside(), rest, spacing)
         }
     };
     if pts.is_empty() {

@@ -311,7 +311,8 @@ impl ControlTarget {
         let fill = match desc.deficit()? {
             Deficit::Shape => {
                 let idx = &ch.mesh.indices;
-                let volume = crate::character::inside::volume(&rest_mesh, idx, spacing).0;
+                let closed = ch.check.closed();
+                let volume = crate::character::inside::volume(&rest_mesh, idx, spacing, closed).0;
                 let volume = volume as f32;
                 Some(placement::fill(&mesh.positions, volume, fluid.h))
             }
