@@ -26,7 +26,7 @@ layout(std430, binding = SKIN_B_OUT_NRM) writeonly buffer OutNrm { vec4 out_nrm[
 layout(std430, binding = SKIN_B_MORPH_START) readonly buffer MorphStart { uint morph_start[]; };
 layout(std430, binding = SKIN_B_MORPH_DELTAS) readonly buffer MorphDeltas { vec4 morph_deltas[]; };
 layout(std430, binding = SKIN_B_MORPH_WEIGHTS) readonly buffer MorphWeights { float morph_weights[]; };
-layout(push_constant) uniform Push { uint n; } pc;
+layout(push_constant) uniform Push { uint n; uint morphs; } pc;
 
 mat3 cofactor(mat3 a) { return mat3(cross(a[1], a[2]), cross(a[2], a[0]), cross(a[0], a[1])); }
 vec3 rotate(vec4 q, vec3 v) { return v + 2.0 * cross(q.xyz, cross(q.xyz, v) + q.w * v); }
@@ -37,11 +37,14 @@ void main() {
     if (v >= pc.n) return;
     vec3 p = rest_pos[v].xyz;
     vec3 n = rest_nrm[v].xyz;
-    for (uint e = morph_start[v]; e < morph_start[v + 1u]; ++e) {
-        vec4 dp = morph_deltas[2u * e];
-        float w = morph_weights[uint(dp.w)];
-        p += w * dp.xyz;
-        n += w * morph_deltas[2u * e + 1u].xyz;
+    // (Uniform: a mesh without targets reads no range.)
+    if (pc.morphs != 0u) {
+        for (uint e = morph_start[v]; e < morph_start[v + 1u]; ++e) {
+            vec4 dp = morph_deltas[2u * e];
+            float w = morph_weights[uint(dp.w)];
+            p += w * dp.xyz;
+            n += w * morph_deltas[2u * e + 1u].xyz;
+        }
     }
 #if SKIN_METHOD == 0
     mat3 a = mat3(0.0);

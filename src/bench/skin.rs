@@ -74,9 +74,14 @@ pub fn skin(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             let n = c.mesh.vertices() as u64;
             let detail = json!({ "mesh": c.source, "vertices": n, "joints": c.skeleton.joints.len(),
                                  "influences": 4 * c.mesh.influence_sets, "method": method.as_str() });
-            // Bytes the pass moves: rest position, normal, influences and its morph range in
-            // (and 32 per morph offset); position, normal out.
-            let per = 16.0 + 16.0 + 24.0 * c.mesh.influence_sets as f64 + 8.0 + 32.0;
+            // Bytes the pass moves: rest position, normal, influences (and with morph
+            // targets a range per vertex and 32 per offset) in; position, normal out.
+            let range = if c.mesh.morphs.deltas.is_empty() {
+                0.0
+            } else {
+                8.0
+            };
+            let per = 16.0 + 16.0 + 24.0 * c.mesh.influence_sets as f64 + range + 32.0;
             let offsets = 32.0 * c.mesh.morphs.deltas.len() as f64;
             moved.push(n as f64 * per + offsets);
             cases.push(Case::new(variant, n, SKIN, detail, move |prof, cmd| {

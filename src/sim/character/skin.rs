@@ -13,6 +13,9 @@ use bytemuck::{Pod, Zeroable};
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct SkinPush {
     pub n: u32,
+    /// 1 when the mesh has morph targets: a mesh without skips their ranges (a uniform
+    /// branch) instead of reading an empty one per vertex.
+    pub morphs: u32,
 }
 
 crate::gpu_interface! {
@@ -96,7 +99,10 @@ impl SkinPass {
             ctx,
             cmd,
             &bufs,
-            &SkinPush { n: m.vertices },
+            &SkinPush {
+                n: m.vertices,
+                morphs: (m.targets > 0) as u32,
+            },
             m.vertices as u64,
         );
         Ok(())
