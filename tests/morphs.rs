@@ -5,7 +5,7 @@ mod common;
 use common::gltf::{cube, write, Doc};
 use fluidform::character::skin::Skinner;
 use fluidform::character::{self, inspect, Animator, Character, Skinning};
-use fluidform::gpu::{sync, Context};
+use fluidform::gpu::Context;
 use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
 
@@ -105,16 +105,7 @@ fn gpu_against_cpu(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> f
     let weights = a.morph_weights(ch, t);
     let joints = ch.gpu_joints(&mats, method).unwrap();
     let mut sk = Skinner::new(ctx, ch, method).unwrap();
-    ctx.one_shot(|cmd| {
-        sk.record(ctx, cmd, &joints, &weights).unwrap();
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::HOST_READ | sync::TRANSFER_READ,
-        );
-    })
-    .unwrap();
-    let gpu: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.pos).unwrap();
+    let (gpu, _) = common::skin_on_gpu(ctx, &sk, &joints, &weights);
     sk.destroy(ctx);
     let (cpu, _) = ch.skinned_with(&mats, &weights, method).unwrap();
     (gpu.iter().zip(&cpu))

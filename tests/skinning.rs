@@ -5,14 +5,14 @@ use common::asset;
 use fluidform::character::skin::{SkinnedMesh, Skinner};
 use fluidform::character::Skinning;
 use fluidform::character::{self, Animator, Character};
-use fluidform::gpu::{sync, Context};
+use fluidform::gpu::Context;
 use glam::{Mat4, Vec3};
 use rand::{Rng, SeedableRng};
 
 /// Skin on the GPU; the largest position error relative to the mesh size, and the largest
 /// normal error, against the CPU reference. Each vertex carries a tag in its rest position's
 /// w (the control particles' fill of the shape), which must come out unchanged.
-pub fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
+fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32, f32) {
     let anim = Animator {
         clip: (!ch.clips.is_empty()).then_some(0),
         looping: true,
@@ -32,17 +32,7 @@ pub fn compare(ctx: &Context, ch: &Character, method: Skinning, t: f32) -> (f32,
     };
     let mut unused = plain.mesh;
     unused.destroy(ctx);
-    ctx.one_shot(|cmd| {
-        sk.record(ctx, cmd, &joints, &weights).unwrap();
-        ctx.barrier(
-            cmd,
-            sync::COMPUTE_WRITE,
-            sync::HOST_READ | sync::TRANSFER_READ,
-        );
-    })
-    .unwrap();
-    let pos: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.pos).unwrap();
-    let nrm: Vec<[f32; 4]> = ctx.read_all(&sk.mesh.nrm).unwrap();
+    let (pos, nrm) = common::skin_on_gpu(ctx, &sk, &joints, &weights);
     sk.destroy(ctx);
     for (v, p) in pos.iter().enumerate() {
         assert_eq!(p[3], tags[v], "{method:?}: vertex {v}'s tag");

@@ -246,7 +246,8 @@ impl Context {
         };
     }
 
-    /// Write `data` (at most 65536 bytes) into `b` at byte `offset`, in command order.
+    /// Write `data` into `b` at byte `offset`, in command order: one vkCmdUpdateBuffer per
+    /// 65536 bytes, the most one takes.
     pub fn update<T: bytemuck::Pod>(
         &self,
         cmd: vk::CommandBuffer,
@@ -254,12 +255,14 @@ impl Context {
         offset: u64,
         data: &[T],
     ) {
+        const MOST: usize = 65536;
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        if !bytes.is_empty() {
-            let u = BufferUse::transfer(b.raw, true).bytes(offset, bytes.len() as u64);
+        for (k, chunk) in bytes.chunks(MOST).enumerate() {
+            let at = offset + (k * MOST) as u64;
+            let u = BufferUse::transfer(b.raw, true).bytes(at, chunk.len() as u64);
             self.track(cmd, &[u], true);
             self.count_transfer(cmd);
-            unsafe { self.device.cmd_update_buffer(cmd, b.raw, offset, bytes) };
+            unsafe { self.device.cmd_update_buffer(cmd, b.raw, at, chunk) };
         }
     }
 

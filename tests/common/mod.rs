@@ -147,3 +147,27 @@ pub fn box_scene(
     s.name = "solver test".into();
     s
 }
+
+/// Record `sk`'s joints, morph weights and skinning pass, then read back its skinned
+/// positions and normals (vec4 each).
+pub fn skin_on_gpu(
+    ctx: &Context,
+    sk: &fluidform::character::skin::Skinner,
+    joints: &[fluidform::character::pose::GpuJoint],
+    weights: &[f32],
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    use fluidform::gpu::sync;
+    ctx.one_shot(|cmd| {
+        sk.record(ctx, cmd, joints, weights).unwrap();
+        ctx.barrier(
+            cmd,
+            sync::COMPUTE_WRITE,
+            sync::HOST_READ | sync::TRANSFER_READ,
+        );
+    })
+    .unwrap();
+    (
+        ctx.read_all(&sk.mesh.pos).unwrap(),
+        ctx.read_all(&sk.mesh.nrm).unwrap(),
+    )
+}

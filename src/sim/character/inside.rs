@@ -183,15 +183,12 @@ impl Crossings {
 /// (1 inside a closed outward mesh, 0 outside).
 pub fn winding_number(positions: &[Vec3], indices: &[u32], p: Vec3) -> f64 {
     let p = p.as_dvec3();
-    let mut sum = 0.0;
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize].as_dvec3() - p);
-        let (la, lb, lc) = (a.length(), b.length(), c.length());
-        let num = a.dot(b.cross(c));
-        let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-        sum += 2.0 * num.atan2(den);
-    }
-    sum / (4.0 * std::f64::consts::PI)
+    (indices.chunks_exact(3))
+        .map(|t| {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize].as_dvec3() - p);
+            super::winding::triangle_winding(a, b, c)
+        })
+        .sum()
 }
 
 /// Voxels a volume may take: a finer side is coarsened to hold it.

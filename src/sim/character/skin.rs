@@ -255,16 +255,7 @@ impl SkinnedMesh {
                 self.joint_count
             )));
         }
-        // vkCmdUpdateBuffer takes at most 65536 bytes a call.
-        let per = 65536 / std::mem::size_of::<GpuJoint>();
-        for (k, chunk) in joints.chunks(per).enumerate() {
-            ctx.update(
-                cmd,
-                &self.joints,
-                (k * per * std::mem::size_of::<GpuJoint>()) as u64,
-                chunk,
-            );
-        }
+        ctx.update(cmd, &self.joints, 0, joints);
         Ok(())
     }
 
@@ -282,9 +273,7 @@ impl SkinnedMesh {
                 self.targets
             )));
         }
-        for (k, chunk) in weights.chunks(16384).enumerate() {
-            ctx.update(cmd, &self.morph_weights, (k * 16384 * 4) as u64, chunk);
-        }
+        ctx.update(cmd, &self.morph_weights, 0, weights);
         Ok(())
     }
 

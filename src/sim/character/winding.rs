@@ -117,10 +117,7 @@ impl FastWinding {
 /// -1/2 just in front (they face inward). A sheet has neither.
 pub fn facing(positions: &[Vec3], indices: &[u32]) -> (usize, usize) {
     let w = FastWinding::new(positions, indices);
-    let (lo, hi) = positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
+    let (lo, hi) = super::check::bounds(positions);
     let depth = 1e-3 * (hi - lo).length();
     let step = (indices.len() / 3).div_ceil(512).max(1);
     let (mut outward, mut inward) = (0, 0);
