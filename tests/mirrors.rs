@@ -185,7 +185,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
         (
             "character/skin.comp",
             "Push",
-            fields!(fluidform::character::skin::SkinPush; n),
+            fields!(fluidform::character::skin::SkinPush; n, morphs),
         ),
         (
             "psys/draw.vert",
