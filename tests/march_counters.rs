@@ -27,22 +27,7 @@ fn render(
     ctx: &fluidform::gpu::Context,
     s: &MetaballSettings,
 ) -> (FrameStats, Vec<u8>, Vec<[f32; 4]>) {
-    let pts = blob(N, SPACING);
-    let cam = blob_camera(N, SPACING, W as f32 / H as f32);
-    let mut centers = ctx.storage_buffer("centers", (N * 16) as u64).unwrap();
-    ctx.upload(&mut centers, 0, &pts).unwrap();
-    let mut r = FluidRenderer::new(ctx, s.clone()).unwrap();
-    let mut b = r.buffers(ctx, N as u64, 1, true).unwrap();
-    let (st, _) = r
-        .render_sync(ctx, &mut b, &centers, N as u32, &cam, 0)
-        .unwrap();
-    assert_eq!(st.budget_pixels, 0);
-    let px = b.pixels(0).to_vec();
-    let dbg = r.debug(ctx, &b).unwrap();
-    b.destroy(ctx);
-    r.destroy(ctx);
-    ctx.destroy_buffer(&mut centers);
-    (st, px, dbg)
+    common::blob::frame(ctx, s, N, SPACING)
 }
 
 /// One Phong frame of the blob with `list`: its settings, statistics and primary hits.

@@ -1,19 +1,24 @@
 //! `bench march`: what the march's own machinery costs, each suspect switched alone on
 //! `bench render`'s resting blob, timed together under the protocol: the counters (added
 //! per subgroup into 64 slots, the default; summed per workgroup first; off) and the
-//! lanes (8 x 8 blocks, the default; rows of 64), per list mode (or --list). Each row
-//! gives the march scope's ms beside the frame's, and its ratio to the default's row.
+//! lanes (8 x 8 blocks, the default; rows of 64), and the lanes per ray (1, the default;
+//! 8, 16 and 32 where the device's subgroup holds them), per list mode (or --list). Each
+//! row gives the march scope's ms beside the frame's, its ratio to the default's row and
+//! the longest serial chain.
 use super::{BenchOptions, Row};
 use crate::error::Result;
 use crate::gpu::Context;
 use crate::render::{Counters, Lanes, ListKind};
 
-/// (counters, lanes) per row: the default first, then each switched alone.
-const SUSPECTS: [(Counters, Lanes); 4] = [
-    (Counters::Subgroup, Lanes::Blocks),
-    (Counters::Workgroup, Lanes::Blocks),
-    (Counters::Off, Lanes::Blocks),
-    (Counters::Subgroup, Lanes::Rows),
+/// (counters, lanes, lanes per ray) per row: the default first, then each switched alone.
+const SUSPECTS: [(Counters, Lanes, u32); 7] = [
+    (Counters::Subgroup, Lanes::Blocks, 1),
+    (Counters::Workgroup, Lanes::Blocks, 1),
+    (Counters::Off, Lanes::Blocks, 1),
+    (Counters::Subgroup, Lanes::Rows, 1),
+    (Counters::Subgroup, Lanes::Blocks, 8),
+    (Counters::Subgroup, Lanes::Blocks, 16),
+    (Counters::Subgroup, Lanes::Blocks, 32),
 ];
 const DEFAULT: &str = "counters=subgroup lanes=blocks";
 
@@ -22,20 +27,27 @@ pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     for (list, sorted, build) in super::render::rows_of(&opts.switches)? {
         let mut s = crate::settings::metaball_settings(&opts.switches)?;
         (s.list, s.sorted, s.build) = (list, sorted, build);
-        for (counters, lanes) in SUSPECTS {
+        for (counters, lanes, ray_lanes) in SUSPECTS {
             if list == ListKind::Tiles && lanes == Lanes::Rows {
                 continue; // tiles stage their tile per block
             }
-            let name = format!(
+            if ray_lanes > ctx.info.subgroup_size || !ctx.info.subgroup_shuffle {
+                continue; // a ray's lanes share one subgroup
+            }
+            let mut name = format!(
                 "{} counters={} lanes={}",
                 s.list_name(),
                 counters.as_str(),
                 lanes.as_str()
             );
+            if ray_lanes > 1 {
+                name += &format!(" ray-lanes={ray_lanes}");
+            }
             rows.push((
                 crate::render::metaball::MetaballSettings {
                     counters,
                     lanes,
+                    ray_lanes,
                     ..s.clone()
                 },
                 name,
@@ -107,6 +119,18 @@ pub fn notes(rows: &[Row]) -> Vec<String> {
         for (what, suffix) in [
             ("summed per workgroup", "counters=workgroup lanes=blocks"),
             ("rows of 64", "counters=subgroup lanes=rows"),
+            (
+                "8 lanes a ray",
+                "counters=subgroup lanes=blocks ray-lanes=8",
+            ),
+            (
+                "16 lanes a ray",
+                "counters=subgroup lanes=blocks ray-lanes=16",
+            ),
+            (
+                "32 lanes a ray",
+                "counters=subgroup lanes=blocks ray-lanes=32",
+            ),
         ] {
             if let Some(m) = of(suffix) {
                 line += &format!("; {what}: {:.3}x", m / on);

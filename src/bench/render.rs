@@ -104,6 +104,11 @@ pub fn time_rows(
             ("steps/px".into(), format!("{:.1}", per_px.0)),
             ("evals/px".into(), format!("{:.0}", per_px.1)),
             ("candidates/px".into(), format!("{:.1}", per_px.2)),
+            ("serial max".into(), after.march.serial_max.to_string()),
+            (
+                "serial mean".into(),
+                format!("{:.1}", after.march.serial_mean),
+            ),
             ("redos".into(), redos.to_string()),
             (
                 "overflow in timed frames".into(),

@@ -21,6 +21,8 @@ pub struct DeviceInfo {
     pub subgroup_size: u32,
     /// Subgroup arithmetic in compute shaders (the scan's fast path).
     pub subgroup_arithmetic: bool,
+    /// Subgroup ballots and shuffles in compute shaders (rays marched by several lanes).
+    pub subgroup_shuffle: bool,
     pub subgroup_size_control: bool,
     pub max_storage_buffer_range: u64,
     pub max_shared_memory: u32,
@@ -107,6 +109,12 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
         && subgroup
             .supported_stages
             .contains(vk::ShaderStageFlags::COMPUTE);
+    let shuffle = subgroup
+        .supported_operations
+        .contains(vk::SubgroupFeatureFlags::BALLOT | vk::SubgroupFeatureFlags::SHUFFLE)
+        && subgroup
+            .supported_stages
+            .contains(vk::ShaderStageFlags::COMPUTE);
     let cstr = |s: &[std::ffi::c_char]| {
         unsafe { std::ffi::CStr::from_ptr(s.as_ptr()) }
             .to_string_lossy()
@@ -132,6 +140,7 @@ pub fn describe(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) 
         timestamp_valid_bits: valid_bits,
         subgroup_size: subgroup.subgroup_size,
         subgroup_arithmetic: arith,
+        subgroup_shuffle: shuffle,
         subgroup_size_control: f13.subgroup_size_control == vk::TRUE
             && f13.compute_full_subgroups == vk::TRUE,
         max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,

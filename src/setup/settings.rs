@@ -28,6 +28,7 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
         march: m.march.unwrap_or(t.march),
         counters: m.counters.unwrap_or(t.counters),
         lanes: m.lanes.unwrap_or(t.lanes),
+        ray_lanes: m.ray_lanes.unwrap_or(t.ray_lanes),
         build: m.build.unwrap_or(t.build),
         tile: m.tile.unwrap_or(t.tile),
         offscreen_end: m
@@ -58,6 +59,7 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
             ("--march", m.march.is_some()),
             ("--counters", m.counters.is_some()),
             ("--lanes", m.lanes.is_some()),
+            ("--ray-lanes", m.ray_lanes.is_some()),
             ("--build", m.build.is_some()),
             ("--tile", m.tile.is_some()),
         ];

@@ -1,6 +1,7 @@
 //! Shared test helpers: every test opens its device with the validation layer on and
 //! ends with `finish`, which fails on any validation error.
 #![allow(dead_code)]
+pub mod blob;
 pub mod gltf;
 use fluidform::gpu::{Context, ContextOptions};
 

@@ -1,7 +1,12 @@
 #version 450
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
-// Ray marching through the metaball field, one invocation per pixel. The primary ray
+#if RAY_LANES > 1
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_shuffle : require
+#endif
+// Ray marching through the metaball field, one invocation per pixel (--ray-lanes: a group
+// of RAY_LANES lanes per pixel, march_lanes.glsl). The primary ray
 // marches the depth interval covered by the spheres of its pixel's list (LIST none: the
 // fluid's bounds), sums only those metaballs, refines the hit by bisection and takes the
 // normal from the analytic gradient. Glass and tinted trace reflection and refraction
@@ -10,6 +15,16 @@
 #include "common/index.glsl"
 #include "common.glsl"
 #include "blocks.glsl"
+#include "march_lanes.glsl"
+
+// --lanes blocks and tiles: the 8 x 8 block this workgroup marches. RAY_LANES workgroups
+// share a block, each taking 64 / RAY_LANES of its pixels in raster order.
+uint march_block() { return group_id() / RAY_LANES; }
+uvec2 march_block_origin() { return block_origin_of(march_block()); }
+uvec2 march_block_pixel() {
+    uint q = (group_id() % RAY_LANES) * (64u / RAY_LANES) + ray_group();
+    return march_block_origin() + uvec2(q % 8u, q / 8u);
+}
 
 const uint ALL = 0xFFFFFFFEu;  // "every metaball" instead of a pixel's list
 uint offscreen_samples = 0u;
@@ -17,6 +32,9 @@ uint longest = 0u;
 // Per-ray counters (summed per subgroup and workgroup, then added to stats as 64-bit
 // totals: add_counters).
 uint n_rays = 0u, n_steps = 0u, n_evals = 0u, n_candidates = 0u;
+// The field and gradient evaluations this invocation makes one after another: the serial
+// chain that sets a pixel's time (stats' serial_max and serial_mean).
+uint n_serial = 0u;
 // llvmpipe stops a batch's loops after about 65535 iterations in total (hang protection);
 // every later loop then exits at once. Each loop below checks on exit that it ended by
 // its own condition (CUT_UNLESS, the negated loop condition); pixels where one did not are counted in stats.budget_pixels, so a
@@ -127,6 +145,7 @@ float field(vec3 x, uint p) {
     p = ALL;
 #endif
     float f = 0.0;
+    n_serial++;
     SUM_METABALLS(x, p, f, density2(dot(d, d)))
     return f;
 }
@@ -139,6 +158,7 @@ vec2 field_reach(vec3 x, uint p, float reach) {
 #endif
     float near2 = (radius() + reach) * (radius() + reach);
     vec2 f = vec2(0.0);
+    n_serial++;
     reach_extra = reach;
     SUM_METABALLS(x, p, f, vec2(density2(dot(d, d)), dot(d, d) < near2 ? 1.0 : 0.0))
     reach_extra = 0.0;
@@ -150,6 +170,7 @@ vec3 gradient(vec3 x, uint p) {
     p = ALL;
 #endif
     vec3 g = vec3(0.0);
+    n_serial++;
     SUM_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
     return g;
 }
@@ -171,7 +192,8 @@ vec2 ray_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
 }
 
 #if LIST != LIST_TILES
-// The depth interval the spheres of pixel p cover along the primary ray.
+// The depth interval the spheres of pixel p cover along the primary ray (the S-buffer's
+// range split over the ray's lanes; min and max meet exactly in any order).
 vec2 list_interval(vec3 o, vec3 d, uint p) {
     float R2 = radius() * radius();
     vec2 iv = vec2(1e30, -1e30);
@@ -184,7 +206,7 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
 #elif LIST == LIST_SBUFFER
     uint s = range_start(p), e = min(offsets[p], P.list_capacity);
     len = e - min(s, e);
-    for (; s < e; ++s) {
+    for (s += ray_lane(); s < e; s += RAY_LANES) {
         vec3 oc = o - centers[list[s]].xyz;
 #elif LIST == LIST_NONE
     for (uint j = 0u; j < 0u; ++j) {
@@ -203,6 +225,7 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
 #elif LIST != LIST_NONE
 #error "LIST names no list mode"
 #endif
+    iv = vec2(lanes_min(iv.x), lanes_max(iv.y));
     longest = max(longest, len);
     n_candidates += len;
     return vec2(max(iv.x, 0.0), iv.y);
@@ -214,7 +237,9 @@ vec2 list_interval(vec3 o, vec3 d, uint p) {
 // (every invocation of the group calls this: it holds barriers); then the tile's front
 // STAGE pairs are staged for the sums. Candidates: the tile's pairs.
 vec2 tile_interval(vec3 o, vec3 d) {
-    uvec2 range = tile_ranges[tile_of(block_origin())];
+    // Blocks past the frame (a dispatch split over y) stage nothing.
+    uvec2 origin = march_block_origin();
+    uvec2 range = origin.y < P.height ? tile_ranges[tile_of(origin)] : uvec2(0u);
     float R2 = radius() * radius();
     vec2 iv = vec2(1e30, -1e30);
     uint l = gl_LocalInvocationIndex;
@@ -252,100 +277,15 @@ vec2 tile_interval(vec3 o, vec3 d) {
 vec3 box_lo() { return bounds[0].xyz - vec3(radius()); }
 vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
 
-// The crossing between ray parameters a (this side of T) and b (across it), refined by
-// P.refine bisection steps; pixel as in `march` (NIL: each sample projects).
-float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
-    float T = threshold();
-    uint k = 0u;
-    for (; k < P.refine; ++k) {
-        float m = 0.5 * (a + b);
-        vec3 xm = o + d * m;
-        uint pm = pixel == NIL ? project(xm) : pixel;
-        if (pm == NIL) pm = ALL;
-        if ((field(xm, pm) >= T) != inside) b = m; else a = m;
-    }
-    CUT_UNLESS(!(k < P.refine))
-    n_steps += k;  // the samples taken, counted once (not per sample)
-    return b;
-}
-
-// March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
-// ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
-// -2 when a secondary sample left the screen and paths end there. Samples sit on the
-// grid t = k * step from the ray's origin, so every list variant (whose intervals start
-// at different t0) takes the same samples and bisects the same steps.
-float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
-    float T = threshold(), step = P.sun.w;
-    float t = ceil(t0 / step) * step;
-    float prev = max(t - step, 0.0);
-    uint i = 0u;
-    n_rays++;
-    // The samples are counted once at each exit (i + 1 where sample i ends the march).
-    for (; i < P.max_steps && t <= t1; ++i) {
-        vec3 x = o + d * t;
-        uint p = pixel;
-        if (pixel == NIL) {
-            p = project(x);
-            if (p == NIL) {
-                offscreen_samples++;
-                if (P.offscreen_end != 0u) {
-                    n_steps += i + 1u;
-                    return -2.0;
-                }
-                p = ALL;
-            }
-        }
-        if ((field(x, p) >= T) != inside) {
-            n_steps += i + 1u;
-            return bisect(o, d, prev, t, inside, pixel);
-        }
-        prev = t;
-        t += step;
-    }
-    CUT_UNLESS(!(i < P.max_steps && t <= t1))
-    n_steps += i;
-    return -1.0;
-}
-
-#if MARCH == MARCH_LIPSCHITZ
-// `march` on the same grid for a primary ray, whose pixel's list holds every metaball the
-// ray meets: at a sample where the field is f, the m metaballs within R + R of it change
-// the field by at most m SLOPE_MAX / R per unit length over the next R, so the grid samples
-// closer than |f - T| R / (m SLOPE_MAX) are on this sample's side and are skipped (all of
-// the next R when m = 0). The first sample across T, its bracket and its bisection are the
-// fixed march's: the same hits.
-float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
-    float T = threshold(), step = P.sun.w, reach = radius();
-    float slope = SLOPE_MAX / radius();
-    float k0 = ceil(t0 / step);
-    float k = 0.0;
-    float t = k0 * step;
-    n_rays++;
-    uint i = 0u;
-    for (; i < P.max_steps && k < float(P.max_steps) && t <= t1; ++i) {
-        vec3 x = o + d * t;
-        vec2 fm = field_reach(x, pixel, reach);
-        if ((fm.x >= T) != inside) {
-            n_steps += i + 1u;
-            return bisect(o, d, max(t - step, 0.0), t, inside, pixel);
-        }
-        float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
-        // Samples strictly closer than `safe` (and within `reach`) are skipped.
-        k += max(ceil(min(safe, reach) / step - 1e-4), 1.0);
-        t = (k0 + k) * step;
-    }
-    CUT_UNLESS(!(i < P.max_steps && k < float(P.max_steps) && t <= t1))
-    n_steps += i;
-    return -1.0;
-}
-#elif MARCH != MARCH_FIXED
-#error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
-#endif
+#include "march_ray.glsl"
 
 vec3 normal_at(vec3 x, uint pixel) {
     uint p = pixel == NIL ? project(x) : pixel;
     if (p == NIL) p = ALL;
+    // Every lane of a ray's group takes the same gradient; the first counts its terms.
+    uint e0 = n_evals;
     vec3 g = gradient(x, p);
+    if (ray_lane() != 0u) n_evals = e0;
     float l = length(g);
     return l > 0.0 ? -g / l : vec3(0.0, 1.0, 0.0);
 }
@@ -376,11 +316,11 @@ struct Path { vec3 o; vec3 d; vec3 w; uint depth; bool inside; vec2 cone; };
 void march_pixel() {
 #if LIST == LIST_TILES || LANES == LANES_BLOCKS
     // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
-    uvec2 pix = block_pixel();
+    uvec2 pix = march_block_pixel();
     bool valid = pix.x < P.width && pix.y < P.height;
     uint id = valid ? pixel_index(pix) : 0u;
 #elif LANES == LANES_ROWS
-    uint id = global_id();
+    uint id = group_id() * (gl_WorkGroupSize.x / RAY_LANES) + ray_group();
     bool valid = id < P.width * P.height;
     uvec2 pix = uvec2(id % P.width, id / P.width);
 #else
@@ -490,6 +430,9 @@ void march_pixel() {
 #else
     CUT_UNLESS(!more)
 #endif
+    // Every lane of the ray's group holds the same colour: its first writes it.
+    bool cut_any = lanes_ballot(cut) != 0u;
+    if (ray_lane() != 0u) return;
     color = with_tank(color, o, d, min(dbg.x >= 0.0 ? dbg.x : 1e30, t_opaque));
     color = pow(clamp(color, 0.0, 1.0), vec3(1.0 / 2.2));
     pixels[id] = packUnorm4x8(vec4(color, 1.0));
@@ -504,10 +447,13 @@ void march_pixel() {
     }
     if (P.debug != 0u) debug_out[id] = dbg;
     // Not a counter: a cut-short pixel makes a wrong frame, reported in every mode.
-    if (cut) atomicAdd(stats.budget_pixels, 1u);
+    if (cut_any) atomicAdd(stats.budget_pixels, 1u);
 }
 
 void main() {
     march_pixel();
+    // The group's per-ray counts are its first lane's (every lane counted the same rays);
+    // terms, off-screen samples and serial chains are each lane's own.
+    if (ray_lane() != 0u) n_rays = n_steps = n_candidates = 0u;
     add_counters();  // every invocation: WORKGROUP's barriers
 }

@@ -3,7 +3,8 @@
 #ifndef RENDER_METABALL_MARCH_COUNTERS_GLSL
 #define RENDER_METABALL_MARCH_COUNTERS_GLSL
 // The frame's counters (COUNTERS): rays, samples, terms and candidates, with the longest
-// list and the off-screen samples, added to the workgroup's counter slot (common.glsl: the
+// list and the off-screen samples, and the serial chains (the most evaluations one
+// invocation made, the invocations that evaluated and their evaluations' sum), added to the workgroup's counter slot (common.glsl: the
 // frame's atomics spread over MARCH_SLOTS cache lines, summed by the host). WORKGROUP:
 // each subgroup's sums meet in shared memory and one invocation per workgroup adds them;
 // SUBGROUP: each subgroup adds its own; OFF: nothing counted (the increments above are
@@ -18,15 +19,17 @@
     c_ += o_ + a_ < o_ ? 1u : 0u; \
     if (c_ > 0u) atomicAdd(march_slots[(W) + 1u], c_); }
 
-// Each subgroup's sums (the longest list its max).
-struct Sums { uint rays, longest, offscreen; uint lo[3], hi[3]; };
+// Each subgroup's sums (the longest list and the longest serial chain their max).
+struct Sums { uint rays, longest, offscreen, serial_max, marching; uint lo[4], hi[4]; };
 Sums subgroup_sums() {
     Sums s;
-    uint counts[3] = uint[3](n_steps, n_evals, n_candidates);
+    uint counts[4] = uint[4](n_steps, n_evals, n_candidates, n_serial);
     s.rays = subgroupAdd(n_rays);
     s.longest = subgroupMax(longest);
     s.offscreen = subgroupAdd(offscreen_samples);
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+    s.serial_max = subgroupMax(n_serial);
+    s.marching = subgroupAdd(n_serial > 0u ? 1u : 0u);
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
         s.lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
         s.hi[k] = subgroupAdd(counts[k] >> 16);
     }
@@ -39,17 +42,20 @@ void add_sums(Sums s) {
     if (s.rays > 0u) atomicAdd(march_slots[at], s.rays);
     if (s.longest > 0u) atomicMax(march_slots[at + 1u], s.longest);
     if (s.offscreen > 0u) atomicAdd(march_slots[at + 2u], s.offscreen);
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
         if (s.lo[k] > 0u || s.hi[k] > 0u) ADD64(at + 3u + 2u * k, s.lo[k], s.hi[k])
     }
+    if (s.serial_max > 0u) atomicMax(march_slots[at + 11u], s.serial_max);
+    if (s.marching > 0u) atomicAdd(march_slots[at + 12u], s.marching);
 }
 
 #if COUNTERS == COUNTERS_WORKGROUP
-// rays, longest, off-screen, then (lo, hi) of steps, evals, candidates.
-shared uint c_sum[9];
+// rays, longest, off-screen, the lo then the hi of steps, evals, candidates and serial
+// evaluations, the longest serial chain, the invocations that evaluated.
+shared uint c_sum[13];
 void add_counters() {
     if (gl_LocalInvocationIndex == 0u) {
-        [[unroll]] for (uint k = 0u; k < 9u; ++k) c_sum[k] = 0u;
+        [[unroll]] for (uint k = 0u; k < 13u; ++k) c_sum[k] = 0u;
     }
     barrier();
     Sums s = subgroup_sums();
@@ -57,10 +63,12 @@ void add_counters() {
         atomicAdd(c_sum[0], s.rays);
         atomicMax(c_sum[1], s.longest);
         atomicAdd(c_sum[2], s.offscreen);
-        [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+        [[unroll]] for (uint k = 0u; k < 4u; ++k) {
             atomicAdd(c_sum[3u + k], s.lo[k]);
-            atomicAdd(c_sum[6u + k], s.hi[k]);
+            atomicAdd(c_sum[7u + k], s.hi[k]);
         }
+        atomicMax(c_sum[11], s.serial_max);
+        atomicAdd(c_sum[12], s.marching);
     }
     barrier();
     if (gl_LocalInvocationIndex != 0u) return;
@@ -68,10 +76,12 @@ void add_counters() {
     w.rays = c_sum[0];
     w.longest = c_sum[1];
     w.offscreen = c_sum[2];
-    [[unroll]] for (uint k = 0u; k < 3u; ++k) {
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
         w.lo[k] = c_sum[3u + k];
-        w.hi[k] = c_sum[6u + k];
+        w.hi[k] = c_sum[7u + k];
     }
+    w.serial_max = c_sum[11];
+    w.marching = c_sum[12];
     add_sums(w);
 }
 #elif COUNTERS == COUNTERS_SUBGROUP

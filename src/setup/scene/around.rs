@@ -93,20 +93,21 @@ fn framing_distance(lo: Vec3, hi: Vec3, dir: Vec3) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// The box the placed skin sweeps over the longest of its clip, its path's lap and the
-/// scene's frames (at most [`MAX_SPAN`] s).
-fn swept(
+/// The scene times whose poses play: the longest of the clip, its path's lap and the
+/// scene's frames (at most [`MAX_SPAN`] s), [`RATE`] a second (at most [`MAX_SAMPLES`]),
+/// from the clip's first frame. The one rule for what must fit: the fitted domain holds the
+/// skin at these poses, and the control target checks its particles at the same poses.
+pub fn played_times(
     scene: &Scene,
     desc: &CharacterDesc,
     ch: &Character,
     anim: &Animator,
-) -> Result<(Vec3, Vec3)> {
+) -> Vec<f64> {
     let speed = desc.speed.max(1e-6) as f64;
     let clip = anim
         .clip
         .map_or(0.0, |c| ch.clips[c].duration as f64 / speed);
-    let path = desc.path();
-    let lap = path.as_ref().map_or(0.0, |(p, v)| match *v > 0.0 {
+    let lap = desc.path().as_ref().map_or(0.0, |(p, v)| match *v > 0.0 {
         true => perimeter(p) / *v as f64,
         false => 0.0,
     });
@@ -114,9 +115,21 @@ fn swept(
     let run = scene.frames as f64 * f.dt as f64 * f.substeps as f64;
     let span = clip.max(lap).max(run).min(MAX_SPAN);
     let samples = ((span * RATE).ceil() as usize).clamp(1, MAX_SAMPLES);
+    (0..=samples)
+        .map(|k| span * k as f64 / samples as f64)
+        .collect()
+}
+
+/// The box the placed skin sweeps over the poses that play ([`played_times`]).
+fn swept(
+    scene: &Scene,
+    desc: &CharacterDesc,
+    ch: &Character,
+    anim: &Animator,
+) -> Result<(Vec3, Vec3)> {
+    let path = desc.path();
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-    for k in 0..=samples {
-        let t = span * k as f64 / samples as f64;
+    for t in played_times(scene, desc, ch, anim) {
         let mats = placed_matrices(ch, anim, desc.speed, path.as_ref(), t);
         let (a, b) = bounds(&ch.skinned_at(&mats, Skinning::Lbs)?.0);
         lo = lo.min(a);

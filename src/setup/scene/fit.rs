@@ -272,6 +272,8 @@ const SHOWN_OPEN: usize = 4;
 /// Parts named by the fit's line on thin parts.
 const SHOWN: usize = 3;
 
+use crate::control::fits::DIP;
+
 /// The character's first pose `first` must stand in the domain: a clear error naming the
 /// key to change when it does not (a foot may dip a tenth of its height into the floor, a
 /// hand as far into a wall).
@@ -279,7 +281,7 @@ fn inside(scene: &Scene, first: &[Vec3], height: f32) -> Result<()> {
     let (lo, hi) = crate::character::check::bounds(first);
     let (dlo, dhi) = (Vec3::from(scene.domain.min), Vec3::from(scene.domain.max));
     let name = &scene.name;
-    if lo.y < dlo.y - 0.1 * height {
+    if lo.y < dlo.y - DIP * height {
         return Err(Error::Param(format!(
             "scene {name}: the character reaches {:.3} m below the domain's floor (y = {}): raise [character] position's y, or set [character] up if the file is not Y-up (inspect FILE --up z --picture PNG shows it standing)",
             dlo.y - lo.y,
@@ -287,7 +289,7 @@ fn inside(scene: &Scene, first: &[Vec3], height: f32) -> Result<()> {
         )));
     }
     // (A hand or a nose a little past a wall stays in it, as a foot in the floor.)
-    let slack = Vec3::splat(0.1 * height);
+    let slack = Vec3::splat(DIP * height);
     if lo.cmplt(dlo - slack).any() || hi.cmpgt(dhi + slack).any() {
         return Err(Error::Param(format!(
             "scene {name}: the character's first pose spans {lo:.3}..{hi:.3}, outside the domain {dlo}..{dhi}: move [character] position, widen [domain], or leave [domain] out to fit it"

@@ -6,6 +6,7 @@ pub use kinds::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Pl
 pub mod binding;
 pub mod cache;
 pub mod fidelity;
+pub mod fits;
 pub mod force;
 pub mod grid;
 pub mod mesh_distance;

@@ -1,11 +1,13 @@
 //! A scene's control target (TOML `[control]`, switches override): the character's
-//! control particles placed and bound in the rest pose, and each frame's pose for them
-//! (joint matrices relative to the rest pose, so bound particles follow the animation).
+//! control particles placed and bound in the rest pose, checked against the domain at the
+//! poses that play (`fits`), and each frame's pose for them (joint matrices relative to the
+//! rest pose, so bound particles follow the animation).
 use super::binding;
+use super::fits::{self, Plays};
 use super::force::{ControlForce, ControlSettings, Pose, ALL_GROUPS};
 use super::placement;
 use crate::character::Skinning;
-use crate::character::{check, pose, Animator, Character, Mesh, MAX_INFLUENCES};
+use crate::character::{pose, Animator, Character, Mesh, MAX_INFLUENCES};
 use crate::control::{Adaptive, BoneWeights, ControlMotion, ControlPreset, Deficit, Placement};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -243,45 +245,41 @@ fn rest_inverses(ch: &Character, placed_rest: &[Mat4]) -> Result<Vec<Mat4>> {
         .collect()
 }
 
-impl ControlTarget {
-    /// Place and bind control particles in `ch` (posed by `anim`) for fluid searched by
-    /// `solver`.
-    #[allow(clippy::too_many_arguments)]
+/// The placed rest pose's joint matrices.
+fn placed_rest(ch: &Character, anim: &Animator) -> Vec<Mat4> {
+    ch.rest_matrices()
+        .iter()
+        .map(|m| anim.placement * *m)
+        .collect()
+}
+
+/// Control particles placed in the placed rest pose and bound to the character's joints,
+/// with the inverses of the rest matrices that pose them (what the GPU skins each frame).
+pub struct Bound {
+    pub mesh: Mesh,
+    pub rest_inv: Vec<Mat4>,
+    /// The character's mesh in the placed rest pose.
+    pub rest_mesh: Vec<Vec3>,
+    pub spacing: f32,
+}
+
+impl Bound {
+    /// Place and bind `desc`'s control particles in `ch` posed by `anim`; `None` for
+    /// `--placement rays`, which places in the moving surface every frame instead.
     pub fn new(
-        ctx: &Context,
-        solver: &crate::sph::SphSolver,
         ch: &Character,
         anim: &Animator,
         desc: &ControlDesc,
         fluid: &crate::sph::FluidParams,
-        domain: ([f32; 3], [f32; 3]),
-        (seed, skinning): (u64, Skinning),
-    ) -> Result<Self> {
-        let placed_rest: Vec<Mat4> = ch
-            .rest_matrices()
-            .iter()
-            .map(|m| anim.placement * *m)
-            .collect();
+        seed: u64,
+    ) -> Result<Option<Self>> {
+        if desc.placement == Placement::Rays {
+            return Ok(None);
+        }
+        let placed_rest = placed_rest(ch, anim);
         let (rest_mesh, _) = ch.skinned_at(&placed_rest, Skinning::Lbs)?;
         let spacing = desc.spacing.unwrap_or(fluid.spacing());
         let points = placement::place(ch, &rest_mesh, desc.placement, spacing, seed)?;
-        // Rays place inside the moving surface itself: all of it must fit.
-        let (what, span) = match desc.placement {
-            Placement::Rays => ("surface", check::bounds(&rest_mesh)),
-            _ => ("control particles", check::bounds(&points)),
-        };
-        let (dlo, dhi) = (Vec3::from(domain.0), Vec3::from(domain.1));
-        if span.0.cmplt(dlo).any() || span.1.cmpgt(dhi).any() {
-            return Err(Error::Param(format!(
-                "the control target {} reaches outside the domain {dlo}..{dhi} (its {what} span {}..{})",
-                ch.source, span.0, span.1
-            )));
-        }
-        if desc.placement == Placement::Rays {
-            desc.deficit()?;
-            let rest = (spacing, points.len());
-            return Self::rays(ctx, solver, ch, desc, fluid, domain, rest, skinning);
-        }
         let globals: Vec<Mat4> = ch
             .skeleton
             .globals(&ch.skeleton.rest_locals())
@@ -307,6 +305,52 @@ impl ControlTarget {
             morphs: Default::default(),
         };
         let rest_inv = rest_inverses(ch, &placed_rest)?;
+        Ok(Some(Self {
+            mesh,
+            rest_inv,
+            rest_mesh,
+            spacing,
+        }))
+    }
+
+    /// The particles skinned by `method` to placed joint matrices `mats`.
+    pub fn at(&self, ch: &Character, mats: &[Mat4], method: Skinning) -> Result<Vec<Vec3>> {
+        fits::skin(ch, &self.mesh, &self.rest_inv, mats, method)
+    }
+}
+
+impl ControlTarget {
+    /// Place and bind control particles in `ch` (posed by `anim`) for fluid searched by
+    /// `solver`; refused where they leave the domain at a pose that plays.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &Context,
+        solver: &crate::sph::SphSolver,
+        ch: &Character,
+        anim: &Animator,
+        desc: &ControlDesc,
+        fluid: &crate::sph::FluidParams,
+        plays: &Plays,
+        (seed, skinning): (u64, Skinning),
+    ) -> Result<Self> {
+        let domain = plays.domain;
+        let Some(Bound {
+            mesh,
+            rest_inv,
+            rest_mesh,
+            spacing,
+        }) = Bound::new(ch, anim, desc, fluid, seed)?
+        else {
+            // Rays place inside the moving surface itself: all of it must fit.
+            fits::check(ch, &ch.mesh, &[], skinning, "surface's vertices", plays)?;
+            desc.deficit()?;
+            let spacing = desc.spacing.unwrap_or(fluid.spacing());
+            let rest_mesh = ch.skinned_at(&placed_rest(ch, anim), Skinning::Lbs)?.0;
+            let points = placement::place(ch, &rest_mesh, desc.placement, spacing, seed)?;
+            let rest = (spacing, points.len());
+            return Self::rays(ctx, solver, ch, desc, fluid, domain, rest, skinning);
+        };
+        fits::check(ch, &mesh, &rest_inv, skinning, "control particles", plays)?;
         let settings = desc.settings(fluid);
         let fill = match desc.deficit()? {
             Deficit::Shape => {

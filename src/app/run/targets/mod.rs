@@ -3,6 +3,7 @@
 //! and released by the timeline; each attached target's pose set before the frame's
 //! steps, its metrics read after them; the first shown mesh drawn by the view.
 use crate::character::capsules::{self, BoneCapsule};
+use crate::control::fits::{Plays, DIP};
 use crate::control::metrics::{ControlMetrics, ControlStats};
 use crate::control::target::{ControlDesc, ControlTarget};
 use crate::control::timeline::{FiredEvent, Timeline};
@@ -15,7 +16,8 @@ use crate::gpu::Open;
 use crate::gpu::{Context, Guard, Profiler};
 use crate::render::mesh::MeshDraw;
 use crate::render::ShowMesh;
-use crate::scene::character::CharacterDesc;
+use crate::scene::around::played_times;
+use crate::scene::character::{placed_rest_bounds, CharacterDesc};
 use crate::scene::schema::MAIN_TARGET;
 use crate::scene::Scene;
 use crate::settings::TargetOptions;
@@ -132,6 +134,16 @@ impl SceneTargets {
             let scene_desc = control.cloned();
             let control = match control {
                 Some(d) => {
+                    // What must fit: the poses that play, by the fitted domain's rule.
+                    let times = played_times(scene, cdesc, &character.ch, &character.anim);
+                    let poses: Vec<_> = times.iter().map(|&t| (t, character.matrices(t))).collect();
+                    let (lo, hi) = placed_rest_bounds(&character.ch, &character.anim)?;
+                    let plays = Plays {
+                        domain: (scene.domain.min, scene.domain.max),
+                        slack: DIP * (hi.y - lo.y),
+                        poses: &poses,
+                        frame_s: scene.fluid.dt as f64 * scene.fluid.substeps as f64,
+                    };
                     let t = ControlTarget::new(
                         ctx,
                         solver,
@@ -139,7 +151,7 @@ impl SceneTargets {
                         &character.anim,
                         &(opts.control)(d)?,
                         &scene.fluid,
-                        (scene.domain.min, scene.domain.max),
+                        &plays,
                         (opts.seed, method),
                     )?;
                     let m = ControlMetrics::new(ctx, st.n, t.count(), &name, slots)?;

@@ -2,7 +2,7 @@
 //! list and look every pass compiles with (common.glsl's switches), and the march's own
 //! step, counters, lanes and path stack. Each key enumerates the settings that can run it.
 use super::renderer::MetaballIo;
-use super::settings::{MetaballSettings, MAX_DEPTH};
+use super::settings::{MetaballSettings, MAX_DEPTH, RAY_LANES};
 use crate::gpu::pass::{Defines, PassKey};
 use crate::render::{Counters, DensityFn, Lanes, ListKind, MarchKind, Material};
 
@@ -93,13 +93,15 @@ impl<const U: u8> PassKey for Lists<U> {
     }
 }
 
-/// The march's variant: the list and look, the step, counters, lanes and path stack.
+/// The march's variant: the list and look, the step, counters, lanes, lanes per ray and
+/// path stack.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MarchKey {
     pub lists: ListKey,
     pub march: MarchKind,
     pub counters: Counters,
     pub lanes: Lanes,
+    pub ray_lanes: u32,
     pub depth: u32,
 }
 
@@ -110,6 +112,7 @@ impl MarchKey {
             march: s.march,
             counters: s.counters,
             lanes: s.lanes,
+            ray_lanes: s.ray_lanes,
             depth: s.depth,
         }
     }
@@ -130,14 +133,17 @@ impl PassKey for MarchKey {
             for march in MarchKind::all() {
                 for counters in Counters::all() {
                     for lanes in Self::lanes(lists.list) {
-                        for depth in 0..=MAX_DEPTH {
-                            v.push(Self {
-                                lists,
-                                march: *march,
-                                counters: *counters,
-                                lanes: *lanes,
-                                depth,
-                            });
+                        for ray_lanes in RAY_LANES {
+                            for depth in 0..=MAX_DEPTH {
+                                v.push(Self {
+                                    lists,
+                                    march: *march,
+                                    counters: *counters,
+                                    lanes: *lanes,
+                                    ray_lanes,
+                                    depth,
+                                });
+                            }
                         }
                     }
                 }
@@ -149,15 +155,20 @@ impl PassKey for MarchKey {
     fn defines(&self) -> Defines {
         let mut d = self.lists.list_defines();
         d.extend(MetaballSettings::march_defines(self.march));
-        d.extend(MetaballSettings::lane_defines(self.counters, self.lanes));
+        d.extend(MetaballSettings::lane_defines(
+            self.counters,
+            self.lanes,
+            self.ray_lanes,
+        ));
         d.extend(MetaballSettings::stack_defines(self.depth));
         d
     }
 
     /// Every list, look and step at the default counters, lanes and depth; every counter
     /// mode and lane layout on the default look (their code reads no look); every depth
-    /// on glass over the S-buffer (the stack's code reads no list). Every line of
-    /// march.comp compiles, and the whole product (about 14000 variants) is not rebuilt.
+    /// on glass over the S-buffer (the stack's code reads no list); every lanes per ray on
+    /// every list, with Phong's both steps and glass's path. Every line of march.comp
+    /// compiles, and the whole product (about 56000 variants) is not rebuilt.
     fn compiled() -> Vec<Self> {
         let d = MarchKey::of(&MetaballSettings::thesis());
         Self::all()
@@ -170,8 +181,15 @@ impl PassKey for MarchKey {
                     && k.lists.material == Material::Glass
                     && k.lists.list == ListKind::Sbuffer
                     && k.march == MarchKind::Fixed;
+                let laned = k.ray_lanes != d.ray_lanes
+                    && k.lists.density == DensityFn::Wyvill
+                    && (k.lists.material == Material::Phong
+                        || (k.lists.material == Material::Glass && k.march == MarchKind::Fixed));
                 let usual = (k.counters, k.lanes) == (d.counters, d.lanes);
-                ((usual || plain) && k.depth == d.depth) || (glass && usual)
+                let serial = k.ray_lanes == d.ray_lanes;
+                (serial && (usual || plain) && k.depth == d.depth)
+                    || (serial && glass && usual)
+                    || (laned && usual && k.depth == d.depth)
             })
             .collect()
     }

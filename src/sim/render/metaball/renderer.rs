@@ -61,6 +61,7 @@ pub struct FluidRenderer {
 impl FluidRenderer {
     pub fn new(ctx: &Context, settings: MetaballSettings) -> Result<Self> {
         settings.validate()?;
+        Self::check_ray_lanes(ctx, &settings)?;
         let key = ListKey::of(&settings);
         let storage = GraphicsStates::STORAGE_ONLY;
         let graphics = |p: Result<Graphics>| p.map(|p| Guard::new(ctx, p));
@@ -368,10 +369,11 @@ impl FluidRenderer {
         {
             let _scope = scopes.open(ctx, cmd, MARCH.scope());
             // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
+            // --ray-lanes N: N invocations a pixel, so N times the groups.
             let march_groups = match (s.list, s.lanes) {
                 (ListKind::Tiles, _) | (_, Lanes::Blocks) => blocks(s),
                 (_, Lanes::Rows) => groups,
-            };
+            } * s.ray_lanes as u64;
             march.dispatch_groups(ctx, cmd, &bufs, &(), march_groups);
         }
         Ok(())
@@ -400,7 +402,8 @@ impl FluidRenderer {
 
     /// The statistics of the frame last rendered in `slot` (after its fence).
     pub fn frame_stats(&self, b: &MetaballBuffers, slot: usize) -> FrameStats {
-        let st = GpuStats::read(b.stats_readback[slot].mapped().expect("mapped"));
+        let raw = b.stats_readback[slot].mapped().expect("mapped");
+        let (st, serial) = (GpuStats::read(raw), super::stats::Serial::read(raw));
         let px = self.settings.pixels();
         let pairs = st.pairs as u64;
         let tile_bytes = b.tiles.bytes(pairs, b.tiles.rects.size / 8);
@@ -431,7 +434,7 @@ impl FluidRenderer {
             list_bytes,
             triangles: st.triangles as u64,
             pairs,
-            march: super::stats::MarchCounts::of(&st),
+            march: super::stats::MarchCounts::of(&st, &serial),
         }
     }
 
@@ -480,6 +483,31 @@ impl FluidRenderer {
             return b.grow(ctx, ListKind::Sbuffer, st.fragments);
         }
         Ok(())
+    }
+
+    /// `--ray-lanes N` marches a ray on N lanes of one subgroup (ballots and shuffles):
+    /// refused in one line where the device's subgroup is narrower or lacks them.
+    fn check_ray_lanes(ctx: &Context, s: &MetaballSettings) -> Result<()> {
+        let (n, info) = (s.ray_lanes, &ctx.info);
+        if n == 1 || !s.marches() || (n <= info.subgroup_size && info.subgroup_shuffle) {
+            return Ok(());
+        }
+        Err(Error::Param(format!(
+            "--ray-lanes {n} marches a ray on {n} lanes of one subgroup (ballots and shuffles); \
+             this device's subgroups are {} lanes{}: use --ray-lanes {} or less (a ray over \
+             workgroup shared memory is not built)",
+            info.subgroup_size,
+            if info.subgroup_shuffle {
+                ""
+            } else {
+                " without ballots and shuffles"
+            },
+            super::settings::RAY_LANES
+                .iter()
+                .filter(|&&k| info.subgroup_shuffle && k <= info.subgroup_size)
+                .max()
+                .unwrap_or(&1),
+        )))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -34,6 +34,9 @@ pub struct MetaballSettings {
     /// How the march lays pixels on invocations.
     #[serde(default = "thesis_lanes")]
     pub lanes: Lanes,
+    /// Lanes that march one ray together (1: one invocation per ray; `RAY_LANES`).
+    #[serde(default = "thesis_ray_lanes")]
+    pub ray_lanes: u32,
     /// How the S-buffer's lists are built: rasterised billboards, or compute from the
     /// per-tile lists (each range then in depth order, no sort pass). Tiles: compute.
     #[serde(default = "thesis_build")]
@@ -96,6 +99,7 @@ impl MetaballSettings {
             march: MarchKind::Fixed,
             counters: Counters::Subgroup,
             lanes: Lanes::Blocks,
+            ray_lanes: 1,
             build: BuildKind::Raster,
             tile: 16,
             offscreen_end: false,
@@ -136,6 +140,10 @@ fn thesis_lanes() -> Lanes {
     MetaballSettings::thesis().lanes
 }
 
+fn thesis_ray_lanes() -> u32 {
+    MetaballSettings::thesis().ray_lanes
+}
+
 fn thesis_build() -> BuildKind {
     MetaballSettings::thesis().build
 }
@@ -148,6 +156,8 @@ fn thesis_tile() -> u32 {
 pub const TILES: [u32; 3] = [8, 16, 32];
 
 pub const MAX_DEPTH: u32 = 6;
+/// The lanes `--ray-lanes` takes (march_lanes.glsl).
+pub const RAY_LANES: [u32; 4] = [1, 8, 16, 32];
 pub const MAX_REFINE: u32 = 32;
 
 /// Complex index of refraction (n, k) per RGB channel (about 650, 550, 450 nm).
@@ -256,6 +266,12 @@ impl MetaballSettings {
                     .into(),
             ));
         }
+        if !RAY_LANES.contains(&self.ray_lanes) {
+            return Err(Error::Param(format!(
+                "--ray-lanes must be 1, 8, 16 or 32, got {}",
+                self.ray_lanes
+            )));
+        }
         if self.depth > MAX_DEPTH {
             return Err(Error::Param(format!(
                 "--depth must be at most {MAX_DEPTH}, got {}",
@@ -289,11 +305,12 @@ impl MetaballSettings {
         vec![("STACK".to_string(), (depth + 1).to_string())]
     }
 
-    /// The march.comp defines of its counters and lane layout (COUNTERS, LANES and their
-    /// named values).
-    pub fn lane_defines(counters: Counters, lanes: Lanes) -> Vec<(String, String)> {
+    /// The march.comp defines of its counters, lane layout and lanes per ray (COUNTERS,
+    /// LANES and their named values, RAY_LANES).
+    pub fn lane_defines(counters: Counters, lanes: Lanes, ray_lanes: u32) -> Vec<(String, String)> {
         let mut d = counters.define("COUNTERS");
         d.extend(lanes.define("LANES"));
+        d.push(("RAY_LANES".to_string(), ray_lanes.to_string()));
         d
     }
 

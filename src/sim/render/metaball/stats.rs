@@ -50,11 +50,8 @@ impl GpuStats {
         let (mut steps, mut evals, mut candidates) =
             (wide(st.steps), wide(st.evals), wide(st.candidates));
         // A slot's words: rays, longest list, off-screen samples, then the (lo, hi) totals
-        // of steps, evaluations and candidates (march.comp's add_sums).
-        let word = |slot: usize, k: usize| {
-            let at = Self::SIZE as usize + (slot * MARCH_SLOT_WORDS + k) * 4;
-            u32::from_le_bytes([raw[at], raw[at + 1], raw[at + 2], raw[at + 3]])
-        };
+        // of steps, evaluations and candidates (march.comp's add_sums; Serial reads the rest).
+        let word = |slot: usize, k: usize| Self::slot_word(raw, slot, k);
         for k in 0..MARCH_SLOTS {
             st.rays += word(k, 0);
             st.longest = st.longest.max(word(k, 1));
@@ -67,9 +64,38 @@ impl GpuStats {
         (st.steps, st.evals, st.candidates) = (split(steps), split(evals), split(candidates));
         st
     }
+    /// The 32-bit word k of counter slot `slot` in a read-back stats buffer.
+    fn slot_word(raw: &[u8], slot: usize, k: usize) -> u32 {
+        let at = Self::SIZE as usize + (slot * MARCH_SLOT_WORDS + k) * 4;
+        u32::from_le_bytes([raw[at], raw[at + 1], raw[at + 2], raw[at + 3]])
+    }
+
     /// Where the S-buffer's total is copied.
     pub const SBUFFER_FRAGMENTS_OFFSET: u64 =
         std::mem::offset_of!(GpuStats, sbuffer_fragments) as u64;
+}
+
+/// The march's serial chains, summed from the counter slots (words 9..13: the (lo, hi)
+/// total of every invocation's evaluations, the longest chain, the invocations that
+/// evaluated; march_counters.glsl).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Serial {
+    pub max: u32,
+    pub invocations: u64,
+    pub sum: u64,
+}
+
+impl Serial {
+    pub fn read(raw: &[u8]) -> Self {
+        let word = |slot: usize, k: usize| GpuStats::slot_word(raw, slot, k);
+        let mut s = Self::default();
+        for k in 0..MARCH_SLOTS {
+            s.sum += wide([word(k, 9), word(k, 10)]);
+            s.max = s.max.max(word(k, 11));
+            s.invocations += word(k, 12) as u64;
+        }
+        s
+    }
 }
 
 /// One frame's list statistics (the thesis's memory column is `list_bytes`).
@@ -108,15 +134,24 @@ pub struct MarchCounts {
     pub steps: u64,
     pub evaluations: u64,
     pub candidates: u64,
+    /// The most field and gradient evaluations one invocation made one after another in
+    /// the frame: the longest serial chain, which sets the march's time on a wide device.
+    #[serde(default)]
+    pub serial_max: u64,
+    /// Their mean over the invocations that evaluated at all.
+    #[serde(default)]
+    pub serial_mean: f64,
 }
 
 impl MarchCounts {
-    pub fn of(st: &GpuStats) -> Self {
+    pub fn of(st: &GpuStats, serial: &Serial) -> Self {
         Self {
             rays: st.rays as u64,
             steps: wide(st.steps),
             evaluations: wide(st.evals),
             candidates: wide(st.candidates),
+            serial_max: serial.max as u64,
+            serial_mean: serial.sum as f64 / serial.invocations.max(1) as f64,
         }
     }
 

@@ -1,0 +1,255 @@
+// The march along one ray (march.comp includes it after the field): the bisection of a
+// crossing, the fixed-step march and the Lipschitz march, serial (RAY_LANES 1: one
+// invocation per ray) or over a group of RAY_LANES lanes (march_lanes.glsl), which takes
+// the serial march's samples and bisection midpoints, so its hits are bit for bit the same.
+#ifndef RENDER_METABALL_MARCH_RAY_GLSL
+#define RENDER_METABALL_MARCH_RAY_GLSL
+#if RAY_LANES == 1
+// The crossing between ray parameters a (this side of T) and b (across it), refined by
+// P.refine bisection steps; pixel as in `march` (NIL: each sample projects).
+float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
+    float T = threshold();
+    uint k = 0u;
+    for (; k < P.refine; ++k) {
+        float m = 0.5 * (a + b);
+        vec3 xm = o + d * m;
+        uint pm = pixel == NIL ? project(xm) : pixel;
+        if (pm == NIL) pm = ALL;
+        if ((field(xm, pm) >= T) != inside) b = m; else a = m;
+    }
+    CUT_UNLESS(!(k < P.refine))
+    n_steps += k;  // the samples taken, counted once (not per sample)
+    return b;
+}
+
+// March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
+// ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
+// -2 when a secondary sample left the screen and paths end there. Samples sit on the
+// grid t = k * step from the ray's origin, so every list variant (whose intervals start
+// at different t0) takes the same samples and bisects the same steps.
+float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w;
+    float t = ceil(t0 / step) * step;
+    float prev = max(t - step, 0.0);
+    uint i = 0u;
+    n_rays++;
+    // The samples are counted once at each exit (i + 1 where sample i ends the march).
+    for (; i < P.max_steps && t <= t1; ++i) {
+        vec3 x = o + d * t;
+        uint p = pixel;
+        if (pixel == NIL) {
+            p = project(x);
+            if (p == NIL) {
+                offscreen_samples++;
+                if (P.offscreen_end != 0u) {
+                    n_steps += i + 1u;
+                    return -2.0;
+                }
+                p = ALL;
+            }
+        }
+        if ((field(x, p) >= T) != inside) {
+            n_steps += i + 1u;
+            return bisect(o, d, prev, t, inside, pixel);
+        }
+        prev = t;
+        t += step;
+    }
+    CUT_UNLESS(!(i < P.max_steps && t <= t1))
+    n_steps += i;
+    return -1.0;
+}
+
+#if MARCH == MARCH_LIPSCHITZ
+// `march` on the same grid for a primary ray, whose pixel's list holds every metaball the
+// ray meets: at a sample where the field is f, the m metaballs within R + R of it change
+// the field by at most m SLOPE_MAX / R per unit length over the next R, so the grid samples
+// closer than |f - T| R / (m SLOPE_MAX) are on this sample's side and are skipped (all of
+// the next R when m = 0). The first sample across T, its bracket and its bisection are the
+// fixed march's: the same hits.
+float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w, reach = radius();
+    float slope = SLOPE_MAX / radius();
+    float k0 = ceil(t0 / step);
+    float k = 0.0;
+    float t = k0 * step;
+    n_rays++;
+    uint i = 0u;
+    for (; i < P.max_steps && k < float(P.max_steps) && t <= t1; ++i) {
+        vec3 x = o + d * t;
+        vec2 fm = field_reach(x, pixel, reach);
+        if ((fm.x >= T) != inside) {
+            n_steps += i + 1u;
+            return bisect(o, d, max(t - step, 0.0), t, inside, pixel);
+        }
+        float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
+        // Samples strictly closer than `safe` (and within `reach`) are skipped.
+        k += max(ceil(min(safe, reach) / step - 1e-4), 1.0);
+        t = (k0 + k) * step;
+    }
+    CUT_UNLESS(!(i < P.max_steps && k < float(P.max_steps) && t <= t1))
+    n_steps += i;
+    return -1.0;
+}
+#elif MARCH != MARCH_FIXED
+#error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
+#endif
+#else
+// The crossing between ray parameters a (this side of T) and b (across it), refined by
+// P.refine bisection steps; pixel as in `march` (NIL: each sample projects). Each round
+// takes BISECT_LEVELS levels at once: lane j evaluates node j + 1 of the round's
+// midpoint tree (heap order; a node's midpoint computed down its path exactly as the
+// serial steps compute it), and the ballot's bits replay the serial decisions.
+float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
+    float T = threshold();
+    uint lane = ray_lane(), h = lane + 1u, level = uint(findMSB(h));
+    uint k = 0u;
+    for (; k < P.refine;) {
+        uint r = min(BISECT_LEVELS, P.refine - k);
+        bool mine = level < r;
+        float la = a, lb = b;
+        [[unroll]] for (uint l = 0u; l < BISECT_LEVELS; ++l) {
+            if (l < level) {
+                float m = 0.5 * (la + lb);
+                if (((h >> (level - 1u - l)) & 1u) == 0u) lb = m; else la = m;
+            }
+        }
+        uint e0 = n_evals;
+        bool across = false;
+        if (mine) {
+            float m = 0.5 * (la + lb);
+            vec3 xm = o + d * m;
+            uint pm = pixel == NIL ? project(xm) : pixel;
+            if (pm == NIL) pm = ALL;
+            across = (field(xm, pm) >= T) != inside;
+        }
+        uint bits = lanes_ballot(across);
+        // The serial steps: node n's decision, then its child (2n: across, b = m).
+        uint node = 1u;
+        bool on_path = false;
+        [[unroll]] for (uint l = 0u; l < BISECT_LEVELS; ++l) {
+            if (l < r) {
+                on_path = on_path || node == h;
+                float m = 0.5 * (a + b);
+                bool c = ((bits >> (node - 1u)) & 1u) != 0u;
+                if (c) b = m; else a = m;
+                node = 2u * node + (c ? 0u : 1u);
+            }
+        }
+        // Terms of midpoints off the serial path are speculation, not the march's count.
+        if (mine && !on_path) n_evals = e0;
+        k += r;
+    }
+    CUT_UNLESS(!(k < P.refine))
+    n_steps += k;  // the samples the serial bisection takes
+    return b;
+}
+
+// March [t0, t1] as the serial march does (below RAY_LANES == 1), RAY_LANES samples a
+// round: lane j takes grid sample i + j. The first lane that crosses T (or leaves the
+// screen, with offscreen_end) ends the march; samples past it are speculation and leave
+// the counts as the serial march's.
+float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w;
+    float t = ceil(t0 / step) * step;
+    float prev = max(t - step, 0.0);
+    uint lane = ray_lane();
+    uint i = 0u;
+    n_rays++;
+    bool more = true;
+    for (; more;) {
+        float tj = grid_ahead(t, step, lane);
+        bool valid = i + lane < P.max_steps && tj <= t1;
+        uint e0 = n_evals, off0 = offscreen_samples;
+        bool leaves = false, across = false;
+        if (valid) {
+            vec3 x = o + d * tj;
+            uint p = pixel;
+            if (pixel == NIL) {
+                p = project(x);
+                if (p == NIL) {
+                    offscreen_samples++;
+                    leaves = P.offscreen_end != 0u;
+                    p = ALL;
+                }
+            }
+            if (!leaves) across = (field(x, p) >= T) != inside;
+        }
+        uint f = lanes_first(leaves || across);
+        if (f < RAY_LANES) {
+            if (lane > f) {
+                n_evals = e0;
+                offscreen_samples = off0;
+            }
+            n_steps += i + f + 1u;
+            if (lanes_first(across) != f) return -2.0;
+            float pf = f == 0u ? prev : grid_ahead(t, step, f - 1u);
+            return bisect(o, d, pf, grid_ahead(t, step, f), inside, pixel);
+        }
+        uint end = lanes_first(!valid);
+        if (end < RAY_LANES) {
+            n_steps += i + end;
+            more = false;
+        } else {
+            i += RAY_LANES;
+            prev = grid_ahead(t, step, RAY_LANES - 1u);
+            t = grid_ahead(t, step, RAY_LANES);
+        }
+    }
+    CUT_UNLESS(!more)
+    return -1.0;
+}
+
+#if MARCH == MARCH_LIPSCHITZ
+// The Lipschitz march (below RAY_LANES == 1) on RAY_LANES consecutive grid samples a
+// round: the first that crosses T is the fixed march's first crossing, and the next round
+// starts at the farthest sample a lane's bound proves on this side (each lane's skip
+// starts at or before the last sample evaluated, so nothing unproven is skipped). The
+// samples counted are those evaluated up to the hit.
+float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w, reach = radius();
+    float slope = SLOPE_MAX / radius();
+    float k0 = ceil(t0 / step);
+    uint lane = ray_lane();
+    float k = 0.0;
+    n_rays++;
+    uint i = 0u;
+    bool more = true;
+    for (; more && i < P.max_steps;) {
+        float kj = k + float(lane);
+        float tj = (k0 + kj) * step;
+        bool valid = kj < float(P.max_steps) && tj <= t1;
+        uint e0 = n_evals;
+        bool across = false;
+        float next = kj + 1.0;
+        if (valid) {
+            vec2 fm = field_reach(o + d * tj, pixel, reach);
+            across = (fm.x >= T) != inside;
+            float safe = fm.y > 0.0 ? abs(fm.x - T) / (fm.y * slope) : reach;
+            next = kj + max(ceil(min(safe, reach) / step - 1e-4), 1.0);
+        }
+        uint f = lanes_first(across);
+        if (f < RAY_LANES) {
+            if (lane > f) n_evals = e0;
+            n_steps += i + f + 1u;
+            float tf = (k0 + k + float(f)) * step;
+            return bisect(o, d, max(tf - step, 0.0), tf, inside, pixel);
+        }
+        uint end = lanes_first(!valid);
+        if (end < RAY_LANES) {
+            n_steps += i + end;
+            more = false;
+        } else {
+            i += RAY_LANES;
+            k = lanes_max(next);
+        }
+    }
+    CUT_UNLESS(!more || !(i < P.max_steps))
+    if (more) n_steps += i;
+    return -1.0;
+}
+#elif MARCH != MARCH_FIXED
+#error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
+#endif
+#endif
+#endif
