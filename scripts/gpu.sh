@@ -128,16 +128,20 @@ if [ $quick = 1 ]; then
   reps=(--frames 2 --warmup 1)
   small=(--particles 8192)
   render=(--particles 256 --width 64 --height 64)
+  scopes=(--particles 2048 --width 64 --height 64 --frames 4 --rounds 1)
   solvers=(--particles 1024 --frames 1 --warmup 1 --skip-stability)
   sph=(--skip-stability)
 else
   reps=(--frames $([ "$budget" -ge 900 ] && echo 20 || echo 10) --warmup 2)
   small=() render=() sph=()
+  scopes=(--frames 30 --rounds 1)
   solvers=(--seconds $([ "$budget" -ge 900 ] && echo 10 || echo 3))
 fi
 step bench-primitives "$(until_pct "${ends[0]}")" bash scripts/bench_primitives.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}"
 step bench-sph "$(until_pct "${ends[1]}")" bash scripts/bench_sph.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${small[@]}" "${sph[@]}"
 step bench-render "$(until_pct "${ends[2]}")" bash scripts/bench_render.sh "${dev[@]}" "${val[@]}" "${reps[@]}" "${render[@]}"
+# What the profiler's ~1,000 timestamps a character frame cost (--scopes frame|passes|all).
+step scopes "$(until_pct "${ends[2]}")" bash scripts/scopes_cost.sh "${dev[@]}" "${scopes[@]}"
 step bench-solvers "$(until_pct "${ends[3]}")" bash scripts/bench_solvers.sh "${dev[@]}" "${val[@]}" "${solvers[@]}"
 # SPlisHSPlasH 2.19's DFSPH on this machine's cores beside ours, on the same dam break at
 # 0.1% (issue 59), from carried wheels: the device machine reaches no package index.

@@ -161,6 +161,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Row>> {
         return Err(Error::Param("--frames must be at least 1".into()));
     }
     let sw = &opts.switches;
+    sw.all_scopes("bench")?;
     let ctx = Context::new(&ContextOptions {
         device: sw.common.device.clone(),
         validation: sw.common.validation,

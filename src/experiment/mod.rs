@@ -337,6 +337,7 @@ pub fn run(opts: &ExperimentOptions) -> Result<Vec<PathBuf>> {
         return Err(Error::Param("experiment: no experiment named".into()));
     }
     let sw = &opts.switches;
+    sw.all_scopes("experiment")?;
     let ctx = Context::new(&ContextOptions {
         device: sw.common.device.clone(),
         validation: sw.common.validation,

@@ -38,7 +38,7 @@ pub use memory::{Buffer, Image, MemoryLocation};
 pub use pass::{ComputeDecl, GraphicsDecl, GraphicsStates, PassKey};
 pub use pipeline::{ComputeDesc, ComputePipeline};
 pub use profiler::{
-    FrameTiming, Labels, Open, Profiler, Scope, ScopeKey, ScopeName, Scopes, FRAME,
+    FrameTiming, Labels, Open, Profiler, Scope, ScopeDepth, ScopeKey, ScopeName, Scopes, FRAME,
 };
 pub use target::ColorTarget;
 pub use track::Recorded;

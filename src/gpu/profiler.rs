@@ -39,6 +39,31 @@ impl FrameTiming {
 
 /// Queries per pool (a begin and an end per scope).
 const POOL_QUERIES: u32 = 256;
+/// A scope deeper than the profiler times: its label, no timestamps.
+const UNTIMED: u32 = u32::MAX - 1;
+
+crate::switch_enum!(
+    /// Which scopes write timestamps (`--scopes`): the frame alone, the frame and the
+    /// scopes directly in it (sph, render, ...: one pair each, however many substeps), or
+    /// every scope (about 1,000 timestamps a frame of the 64K character). Deeper scopes keep
+    /// their debug labels. What the profiler itself costs is the frame's time between them.
+    ScopeDepth {
+        Frame,
+        Passes,
+        All
+    }
+);
+
+impl ScopeDepth {
+    /// The deepest scope timed (the frame is depth 0).
+    fn depth(self) -> usize {
+        match self {
+            ScopeDepth::Frame => 0,
+            ScopeDepth::Passes => 1,
+            ScopeDepth::All => usize::MAX,
+        }
+    }
+}
 
 struct Slot {
     pools: Vec<vk::QueryPool>,
@@ -63,6 +88,8 @@ pub struct Profiler {
     mask: u64,
     /// Open scopes: (index into the slot's scopes, key).
     stack: Vec<(usize, String)>,
+    /// The deepest scope that writes timestamps.
+    timed: usize,
     current: usize,
     pub results: Vec<FrameTiming>,
 }
@@ -252,6 +279,7 @@ impl Profiler {
                 (1u64 << bits) - 1
             },
             stack: Vec::new(),
+            timed: ScopeDepth::All.depth(),
             current: 0,
             results: Vec::new(),
         };
@@ -279,6 +307,11 @@ impl Profiler {
         unsafe { ctx.device.reset_query_pool(pool, 0, POOL_QUERIES) };
         s.pools.push(pool);
         Ok(())
+    }
+
+    /// Which scopes write timestamps from the next frame on (`--scopes`; default all).
+    pub fn time_scopes(&mut self, depth: ScopeDepth) {
+        self.timed = depth.depth();
     }
 
     /// Start recording frame `frame` into `slot` (whose previous results were collected).
@@ -325,6 +358,14 @@ impl Profiler {
             Some((_, parent)) if parent != FRAME_SCOPE => format!("{parent}/{name}"),
             _ => name.to_string(),
         };
+        if self.stack.len() > self.timed {
+            let parent = self.stack.last().map(|(i, _)| *i);
+            let s = &mut self.slots[self.current];
+            s.scopes.push((key.clone(), UNTIMED, UNTIMED));
+            s.parents.push(parent);
+            self.stack.push((s.scopes.len() - 1, key));
+            return;
+        }
         let begin = self.next_query(ctx);
         let end = self.next_query(ctx);
         let (b, e) = match (begin, end) {
@@ -356,7 +397,7 @@ impl Profiler {
         };
         let s = &self.slots[self.current];
         let (_, _, q) = s.scopes[i];
-        if q != u32::MAX {
+        if q != u32::MAX && q != UNTIMED {
             unsafe {
                 ctx.device.cmd_write_timestamp2(
                     cmd,
@@ -416,6 +457,9 @@ impl Profiler {
         let mut pass_of = vec![None; s.scopes.len()];
         let mut frame_ms = 0.0;
         for (k, (name, a, b)) in s.scopes.iter().enumerate() {
+            if *a == UNTIMED {
+                continue; // deeper than --scopes times (so are its children)
+            }
             if name == FRAME_SCOPE && s.parents[k].is_none() {
                 frame_ms = ms(*a, *b);
             } else {

@@ -56,6 +56,11 @@ pub struct CommonArgs {
     #[arg(long, value_name = "FILE")]
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trace: Option<std::path::PathBuf>,
+    /// Which GPU scopes write timestamps in `run`: frame (the frame alone), passes (the
+    /// frame and the scopes directly in it: sph, render, ...) or all (default: every pass)
+    #[arg(long, value_parser = choice::<fluidform_gpu::ScopeDepth>())]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scopes: Option<fluidform_gpu::ScopeDepth>,
 }
 
 /// Size of rendered frames.
@@ -439,6 +444,7 @@ impl Default for CommonArgs {
             seed: 1,
             particles: None,
             trace: None,
+            scopes: None,
         }
     }
 }
@@ -498,6 +504,18 @@ fn set_in<T: Serialize + Default>(g: &T) -> Vec<String> {
 }
 
 impl Switches {
+    /// `--scopes` other than `all` belongs to `run`: `what` (a bench, an experiment, the
+    /// window) reads every pass's time, so it is refused there in one line.
+    pub fn all_scopes(&self, what: &str) -> Result<()> {
+        match self.common.scopes {
+            Some(s) if s != fluidform_gpu::ScopeDepth::All => Err(Error::Unsupported(format!(
+                "--scopes {} belongs to run: {what} times every pass (--scopes all)",
+                s.as_str()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// Fail on the first set switch of a group that `what` does not use, naming what uses
     /// it: a switch never silently does nothing. The common and frame groups always apply.
     pub fn reject_unused(&self, what: &str, uses: &[Group]) -> Result<()> {

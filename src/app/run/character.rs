@@ -100,7 +100,15 @@ pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Re
         frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
-    let timings = play(&ctx, frame_count, &mut work, &opts.scene, sw.common.quiet);
+    let scopes = sw.common.scopes.unwrap_or(crate::gpu::ScopeDepth::All);
+    let timings = play_scoped(
+        &ctx,
+        frame_count,
+        &mut work,
+        &opts.scene,
+        sw.common.quiet,
+        scopes,
+    );
     let stats = work.character.stats(None);
     let render = work.view.stats();
     work.character.destroy(&ctx);

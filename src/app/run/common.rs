@@ -2,6 +2,7 @@
 //! camera switches, failing on validation errors, and playing frames of a `FrameWork`.
 use crate::config::Switches;
 use crate::error::{Error, Result};
+use crate::gpu::ScopeDepth;
 use crate::gpu::{Context, ContextOptions, FrameLoop, FrameTiming, FrameWork};
 use crate::render::Camera;
 
@@ -46,7 +47,7 @@ pub fn camera_with_switches(mut cam: Camera, sw: &Switches) -> Camera {
 }
 
 /// Play `frames` frames of `work` with `SLOTS` in flight, reporting progress as `what`
-/// unless `quiet`; the GPU timings of every frame.
+/// unless `quiet`; the GPU timings of every frame (every scope timed).
 pub fn play(
     ctx: &Context,
     frames: u64,
@@ -54,7 +55,20 @@ pub fn play(
     what: &str,
     quiet: bool,
 ) -> Result<Vec<FrameTiming>> {
+    play_scoped(ctx, frames, work, what, quiet, ScopeDepth::All)
+}
+
+/// `play`, timing only the scopes `scopes` asks for (`run --scopes`).
+pub fn play_scoped(
+    ctx: &Context,
+    frames: u64,
+    work: &mut dyn FrameWork,
+    what: &str,
+    quiet: bool,
+    scopes: ScopeDepth,
+) -> Result<Vec<FrameTiming>> {
     let mut fl = FrameLoop::new(ctx, SLOTS)?;
+    fl.profiler.time_scopes(scopes);
     let mut reporting = crate::progress::Reporting {
         work,
         progress: crate::progress::Progress::new(what, frames, quiet),

@@ -96,6 +96,7 @@ fn no_display(e: impl std::fmt::Display) -> Error {
 
 /// Open the window and play until it closes (or `frames` frames have played).
 pub fn view(opts: ViewOptions) -> Result<()> {
+    opts.switches.all_scopes("view (its panel)")?;
     if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
         return Err(no_display("DISPLAY is not set"));
     }
