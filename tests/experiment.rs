@@ -210,6 +210,7 @@ fn quick_experiments_write_every_file_and_column() {
         fluidform::experiment::lists::BEST_PHONG,
         fluidform::experiment::lists::BEST_GLASS,
         fluidform::experiment::lists::DEMO_FASTER,
+        fluidform::experiment::lists::PARALLEL_MARCH,
         findings::SIXFOLD_K2,
         fluidform::experiment::solves::CLAIM,
         "cost rises with the radius R",

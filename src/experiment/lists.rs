@@ -3,7 +3,8 @@
 //! times, list memory and each frame's floor on this device; then the modes that apply on
 //! the liquid character (the default demo). Findings: the compute-built S-buffer against
 //! the A-buffer and the raster-built S-buffer, tiles against every per-pixel list, the
-//! Lipschitz march's steps, and the speed targets of the best mode.
+//! Lipschitz march's steps, the speed targets of the best mode, and the glass rays marched
+//! by several lanes against one invocation a ray (issue 67).
 use super::findings::{Finding, Verdict};
 use super::measure::base;
 use super::shots::{time_shots, Shot};
@@ -30,6 +31,12 @@ pub const BEST_GLASS: &str =
     "best list mode at least 2x the sorted S-buffer (thesis frame, glass depth 3)";
 pub const DEMO_FASTER: &str =
     "the default demo's render pass at least 2x faster with the best list mode";
+/// Issue 67: the sorted S-buffer's glass at depth 3 with the widest `--ray-lanes` the
+/// device's subgroup holds (32 on NVIDIA, 8 on lavapipe) against one invocation a ray.
+pub const PARALLEL_MARCH: &str =
+    "the parallel march at least 4x the serial one on glass at depth 3";
+/// The glass row whose rays are marched by several lanes: the thesis's sorted S-buffer.
+const LANED: Mode = Mode(S, true, R, 16, FIXED);
 
 /// A list mode: (list, sorted, build, tile, march).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +104,9 @@ struct Cell {
     steps: f64,
     evals: f64,
     floor: f64,
+    /// Lanes a ray (`--ray-lanes`) and the longest serial chain (`serial_max`).
+    lanes: u32,
+    serial: u64,
 }
 
 /// Glass at depth 3 costs ten Phong frames on lavapipe: the sorted lists and tiles up to
@@ -117,11 +127,21 @@ const LOOKS: [Look; 2] = [
     ("glass, depth 3 (table 6)", Material::Glass, 3, glass_mode),
 ];
 
+/// The lane counts a ray can be marched with here beyond 1 (a ray's lanes share a subgroup).
+fn lane_counts(ctx: &crate::gpu::Context) -> Vec<u32> {
+    let info = &ctx.info;
+    [8, 16, 32]
+        .into_iter()
+        .filter(|&n| info.subgroup_shuffle && n <= info.subgroup_size)
+        .collect()
+}
+
+/// Every look's cells, then the glass cells of [`LANED`] marched by several lanes.
 fn thesis_frame(
     ctx: &crate::gpu::Context,
     env: &mut Env,
     steps: &mut Steps,
-) -> Result<Vec<Vec<Cell>>> {
+) -> Result<(Vec<Vec<Cell>>, Vec<Cell>)> {
     let centers = env.scene(ctx)?.centers.clone();
     let cam = env.scene(ctx)?.camera;
     let n = centers.len();
@@ -135,16 +155,36 @@ fn thesis_frame(
     // Every look's modes, timed together (the protocol interleaves them).
     let mut shots = Vec::new();
     let mut which = Vec::new();
-    for (k, (label, material, depth, modes)) in LOOKS.into_iter().enumerate() {
-        for mode in MODES.iter().filter(|m| modes(m)) {
+    let laned = (lane_counts(ctx).into_iter()).map(|lanes| (1, LOOKS[1].0, LANED, lanes));
+    let every = LOOKS
+        .into_iter()
+        .enumerate()
+        .flat_map(|(k, (label, _, _, modes))| {
+            MODES
+                .iter()
+                .filter(move |m| modes(m))
+                .map(move |m| (k, label, *m, 1))
+        });
+    for (k, label, mode, lanes) in every.chain(laned) {
+        let (_, material, depth, _) = LOOKS[k];
+        {
             let mut s = base(env.width, env.height)?;
-            (s.material, s.depth) = (material, depth);
+            (s.material, s.depth, s.ray_lanes) = (material, depth, lanes);
             mode.apply(&mut s);
             s.validate()?;
             let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
                 "particles": n });
+            let suffix = if lanes > 1 {
+                format!("-lanes-{lanes}")
+            } else {
+                String::new()
+            };
             shots.push(Shot {
-                variant: format!("{}-{}", material.as_str(), mode.name().replace(' ', "-")),
+                variant: format!(
+                    "{}-{}{suffix}",
+                    material.as_str(),
+                    mode.name().replace(' ', "-")
+                ),
                 settings: s,
                 centers: &buf,
                 centers_key: format!("thesis {n}"),
@@ -152,14 +192,15 @@ fn thesis_frame(
                 cam,
                 detail,
             });
-            which.push((k, label, *mode));
+            which.push((k, label, mode, lanes));
         }
     }
     steps.start("every look and mode, interleaved");
     let timed = time_shots(ctx, env, &opts, &shots)?;
     steps.tick();
     let mut out: Vec<Vec<Cell>> = LOOKS.iter().map(|_| Vec::new()).collect();
-    for ((t, shot), (k, label, mode)) in timed.iter().zip(&shots).zip(which) {
+    let mut laned = Vec::new();
+    for ((t, shot), (k, label, mode, lanes)) in timed.iter().zip(&shots).zip(which) {
         let (st, after) = (&t.sized, &t.after);
         if after.budget_pixels > 0 || after.overflow > 0 {
             return Err(Error::Param(format!(
@@ -178,7 +219,7 @@ fn thesis_frame(
             .map(|(k, v)| format!("{k} {v:.2}"))
             .collect::<Vec<_>>()
             .join(", ");
-        out[k].push(Cell {
+        let cell = Cell {
             mode,
             ms: t.row.main.median,
             est: t.row.estimate().unwrap_or_default(),
@@ -187,9 +228,15 @@ fn thesis_frame(
             steps: st_px,
             evals: ev_px,
             floor: floor.ms(bytes, after.march.evaluations as f64),
-        });
+            lanes,
+            serial: after.march.serial_max,
+        };
+        match lanes {
+            1 => out[k].push(cell),
+            _ => laned.push(cell),
+        }
     }
-    Ok(out)
+    Ok((out, laned))
 }
 
 /// Frames the character plays per mode.
@@ -240,7 +287,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
     let glass = MODES.iter().filter(|m| glass_mode(m)).count();
     let total = (MODES.len() + glass + CHARACTER.len()) as u64;
     let mut steps = Steps::new("lists", total, env.switches.common.quiet);
-    let cells = thesis_frame(ctx, env, &mut steps)?;
+    let (cells, laned) = thesis_frame(ctx, env, &mut steps)?;
     let demo = character(env, &mut steps)?;
     steps.finish();
     let (w, h, n) = (env.width, env.height, env.particles);
@@ -259,12 +306,12 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
         String::from("look,mode,render_ms,passes,list_mb,steps_px,evals_px,floor_ms,x_floor\n");
     for ((label, _, _, _), row) in LOOKS.iter().zip(&cells) {
         md.push_str(&format!(
-            "\n## {label}\n\n| mode | render ms | x first row | passes (ms) | list MB | steps/px | evals/px | floor ms | x floor |\n|---|---|---|---|---|---|---|---|---|\n"
+            "\n## {label}\n\n| mode | render ms | x first row | passes (ms) | list MB | steps/px | evals/px | serial max | floor ms | x floor |\n|---|---|---|---|---|---|---|---|---|---|\n"
         ));
         let sb = row.first().map_or(f64::NAN, |c| c.ms);
         for c in row {
             md.push_str(&format!(
-                "| {} | {:.2} | {:.2} | {} | {:.2} | {:.2} | {:.0} | {:.4} | {:.0} |\n",
+                "| {} | {:.2} | {:.2} | {} | {:.2} | {:.2} | {:.0} | {} | {:.4} | {:.0} |\n",
                 c.mode.name(),
                 c.ms,
                 sb / c.ms,
@@ -272,6 +319,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
                 c.list_mb,
                 c.steps,
                 c.evals,
+                c.serial,
                 c.floor,
                 c.ms / c.floor
             ));
@@ -288,6 +336,7 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
             ));
         }
     }
+    md.push_str(&laned_md(&cells[1], &laned));
     let base_ms = demo.first().map_or(f64::NAN, |d| d.1);
     md.push_str(&format!(
         "\n## The liquid character (`fluidform run --scene character`, {} frames, tinted)\n\n| mode | render ms | x default |\n|---|---|---|\n",
@@ -324,7 +373,8 @@ pub fn lists(ctx: &crate::gpu::Context, env: &mut Env) -> Result<(Vec<PathBuf>, 
         "render ms per frame",
     )?;
     md.push_str("\n![render ms per mode](lists.png)\n\nBars: S = S-buffer, /c = built in compute, L = `--march lipschitz`.\n");
-    let found = findings(&cells, &demo);
+    let mut found = findings(&cells, &demo);
+    found.push(parallel_march(&cells[1], &laned));
     let p_csv = env.out.join("lists.csv");
     write(&p_csv, &csv)?;
     let p_md = super::finish_md(env, Experiment::Lists, md, &found)?;
@@ -470,4 +520,56 @@ fn findings(cells: &[Vec<Cell>], demo: &[(Mode, f64)]) -> Vec<Finding> {
         None => Finding::new(DEMO_FASTER, Verdict::NotMeasured, String::new()),
     });
     found
+}
+
+/// The glass section of rays marched by several lanes: [`LANED`]'s serial row, then each
+/// lane count's, with the longest serial chain.
+fn laned_md(glass: &[Cell], laned: &[Cell]) -> String {
+    let Some(serial) = glass.iter().find(|c| c.mode == LANED) else {
+        return String::new();
+    };
+    let mut md = format!(
+        "\n## Glass, depth 3: rays marched by several lanes\n\n{}: one invocation a ray, or \
+         `--ray-lanes N` lanes of a subgroup (each a grid sample; the same pictures). serial \
+         max: the most field evaluations one invocation made in series.\n\n\
+         | ray lanes | render ms | x serial | serial max |\n|---|---|---|---|\n",
+        LANED.name()
+    );
+    for c in std::iter::once(serial).chain(laned) {
+        md.push_str(&format!(
+            "| {} | {:.2} | {:.2} | {} |\n",
+            c.lanes,
+            c.ms,
+            serial.ms / c.ms,
+            c.serial
+        ));
+    }
+    md
+}
+
+/// [`PARALLEL_MARCH`]: the widest lane count against the serial march, beyond the
+/// intervals (not measured where the device's subgroup holds no lanes).
+fn parallel_march(glass: &[Cell], laned: &[Cell]) -> Finding {
+    let serial = glass.iter().find(|c| c.mode == LANED);
+    let widest = laned.iter().max_by_key(|c| c.lanes);
+    let (Some(s), Some(w)) = (serial, widest) else {
+        return Finding::new(PARALLEL_MARCH, Verdict::NotMeasured, String::new());
+    };
+    let each: Vec<String> = laned
+        .iter()
+        .map(|c| format!("{} lanes {} ({:.2}x)", c.lanes, c.est.text(), s.ms / c.ms))
+        .collect();
+    Finding::new(
+        PARALLEL_MARCH,
+        Verdict::speedup_at_least(&s.est, &w.est, 4.0),
+        format!(
+            "{}: serial {} (serial max {}), {}; serial max at {} lanes {}",
+            LANED.name(),
+            s.est.text(),
+            s.serial,
+            each.join(", "),
+            w.lanes,
+            w.serial
+        ),
+    )
 }
