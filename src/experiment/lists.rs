@@ -530,7 +530,7 @@ fn laned_md(glass: &[Cell], laned: &[Cell]) -> String {
     };
     let mut md = format!(
         "\n## Glass, depth 3: rays marched by several lanes\n\n{}: one invocation a ray, or \
-         `--ray-lanes N` lanes of a subgroup (each a grid sample; the same pictures). serial \
+         `--ray-lanes N` lanes of a subgroup (each a grid sample: the same hits). serial \
          max: the most field evaluations one invocation made in series.\n\n\
          | ray lanes | render ms | x serial | serial max |\n|---|---|---|---|\n",
         LANED.name()

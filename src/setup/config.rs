@@ -217,7 +217,7 @@ pub struct MetaballArgs {
     #[arg(long, value_parser = choice::<Lanes>())]
     pub lanes: Option<Lanes>,
     /// Lanes that march one ray together: 1 (one invocation per ray, default), 8, 16 or
-    /// 32 (each lane a grid sample of the ray; the same hits; at most the subgroup's size)
+    /// 32 (each lane a grid sample of the ray: the same hits; at most the subgroup's size)
     #[arg(long, value_name = "N", value_parser = clap::builder::PossibleValuesParser::new(["1", "8", "16", "32"]).map(|s| s.parse::<u32>().expect("listed")))]
     pub ray_lanes: Option<u32>,
     /// How the S-buffer's per-pixel lists are built: rasterising the billboards (the

@@ -165,13 +165,21 @@ vec2 field_reach(vec3 x, uint p, float reach) {
     return f;
 }
 
+#include "march_split.glsl"
+
+// The field's gradient at x: on a ray's lanes, each sums its share of the terms.
 vec3 gradient(vec3 x, uint p) {
 #if LIST == LIST_NONE
     p = ALL;
 #endif
     vec3 g = vec3(0.0);
     n_serial++;
+#if RAY_LANES == 1
     SUM_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
+#else
+    SPLIT_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
+    g = lanes_sum(g);
+#endif
     return g;
 }
 
@@ -282,10 +290,7 @@ vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
 vec3 normal_at(vec3 x, uint pixel) {
     uint p = pixel == NIL ? project(x) : pixel;
     if (p == NIL) p = ALL;
-    // Every lane of a ray's group takes the same gradient; the first counts its terms.
-    uint e0 = n_evals;
     vec3 g = gradient(x, p);
-    if (ray_lane() != 0u) n_evals = e0;
     float l = length(g);
     return l > 0.0 ? -g / l : vec3(0.0, 1.0, 0.0);
 }

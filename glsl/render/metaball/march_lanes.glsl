@@ -3,8 +3,9 @@
 // it identically (so the group's control flow stays together); only the samples differ:
 // lane j evaluates grid sample i + j of a round, and a ballot over the group gives the
 // first crossing. The bisection evaluates a round's 2^L - 1 midpoints at once and replays
-// the serial decisions, so every hit, picture and count is the serial march's. RAY_LANES 1
-// is the serial march, one invocation per ray.
+// the serial decisions, so every hit is the serial march's; the gradient's terms are split
+// among the lanes (march_split.glsl). RAY_LANES 1 is the serial march, one invocation per
+// ray.
 #ifndef RENDER_METABALL_MARCH_LANES_GLSL
 #define RENDER_METABALL_MARCH_LANES_GLSL
 #if RAY_LANES == 1
@@ -29,6 +30,7 @@ uint ray_group() { return gl_LocalInvocationIndex; }
 // The lanes (bit j: lane j) where c holds.
 uint lanes_ballot(bool c) { return c ? 1u : 0u; }
 uint lanes_max(uint v) { return v; }
+vec3 lanes_sum(vec3 v) { return v; }
 float lanes_min(float v) { return v; }
 float lanes_max(float v) { return v; }
 #else
@@ -47,6 +49,11 @@ uint lanes_max(uint v) {
 }
 float lanes_min(float v) {
     [[unroll]] for (uint s = 1u; s < RAY_LANES; s <<= 1u) v = min(v, subgroupShuffleXor(v, s));
+    return v;
+}
+// Each pair adds the same two values (a + b == b + a), so every lane ends with the same sum.
+vec3 lanes_sum(vec3 v) {
+    [[unroll]] for (uint s = 1u; s < RAY_LANES; s <<= 1u) v += subgroupShuffleXor(v, s);
     return v;
 }
 float lanes_max(float v) {
