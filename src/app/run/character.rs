@@ -100,15 +100,7 @@ pub(super) fn run_character(opts: &RunOptions, scene: crate::scene::Scene) -> Re
         frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
-    let scopes = sw.common.scopes.unwrap_or(crate::gpu::ScopeDepth::All);
-    let timings = play_scoped(
-        &ctx,
-        frame_count,
-        &mut work,
-        &opts.scene,
-        sw.common.quiet,
-        scopes,
-    );
+    let timings = play_run(&ctx, frame_count, &mut work, &opts.scene, &sw.common);
     let stats = work.character.stats(None);
     let render = work.view.stats();
     work.character.destroy(&ctx);

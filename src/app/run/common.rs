@@ -58,8 +58,20 @@ pub fn play(
     play_scoped(ctx, frames, work, what, quiet, ScopeDepth::All)
 }
 
+/// `play` for `run`: quiet and timing the scopes as the switches say (`--quiet`, `--scopes`).
+pub fn play_run(
+    ctx: &Context,
+    frames: u64,
+    work: &mut dyn FrameWork,
+    what: &str,
+    common: &crate::config::CommonArgs,
+) -> Result<Vec<FrameTiming>> {
+    let scopes = common.scopes.unwrap_or(ScopeDepth::All);
+    play_scoped(ctx, frames, work, what, common.quiet, scopes)
+}
+
 /// `play`, timing only the scopes `scopes` asks for (`run --scopes`).
-pub fn play_scoped(
+fn play_scoped(
     ctx: &Context,
     frames: u64,
     work: &mut dyn FrameWork,

@@ -12,7 +12,7 @@ use crate::render::Camera;
 use crate::render::{RenderKind, ShowMesh};
 use crate::report::{Report, Summary};
 pub use crate::run::common::{camera_with_switches, check_validation, SLOTS};
-use crate::run::common::{open, play_scoped};
+use crate::run::common::{open, play_run};
 use crate::run::targets::character::{CharacterStats, SceneCharacter};
 use crate::run::view::{FluidView, Picture, PointsViewer};
 use crate::sph::FluidParams;

@@ -15,7 +15,7 @@ use crate::psys::{Integrator, SpriteMode};
 use crate::render::mesh::MeshView;
 use crate::render::Camera;
 use crate::render::ShowMesh;
-use crate::run::common::{camera_with_switches, open, play_scoped, SLOTS};
+use crate::run::common::{camera_with_switches, open, play_run, SLOTS};
 use crate::run::targets::character::SceneCharacter;
 use crate::run::view::Picture;
 use crate::run::{finish_fluidless, Frames, RunOptions, RunResult, RunStats};
@@ -354,15 +354,7 @@ pub fn run(opts: &RunOptions, scene: ParticleScene) -> Result<RunResult> {
         frames: Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame),
     };
     let memory = ctx.memory_bytes();
-    let scopes = sw.common.scopes.unwrap_or(crate::gpu::ScopeDepth::All);
-    let timings = play_scoped(
-        &ctx,
-        frame_count,
-        &mut work,
-        &scene.name,
-        sw.common.quiet,
-        scopes,
-    );
+    let timings = play_run(&ctx, frame_count, &mut work, &scene.name, &sw.common);
     let stats = match &timings {
         Ok(_) => work
             .scene

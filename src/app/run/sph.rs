@@ -208,15 +208,7 @@ pub(super) fn run_sph(opts: &RunOptions, scene: crate::scene::Scene) -> Result<R
     fits(&ctx, &scene)?;
     let frames = Frames::new(&opts.out, opts.save_every, frame_count).sampled(&sw.frame);
     let mut work = SphWork::new(&ctx, (&opts.out, frames), &scene, sw, render, neighbors)?;
-    let scopes = sw.common.scopes.unwrap_or(crate::gpu::ScopeDepth::All);
-    let timings = play_scoped(
-        &ctx,
-        frame_count,
-        &mut work,
-        &opts.scene,
-        sw.common.quiet,
-        scopes,
-    );
+    let timings = play_run(&ctx, frame_count, &mut work, &opts.scene, &sw.common);
     let how = (sw, render, neighbors);
     work.finish(&ctx, opts, &scene, how, frame_count, timings)
 }
