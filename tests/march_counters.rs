@@ -106,6 +106,7 @@ fn lipschitz_march_finds_the_fixed_hits_from_fewer_samples() {
     let ctx = common::ctx();
     for (list, sorted, material) in [
         (ListKind::None, false, Material::Phong),
+        (ListKind::None, false, Material::Glass),
         (ListKind::Abuffer, false, Material::Phong),
         (ListKind::Sbuffer, false, Material::Phong),
         (ListKind::Sbuffer, true, Material::Glass),

@@ -160,6 +160,7 @@ fn ray_lanes_keep_the_lipschitz_hits() {
     let ctx = common::ctx();
     for (list, sorted, material) in [
         (ListKind::None, false, Material::Phong),
+        (ListKind::None, false, Material::Glass),
         (ListKind::Abuffer, false, Material::Phong),
         (ListKind::Sbuffer, true, Material::Glass),
         (ListKind::Tiles, false, Material::Phong),

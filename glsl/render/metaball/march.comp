@@ -371,9 +371,18 @@ void march_pixel() {
         bool primary = r.depth == 0u;
         vec2 span = primary ? iv : ray_box(r.o, r.d, box_lo(), box_hi());
 #if MARCH == MARCH_LIPSCHITZ
-        // Secondary rays sample other pixels' lists: no bound holds across them.
+        // Secondary rays sample other pixels' lists: no bound holds across them. Without
+        // lists every sample sums every metaball and the bound holds on any ray, unless
+        // off-screen samples end paths (then every sample must be projected).
+#if LIST == LIST_NONE
+        bool bounded = primary || P.offscreen_end == 0u;
+#elif LIST == LIST_ABUFFER || LIST == LIST_SBUFFER || LIST == LIST_TILES
+        bool bounded = primary;
+#else
+#error "LIST names no list mode"
+#endif
         float t = span.x > span.y ? -1.0
-            : primary ? march_lipschitz(r.o, r.d, span.x, span.y, r.inside, id)
+            : bounded ? march_lipschitz(r.o, r.d, span.x, span.y, r.inside, primary ? id : NIL)
             : march(r.o, r.d, span.x, span.y, r.inside, NIL);
 #elif MARCH == MARCH_FIXED
         float t = span.x <= span.y ? march(r.o, r.d, span.x, span.y, r.inside, primary ? id : NIL) : -1.0;
