@@ -176,9 +176,11 @@ vec3 gradient(vec3 x, uint p) {
     n_serial++;
 #if RAY_LANES == 1
     SUM_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
-#else
+#elif RAY_LANES == 8 || RAY_LANES == 16 || RAY_LANES == 32
     SPLIT_METABALLS(x, p, g, d * density_grad_over_r(dot(d, d)))
     g = lanes_sum(g);
+#else
+#error "RAY_LANES is 1, 8, 16 or 32"
 #endif
     return g;
 }

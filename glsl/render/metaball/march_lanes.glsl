@@ -33,7 +33,7 @@ uint lanes_max(uint v) { return v; }
 vec3 lanes_sum(vec3 v) { return v; }
 float lanes_min(float v) { return v; }
 float lanes_max(float v) { return v; }
-#else
+#elif RAY_LANES == 8 || RAY_LANES == 16 || RAY_LANES == 32
 uint ray_lane() { return gl_SubgroupInvocationID % RAY_LANES; }
 uint ray_group() { return (gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID) / RAY_LANES; }
 uint lanes_ballot(bool c) {
@@ -60,6 +60,8 @@ float lanes_max(float v) {
     [[unroll]] for (uint s = 1u; s < RAY_LANES; s <<= 1u) v = max(v, subgroupShuffleXor(v, s));
     return v;
 }
+#else
+#error "RAY_LANES is 1, 8, 16 or 32"
 #endif
 // The first lane where c holds, RAY_LANES where none does.
 uint lanes_first(bool c) {

@@ -94,7 +94,7 @@ float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixe
 #elif MARCH != MARCH_FIXED
 #error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
 #endif
-#else
+#elif RAY_LANES == 8 || RAY_LANES == 16 || RAY_LANES == 32
 // The crossing between ray parameters a (this side of T) and b (across it), refined by
 // P.refine bisection steps; pixel as in `march` (NIL: each sample projects). Each round
 // takes BISECT_LEVELS levels at once: lane j evaluates node j + 1 of the round's
@@ -251,5 +251,7 @@ float march_lipschitz(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixe
 #elif MARCH != MARCH_FIXED
 #error "MARCH is MARCH_FIXED or MARCH_LIPSCHITZ"
 #endif
+#else
+#error "RAY_LANES is 1, 8, 16 or 32"
 #endif
 #endif
