@@ -31,10 +31,8 @@ fn render(
 
 /// The lane counts this device can march a ray with (beyond the serial 1).
 fn lane_counts(ctx: &fluidform::gpu::Context) -> Vec<u32> {
-    [8, 16, 32]
-        .into_iter()
-        .filter(|&n| ctx.info.subgroup_shuffle && n <= ctx.info.subgroup_size)
-        .collect()
+    let held = fluidform::render::metaball::settings::ray_lanes_on(&ctx.info);
+    held.into_iter().filter(|&n| n > 1).collect()
 }
 
 /// The lanes' picture against the serial one: every primary hit at the same t to the bit

@@ -24,6 +24,7 @@ const DEFAULT: &str = "counters=subgroup lanes=blocks";
 
 pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
+    let held = crate::render::metaball::settings::ray_lanes_on(&ctx.info);
     for (list, sorted, build) in super::render::rows_of(&opts.switches)? {
         let mut s = crate::settings::metaball_settings(&opts.switches)?;
         (s.list, s.sorted, s.build) = (list, sorted, build);
@@ -31,7 +32,7 @@ pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
             if list == ListKind::Tiles && lanes == Lanes::Rows {
                 continue; // tiles stage their tile per block
             }
-            if ray_lanes > ctx.info.subgroup_size || !ctx.info.subgroup_shuffle {
+            if !held.contains(&ray_lanes) {
                 continue; // a ray's lanes share one subgroup
             }
             let mut name = format!(

@@ -127,15 +127,6 @@ const LOOKS: [Look; 2] = [
     ("glass, depth 3 (table 6)", Material::Glass, 3, glass_mode),
 ];
 
-/// The lane counts a ray can be marched with here beyond 1 (a ray's lanes share a subgroup).
-fn lane_counts(ctx: &crate::gpu::Context) -> Vec<u32> {
-    let info = &ctx.info;
-    [8, 16, 32]
-        .into_iter()
-        .filter(|&n| info.subgroup_shuffle && n <= info.subgroup_size)
-        .collect()
-}
-
 /// Every look's cells, then the glass cells of [`LANED`] marched by several lanes.
 fn thesis_frame(
     ctx: &crate::gpu::Context,
@@ -155,7 +146,10 @@ fn thesis_frame(
     // Every look's modes, timed together (the protocol interleaves them).
     let mut shots = Vec::new();
     let mut which = Vec::new();
-    let laned = (lane_counts(ctx).into_iter()).map(|lanes| (1, LOOKS[1].0, LANED, lanes));
+    let laned = crate::render::metaball::settings::ray_lanes_on(&ctx.info)
+        .into_iter()
+        .filter(|&lanes| lanes > 1)
+        .map(|lanes| (1, LOOKS[1].0, LANED, lanes));
     let every = LOOKS
         .into_iter()
         .enumerate()
@@ -167,33 +161,31 @@ fn thesis_frame(
         });
     for (k, label, mode, lanes) in every.chain(laned) {
         let (_, material, depth, _) = LOOKS[k];
-        {
-            let mut s = base(env.width, env.height)?;
-            (s.material, s.depth, s.ray_lanes) = (material, depth, lanes);
-            mode.apply(&mut s);
-            s.validate()?;
-            let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
+        let mut s = base(env.width, env.height)?;
+        (s.material, s.depth, s.ray_lanes) = (material, depth, lanes);
+        mode.apply(&mut s);
+        s.validate()?;
+        let detail = json!({ "look": label, "mode": mode.name(), "settings": s,
                 "particles": n });
-            let suffix = if lanes > 1 {
-                format!("-lanes-{lanes}")
-            } else {
-                String::new()
-            };
-            shots.push(Shot {
-                variant: format!(
-                    "{}-{}{suffix}",
-                    material.as_str(),
-                    mode.name().replace(' ', "-")
-                ),
-                settings: s,
-                centers: &buf,
-                centers_key: format!("thesis {n}"),
-                n: n as u32,
-                cam,
-                detail,
-            });
-            which.push((k, label, mode, lanes));
-        }
+        let suffix = if lanes > 1 {
+            format!("-lanes-{lanes}")
+        } else {
+            String::new()
+        };
+        shots.push(Shot {
+            variant: format!(
+                "{}-{}{suffix}",
+                material.as_str(),
+                mode.name().replace(' ', "-")
+            ),
+            settings: s,
+            centers: &buf,
+            centers_key: format!("thesis {n}"),
+            n: n as u32,
+            cam,
+            detail,
+        });
+        which.push((k, label, mode, lanes));
     }
     steps.start("every look and mode, interleaved");
     let timed = time_shots(ctx, env, &opts, &shots)?;

@@ -358,16 +358,9 @@ impl Profiler {
             Some((_, parent)) if parent != FRAME_SCOPE => format!("{parent}/{name}"),
             _ => name.to_string(),
         };
-        if self.stack.len() > self.timed {
-            let parent = self.stack.last().map(|(i, _)| *i);
-            let s = &mut self.slots[self.current];
-            s.scopes.push((key.clone(), UNTIMED, UNTIMED));
-            s.parents.push(parent);
-            self.stack.push((s.scopes.len() - 1, key));
-            return;
-        }
-        let begin = self.next_query(ctx);
-        let end = self.next_query(ctx);
+        let untimed = self.stack.len() > self.timed;
+        let begin = (!untimed).then(|| self.next_query(ctx)).flatten();
+        let end = (!untimed).then(|| self.next_query(ctx)).flatten();
         let (b, e) = match (begin, end) {
             (Some((pool, q)), Some(_)) => {
                 unsafe {
@@ -381,6 +374,8 @@ impl Profiler {
                 self.settle_timestamp(ctx, cmd);
                 (q, q + 1)
             }
+            // Deeper than --scopes times: the label alone.
+            _ if untimed => (UNTIMED, UNTIMED),
             // No query pool could be made: keep the label, report at collect.
             _ => (u32::MAX, u32::MAX),
         };

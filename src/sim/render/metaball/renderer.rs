@@ -489,7 +489,8 @@ impl FluidRenderer {
     /// refused in one line where the device's subgroup is narrower or lacks them.
     fn check_ray_lanes(ctx: &Context, s: &MetaballSettings) -> Result<()> {
         let (n, info) = (s.ray_lanes, &ctx.info);
-        if n == 1 || !s.marches() || (n <= info.subgroup_size && info.subgroup_shuffle) {
+        let held = super::settings::ray_lanes_on(info);
+        if !s.marches() || held.contains(&n) {
             return Ok(());
         }
         Err(Error::Param(format!(
@@ -502,11 +503,7 @@ impl FluidRenderer {
             } else {
                 " without ballots and shuffles"
             },
-            super::settings::RAY_LANES
-                .iter()
-                .filter(|&&k| info.subgroup_shuffle && k <= info.subgroup_size)
-                .max()
-                .unwrap_or(&1),
+            held.iter().max().unwrap_or(&1),
         )))
     }
 

@@ -158,6 +158,15 @@ pub const TILES: [u32; 3] = [8, 16, 32];
 pub const MAX_DEPTH: u32 = 6;
 /// The lanes `--ray-lanes` takes (march_lanes.glsl).
 pub const RAY_LANES: [u32; 4] = [1, 8, 16, 32];
+
+/// The lanes per ray a device marches with: 1 always, and each wider count its subgroup
+/// holds where it has ballots and shuffles (a ray's lanes share one subgroup).
+pub fn ray_lanes_on(info: &crate::gpu::DeviceInfo) -> Vec<u32> {
+    RAY_LANES
+        .into_iter()
+        .filter(|&n| n == 1 || (info.subgroup_shuffle && n <= info.subgroup_size))
+        .collect()
+}
 pub const MAX_REFINE: u32 = 32;
 
 /// Complex index of refraction (n, k) per RGB channel (about 650, 550, 450 nm).
