@@ -79,6 +79,10 @@ enum Command {
         /// Seconds the sentinel's warm-up may take before timing starts anyway
         #[arg(long, global = true, default_value_t = 2.0)]
         warmup_s: f64,
+        /// Percent a round's sentinel or steady pass may move from its median before the
+        /// round is rerun and, if still off, its row flagged (raise it on a shared machine)
+        #[arg(long, global = true, default_value_t = 100.0 * fluidform::bench::protocol::DRIFT)]
+        drift: f64,
     },
     /// Plot a sweep.csv (e.g. a committed results/<device>/sph.csv) as a PNG
     Plot {
@@ -215,6 +219,7 @@ fn real_main() -> Result<()> {
             budget_s,
             rounds,
             warmup_s,
+            drift,
         } => {
             let timing = fluidform::bench::args::Timing {
                 frames,
@@ -222,6 +227,7 @@ fn real_main() -> Result<()> {
                 budget_s,
                 rounds,
                 warmup_s,
+                drift,
             };
             let (out, rows) = fluidform::bench::args::run(what, out, timing)?;
             print!("{}", std::fs::read_to_string(out.join("sweep.md"))?);

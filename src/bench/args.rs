@@ -295,6 +295,8 @@ pub struct Timing {
     pub budget_s: f64,
     pub rounds: u64,
     pub warmup_s: f64,
+    /// Percent (see `BenchOptions::drift`).
+    pub drift: f64,
 }
 
 /// `bench`: run one benchmark; where its table went and how many configurations it has.
@@ -303,6 +305,12 @@ pub fn run(what: BenchWhat, out: PathBuf, t: Timing) -> Result<(PathBuf, usize)>
         return Err(crate::Error::Param(format!(
             "--warmup-s must be a number of seconds >= 0 (got {})",
             t.warmup_s
+        )));
+    }
+    if !(t.drift.is_finite() && t.drift > 0.0) {
+        return Err(crate::Error::Param(format!(
+            "--drift must be a percentage > 0 (got {})",
+            t.drift
         )));
     }
     let seconds = match &what {
@@ -318,6 +326,7 @@ pub fn run(what: BenchWhat, out: PathBuf, t: Timing) -> Result<(PathBuf, usize)>
         budget_s: t.budget_s,
         rounds: t.rounds,
         warmup_s: t.warmup_s,
+        drift: t.drift / 100.0,
         switches,
         character,
         vertices,

@@ -72,6 +72,9 @@ pub struct BenchOptions {
     pub rounds: u64,
     /// Seconds the sentinel's warm-up may take before timing starts anyway.
     pub warmup_s: f64,
+    /// A round is off when its sentinel or a steady pass is further than this fraction
+    /// from its median (`protocol::DRIFT` unless `--drift` says otherwise).
+    pub drift: f64,
     /// Seconds of GPU time a configuration may take; slower ones get fewer repetitions
     /// (at least 3), and the table reports how many each had.
     pub budget_s: f64,
@@ -379,7 +382,7 @@ pub fn protocol_text(opts: &BenchOptions) -> String {
         opts.frames,
         opts.budget_s,
         opts.warmup.max(1),
-        protocol::DRIFT * 100.0,
+        opts.drift * 100.0,
         p.commit,
         p.rustc,
         p.date

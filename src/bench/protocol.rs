@@ -34,7 +34,8 @@ use std::time::Instant;
 pub const SENTINEL: ScopeKey = ScopeKey::new("sentinel");
 /// Rounds at the least; more where a case has frames to spare.
 pub const MIN_ROUNDS: u64 = 5;
-/// A round is off when its sentinel or a steady pass is further than this from the median.
+/// A round is off when its sentinel or a steady pass is further than this from the median
+/// (the default of `bench --drift`).
 pub const DRIFT: f64 = 0.10;
 /// The sentinel's warm-up is stable when two batches' medians agree within this.
 const SETTLED: f64 = 0.03;
@@ -246,7 +247,7 @@ pub fn run(ctx: &Context, opts: &BenchOptions, mut cases: Vec<Case>) -> Result<V
         .collect();
     let run_sentinel = median(&sent).unwrap_or(0.0);
     // Rounds that drifted run once more, shuffled; their frames replace the first ones.
-    let off = drifted(&cases, &frames, rounds, run_sentinel);
+    let off = drifted(&cases, &frames, rounds, run_sentinel, opts.drift);
     if !off.is_empty() {
         let mut again: Vec<(usize, u64)> = off.iter().map(|(c, r, _)| (*c, *r)).collect();
         again.shuffle(&mut rng);
@@ -265,7 +266,7 @@ pub fn run(ctx: &Context, opts: &BenchOptions, mut cases: Vec<Case>) -> Result<V
         frames.retain(|(s, _)| !again.contains(&(s.case, s.round)));
         frames.extend(redo.into_iter().map(|f| (slots[f.frame as usize], f)));
     }
-    let still = drifted(&cases, &frames, rounds, run_sentinel);
+    let still = drifted(&cases, &frames, rounds, run_sentinel, opts.drift);
     if let Some(path) = &opts.switches.common.trace {
         // In the order they ran, numbered so (case, frame) names one frame.
         let mut order: Vec<(usize, FrameTiming)> =
@@ -390,7 +391,7 @@ fn main_ms(key: ScopeKey, f: &FrameTiming) -> Result<f64> {
     key.ms_in(f)
 }
 
-/// (case, round, why) of every round whose sentinel or steady pass moved past `DRIFT`:
+/// (case, round, why) of every round whose sentinel or steady pass moved past `drift`:
 /// the sentinel against the run's median, a steady pass against its median over every
 /// round of every case in the same steady group (or of the case alone).
 fn drifted(
@@ -398,6 +399,7 @@ fn drifted(
     frames: &[(Slot, FrameTiming)],
     rounds: u64,
     run_sentinel: f64,
+    drift: f64,
 ) -> Vec<(usize, u64, String)> {
     let of = |c: usize, r: Option<u64>, key: &str| -> Option<f64> {
         let v: Vec<f64> = frames
@@ -437,7 +439,7 @@ fn drifted(
             let mut check = |key: &str, mid: f64| {
                 if let Some(v) = of(c, Some(r), key) {
                     let d = v / mid.max(1e-12) - 1.0;
-                    if d.abs() > DRIFT {
+                    if d.abs() > drift {
                         why.push(format!("{key} {:+.0}%", 100.0 * d));
                     }
                 }
@@ -552,7 +554,7 @@ fn write_protocol(
     let p = opts.out.join("rounds.csv");
     std::fs::write(&p, csv).map_err(|e| io(&p, e))?;
     let json = serde_json::json!({
-        "rounds": rounds, "seed": opts.switches.common.seed, "drift": DRIFT,
+        "rounds": rounds, "seed": opts.switches.common.seed, "drift": opts.drift,
         "warmup": warm, "sentinel_median_ms": sentinel,
         "provenance": crate::bench::provenance::measured(opts.frames, opts.warmup),
     });

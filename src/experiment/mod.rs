@@ -153,6 +153,7 @@ impl Env {
             budget_s: self.budget_s,
             rounds: crate::bench::protocol::MIN_ROUNDS,
             warmup_s: if self.quick { 0.5 } else { 2.0 },
+            drift: crate::bench::protocol::DRIFT,
             switches,
             character: None,
             vertices: None,
