@@ -67,7 +67,7 @@ fn gpu_struct_mirrors_match_glsl_field_offsets() {
             view_proj, inv_view_proj, view, proj, eye, sun, absorb, f0, base, tank_min, tank_max,
             width, height,
             n, refine, depth, max_steps, list_capacity, offscreen_end, sky_w, sky_h, debug, opaque,
-            tile, tiles_x, rank_bits, pair_capacity),
+            tile, tiles_x, rank_bits, pair_capacity, occupancy, pad0, pad1, pad2),
         ),
         (
             "render/metaball/march.comp",

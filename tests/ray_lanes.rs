@@ -1,6 +1,7 @@
 //! Rays marched by several lanes (`--ray-lanes`): the same pictures, hits and counts as
 //! the serial march for every material, list and depth; the serial chains counted on the
-//! GPU equal a CPU count; lane counts the device's subgroup cannot hold are refused.
+//! GPU equal a CPU count; lane counts the device's subgroup cannot hold are refused. The
+//! occupancy grid's passed-over samples keep every picture and hit.
 mod common;
 use fluidform::render::metaball::reference::{march_counted, ray_box, MarchParams};
 use fluidform::render::metaball::{blob, blob_camera, FluidRenderer, FrameStats, MetaballSettings};
@@ -313,5 +314,115 @@ fn ray_lanes_wider_than_the_subgroup_are_refused() {
     );
     let o = common::fluidform(&["bench", "render", "--ray-lanes", "3"]);
     assert!(!o.status.success());
+    common::finish(&ctx);
+}
+
+/// Two blobs apart, with air between them and around them, and a hidden ball far off
+/// that widens the fluid's bounds (hidden balls are in no sum and mark no cell).
+fn two_blobs() -> (Vec<[f32; 4]>, fluidform::render::Camera) {
+    let mut pts = blob(N / 2, SPACING);
+    let shifted: Vec<[f32; 4]> = pts
+        .iter()
+        .map(|p| [p[0] + 0.3, p[1] + 0.08, p[2] - 0.2, 0.0])
+        .collect();
+    pts.extend(shifted);
+    pts.push([-0.6, 0.5, 0.4, -1.0]);
+    let cam = fluidform::render::Camera::look_at(
+        Vec3::new(0.15, 0.2, 0.55),
+        Vec3::new(0.15, 0.04, -0.1),
+        45.0,
+        W as f32 / H as f32,
+    );
+    (pts, cam)
+}
+
+/// `--occupancy on` (the default) against off, on two blobs with air between them: glass
+/// at depth 3 on every list; Phong, tinted and gold, glass on every lane count and with
+/// off-screen ends on the sorted S-buffer: the same pictures to the byte and the same hits
+/// to the bit; each sample it passes over is one the full march evaluates (samples taken
+/// plus passed over equal the full march's, rays and off-screen samples equal), with no
+/// more terms and no longer chain; glass passes over some. Phong has no secondary ray: it
+/// passes over none.
+#[test]
+fn occupancy_passes_over_empty_cells_with_the_same_hits() {
+    let ctx = common::ctx();
+    let (pts, cam) = two_blobs();
+    let mut cases = Vec::new();
+    for (list, sorted) in [
+        (ListKind::None, false),
+        (ListKind::Abuffer, false),
+        (ListKind::Sbuffer, false),
+        (ListKind::Sbuffer, true),
+        (ListKind::Tiles, false),
+    ] {
+        cases.push(settings(list, sorted, Material::Glass, 3));
+    }
+    // The other paths read the grid through the same march: on one list.
+    cases.push(settings(ListKind::Sbuffer, false, Material::Phong, 1));
+    cases.push(settings(ListKind::Sbuffer, true, Material::Tinted, 1));
+    cases.push(settings(ListKind::Sbuffer, true, Material::Gold, 2));
+    let glass = settings(ListKind::Sbuffer, true, Material::Glass, 2);
+    for n in lane_counts(&ctx) {
+        cases.push(MetaballSettings {
+            ray_lanes: n,
+            ..glass.clone()
+        });
+    }
+    cases.push(MetaballSettings {
+        offscreen_end: true,
+        ..glass.clone()
+    });
+    let mut passed_glass = 0;
+    for on in cases {
+        assert!(on.occupancy, "the default is on");
+        let off = MetaballSettings {
+            occupancy: false,
+            ..on.clone()
+        };
+        let what = format!(
+            "{} {:?} depth {} ray-lanes {} offscreen_end {}",
+            on.list_name(),
+            on.material,
+            on.depth,
+            on.ray_lanes,
+            on.offscreen_end
+        );
+        let (st, px, dbg) = common::blob::frame_of(&ctx, &on, &pts, &cam);
+        let (st0, px0, dbg0) = common::blob::frame_of(&ctx, &off, &pts, &cam);
+        assert!(dbg0.iter().any(|d| d[0] >= 0.0), "{what}: no hits");
+        assert!(px == px0, "{what}: the pictures differ");
+        for (k, (a, b)) in dbg.iter().zip(&dbg0).enumerate() {
+            assert!(
+                a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{what}: pixel {k}'s hit {a:?} against {b:?}"
+            );
+        }
+        let (m, m0) = (st.march, st0.march);
+        assert_eq!(m0.skipped, 0, "{what}: off passed over {m0:?}");
+        assert_eq!(m.rays, m0.rays, "{what}");
+        assert_eq!(
+            m.steps + m.skipped,
+            m0.steps,
+            "{what}: {m:?} against {m0:?}"
+        );
+        assert_eq!(st.offscreen_samples, st0.offscreen_samples, "{what}");
+        assert!(
+            m.evaluations <= m0.evaluations,
+            "{what}: {m:?} against {m0:?}"
+        );
+        assert!(
+            m.serial_max <= m0.serial_max,
+            "{what}: {m:?} against {m0:?}"
+        );
+        match on.material {
+            Material::Phong => assert_eq!(m.skipped, 0, "{what}"),
+            Material::Glass => {
+                assert!(m.skipped > 0, "{what}: nothing passed over");
+                passed_glass += 1;
+            }
+            _ => {}
+        }
+    }
+    assert!(passed_glass >= 6, "{passed_glass} glass cases");
     common::finish(&ctx);
 }

@@ -34,6 +34,10 @@ struct RenderParams {
     uint tiles_x;
     uint rank_bits;
     uint pair_capacity;
+    uint occupancy;  // 1: secondary rays pass over the occupancy grid's empty cells
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 const uint NIL = 0xFFFFFFFFu;
 struct RenderStats {

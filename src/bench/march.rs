@@ -4,7 +4,8 @@
 //! lanes (8 x 8 blocks, the default; rows of 64), and the lanes per ray (1, the default;
 //! 8, 16 and 32 where the device's subgroup holds them), per list mode (or --list). Each
 //! row gives the march scope's ms beside the frame's, its ratio to the default's row and
-//! the longest serial chain.
+//! the longest serial chain. Where the frame has secondary rays, a last row marches them
+//! over every sample (--occupancy off).
 use super::{BenchOptions, Row};
 use crate::error::Result;
 use crate::gpu::Context;
@@ -53,6 +54,15 @@ pub fn march(ctx: &Context, opts: &BenchOptions) -> Result<Vec<Row>> {
                 },
                 name,
             ));
+        }
+        // Secondary rays over every sample, where the frame has them.
+        if s.skips_empty() {
+            let name = format!("{} {DEFAULT} occupancy=off", s.list_name());
+            let off = crate::render::metaball::MetaballSettings {
+                occupancy: false,
+                ..s.clone()
+            };
+            rows.push((off, name));
         }
     }
     let mut out = super::render::time_rows(ctx, opts, rows)?;
@@ -131,6 +141,10 @@ pub fn notes(rows: &[Row]) -> Vec<String> {
             (
                 "32 lanes a ray",
                 "counters=subgroup lanes=blocks ray-lanes=32",
+            ),
+            (
+                "secondary rays over every sample",
+                "counters=subgroup lanes=blocks occupancy=off",
             ),
         ] {
             if let Some(m) = of(suffix) {

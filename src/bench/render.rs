@@ -102,6 +102,13 @@ pub fn time_rows(
             ("fragments".into(), st.fragments.to_string()),
             ("longest list".into(), st.longest.to_string()),
             ("steps/px".into(), format!("{:.1}", per_px.0)),
+            (
+                "skipped/px".into(),
+                format!(
+                    "{:.1}",
+                    after.march.skipped as f64 / settings.pixels().max(1) as f64
+                ),
+            ),
             ("evals/px".into(), format!("{:.0}", per_px.1)),
             ("candidates/px".into(), format!("{:.1}", per_px.2)),
             ("serial max".into(), after.march.serial_max.to_string()),

@@ -220,6 +220,10 @@ pub struct MetaballArgs {
     /// 32 (each lane a grid sample of the ray: the same hits; at most the subgroup's size)
     #[arg(long, value_name = "N", value_parser = clap::builder::PossibleValuesParser::new(["1", "8", "16", "32"]).map(|s| s.parse::<u32>().expect("listed")))]
     pub ray_lanes: Option<u32>,
+    /// Secondary rays pass over the samples in cells of an occupancy grid that no
+    /// metaball reaches: on (default; the same hits from fewer samples) or off (every sample)
+    #[arg(long, value_parser = choice::<OnOff>())]
+    pub occupancy: Option<OnOff>,
     /// How the S-buffer's per-pixel lists are built: rasterising the billboards (the
     /// thesis's, default) or compute from the per-tile lists (already in depth order)
     #[arg(long, value_parser = choice::<BuildKind>())]

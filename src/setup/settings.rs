@@ -29,6 +29,10 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
         counters: m.counters.unwrap_or(t.counters),
         lanes: m.lanes.unwrap_or(t.lanes),
         ray_lanes: m.ray_lanes.unwrap_or(t.ray_lanes),
+        occupancy: m
+            .occupancy
+            .map(|o| o == crate::config::OnOff::On)
+            .unwrap_or(t.occupancy),
         build: m.build.unwrap_or(t.build),
         tile: m.tile.unwrap_or(t.tile),
         offscreen_end: m
@@ -60,6 +64,7 @@ pub fn metaball_settings(sw: &Switches) -> Result<MetaballSettings> {
             ("--counters", m.counters.is_some()),
             ("--lanes", m.lanes.is_some()),
             ("--ray-lanes", m.ray_lanes.is_some()),
+            ("--occupancy", m.occupancy.is_some()),
             ("--build", m.build.is_some()),
             ("--tile", m.tile.is_some()),
         ];

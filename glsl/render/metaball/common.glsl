@@ -42,6 +42,8 @@ layout(std430, binding = MB_B_PAIR_KEYS) buffer PairKeys { uint pair_keys[]; };
 layout(std430, binding = MB_B_PAIR_IDS) buffer PairIds { uint pair_ids[]; };
 layout(std430, binding = MB_B_TILE_BALLS) buffer TileBalls { vec4 tile_balls[]; };
 layout(std430, binding = MB_B_TILE_RANGES) buffer TileRanges { uvec2 tile_ranges[]; };
+// The occupancy grid (occupancy.glsl): a header, then one word per cell (1: reached).
+layout(std430, binding = MB_B_OCCUPANCY) buffer Occupancy { uint occupancy[]; };
 
 uint range_start(uint p) { return p == 0u ? 0u : offsets[p - 1u]; }
 

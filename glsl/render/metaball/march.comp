@@ -32,6 +32,8 @@ uint longest = 0u;
 // Per-ray counters (summed per subgroup and workgroup, then added to stats as 64-bit
 // totals: add_counters).
 uint n_rays = 0u, n_steps = 0u, n_evals = 0u, n_candidates = 0u;
+// Grid samples of secondary rays passed over in empty cells, not evaluated (--occupancy).
+uint n_skipped = 0u;
 // The field and gradient evaluations this invocation makes one after another: the serial
 // chain that sets a pixel's time (stats' serial_max and serial_mean).
 uint n_serial = 0u;
@@ -287,6 +289,35 @@ vec2 tile_interval(vec3 o, vec3 d) {
 vec3 box_lo() { return bounds[0].xyz - vec3(radius()); }
 vec3 box_hi() { return bounds[1].xyz + vec3(radius()); }
 
+#include "occupancy.glsl"
+// --occupancy on: a secondary ray outside the fluid passes over grid samples in cells no
+// metaball reaches (occupancy.glsl: the field is 0 < T there, so no sample crosses T).
+// Primary rays march their list's interval, and rays inside cross T where the field is 0.
+bool skips_empty(uint pixel, bool inside) { return P.occupancy != 0u && pixel == NIL && !inside; }
+// Whether x lies in an empty cell; the cell last read and what it held are kept, so a ray
+// loads each cell it crosses once.
+OccGrid occ = OccGrid(vec3(0.0), vec3(0.0), uvec3(0u));
+bool occ_read = false, occ_last_empty = false;
+uint occ_last = NIL;
+bool in_empty_cell(vec3 x) {
+    if (!occ_read) {
+        occ = occ_header();
+        occ_read = true;
+    }
+    uint c = occ_cell(occ, x);
+    if (c == NIL) return false;
+    if (c != occ_last) {
+        occ_last = c;
+        occ_last_empty = occupancy[OCC_CELLS + c] == 0u;
+    }
+    return occ_last_empty;
+}
+// A march's samples: `taken` grid samples up to its exit, `skipped` of them passed over.
+void count_samples(uint taken, uint skipped) {
+    n_steps += taken - skipped;
+    n_skipped += skipped;
+}
+
 #include "march_ray.glsl"
 
 vec3 normal_at(vec3 x, uint pixel) {
@@ -470,6 +501,6 @@ void main() {
     march_pixel();
     // The group's per-ray counts are its first lane's (every lane counted the same rays);
     // terms, off-screen samples and serial chains are each lane's own.
-    if (ray_lane() != 0u) n_rays = n_steps = n_candidates = 0u;
+    if (ray_lane() != 0u) n_rays = n_steps = n_candidates = n_skipped = 0u;
     add_counters();  // every invocation: WORKGROUP's barriers
 }

@@ -4,7 +4,8 @@
 #define RENDER_METABALL_MARCH_COUNTERS_GLSL
 // The frame's counters (COUNTERS): rays, samples, terms and candidates, with the longest
 // list and the off-screen samples, and the serial chains (the most evaluations one
-// invocation made, the invocations that evaluated and their evaluations' sum), added to the workgroup's counter slot (common.glsl: the
+// invocation made, the invocations that evaluated and their evaluations' sum) and the samples passed over
+// in empty cells, added to the workgroup's counter slot (common.glsl: the
 // frame's atomics spread over MARCH_SLOTS cache lines, summed by the host). WORKGROUP:
 // each subgroup's sums meet in shared memory and one invocation per workgroup adds them;
 // SUBGROUP: each subgroup adds its own; OFF: nothing counted (the increments above are
@@ -20,16 +21,17 @@
     if (c_ > 0u) atomicAdd(march_slots[(W) + 1u], c_); }
 
 // Each subgroup's sums (the longest list and the longest serial chain their max).
-struct Sums { uint rays, longest, offscreen, serial_max, marching; uint lo[4], hi[4]; };
+// lo and hi: steps, evals, candidates, serial evaluations, skipped samples.
+struct Sums { uint rays, longest, offscreen, serial_max, marching; uint lo[5], hi[5]; };
 Sums subgroup_sums() {
     Sums s;
-    uint counts[4] = uint[4](n_steps, n_evals, n_candidates, n_serial);
+    uint counts[5] = uint[5](n_steps, n_evals, n_candidates, n_serial, n_skipped);
     s.rays = subgroupAdd(n_rays);
     s.longest = subgroupMax(longest);
     s.offscreen = subgroupAdd(offscreen_samples);
     s.serial_max = subgroupMax(n_serial);
     s.marching = subgroupAdd(n_serial > 0u ? 1u : 0u);
-    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+    [[unroll]] for (uint k = 0u; k < 5u; ++k) {
         s.lo[k] = subgroupAdd(counts[k] & 0xFFFFu);
         s.hi[k] = subgroupAdd(counts[k] >> 16);
     }
@@ -47,15 +49,17 @@ void add_sums(Sums s) {
     }
     if (s.serial_max > 0u) atomicMax(march_slots[at + 11u], s.serial_max);
     if (s.marching > 0u) atomicAdd(march_slots[at + 12u], s.marching);
+    if (s.lo[4] > 0u || s.hi[4] > 0u) ADD64(at + 13u, s.lo[4], s.hi[4])
 }
 
 #if COUNTERS == COUNTERS_WORKGROUP
 // rays, longest, off-screen, the lo then the hi of steps, evals, candidates and serial
-// evaluations, the longest serial chain, the invocations that evaluated.
-shared uint c_sum[13];
+// evaluations, the longest serial chain, the invocations that evaluated, the lo and hi of
+// skipped samples.
+shared uint c_sum[15];
 void add_counters() {
     if (gl_LocalInvocationIndex == 0u) {
-        [[unroll]] for (uint k = 0u; k < 13u; ++k) c_sum[k] = 0u;
+        [[unroll]] for (uint k = 0u; k < 15u; ++k) c_sum[k] = 0u;
     }
     barrier();
     Sums s = subgroup_sums();
@@ -69,6 +73,8 @@ void add_counters() {
         }
         atomicMax(c_sum[11], s.serial_max);
         atomicAdd(c_sum[12], s.marching);
+        atomicAdd(c_sum[13], s.lo[4]);
+        atomicAdd(c_sum[14], s.hi[4]);
     }
     barrier();
     if (gl_LocalInvocationIndex != 0u) return;
@@ -82,6 +88,8 @@ void add_counters() {
     }
     w.serial_max = c_sum[11];
     w.marching = c_sum[12];
+    w.lo[4] = c_sum[13];
+    w.hi[4] = c_sum[14];
     add_sums(w);
 }
 #elif COUNTERS == COUNTERS_SUBGROUP

@@ -63,6 +63,8 @@ float lanes_max(float v) {
 #else
 #error "RAY_LANES is 1, 8, 16 or 32"
 #endif
+// The lanes below lane k (k <= RAY_LANES), as a ballot's bits.
+uint lanes_below(uint k) { return k >= 32u ? 0xFFFFFFFFu : (1u << k) - 1u; }
 // The first lane where c holds, RAY_LANES where none does.
 uint lanes_first(bool c) {
     uint b = lanes_ballot(c);

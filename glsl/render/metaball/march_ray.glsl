@@ -2,6 +2,8 @@
 // crossing, the fixed-step march and the Lipschitz march, serial (RAY_LANES 1: one
 // invocation per ray) or over a group of RAY_LANES lanes (march_lanes.glsl), which takes
 // the serial march's samples and bisection midpoints, so its hits are bit for bit the same.
+// Secondary rays outside the fluid pass over samples in cells the occupancy grid proves
+// empty (P.occupancy; occupancy.glsl): their field is 0 < T, so the hits stay the same.
 #ifndef RENDER_METABALL_MARCH_RAY_GLSL
 #define RENDER_METABALL_MARCH_RAY_GLSL
 #if RAY_LANES == 1
@@ -31,9 +33,11 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float T = threshold(), step = P.sun.w;
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
-    uint i = 0u;
+    uint i = 0u, skipped = 0u;
+    bool skips = skips_empty(pixel, inside);
     n_rays++;
-    // The samples are counted once at each exit (i + 1 where sample i ends the march).
+    // The samples are counted once at each exit (i + 1 where sample i ends the march),
+    // less those passed over in empty cells (counted apart).
     for (; i < P.max_steps && t <= t1; ++i) {
         vec3 x = o + d * t;
         uint p = pixel;
@@ -42,21 +46,27 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
             if (p == NIL) {
                 offscreen_samples++;
                 if (P.offscreen_end != 0u) {
-                    n_steps += i + 1u;
+                    count_samples(i + 1u, skipped);
                     return -2.0;
                 }
                 p = ALL;
             }
+            if (skips && in_empty_cell(x)) {
+                skipped++;
+                prev = t;
+                t += step;
+                continue;
+            }
         }
         if ((field(x, p) >= T) != inside) {
-            n_steps += i + 1u;
+            count_samples(i + 1u, skipped);
             return bisect(o, d, prev, t, inside, pixel);
         }
         prev = t;
         t += step;
     }
     CUT_UNLESS(!(i < P.max_steps && t <= t1))
-    n_steps += i;
+    count_samples(i, skipped);
     return -1.0;
 }
 
@@ -154,14 +164,15 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
     uint lane = ray_lane();
-    uint i = 0u;
+    uint i = 0u, skipped = 0u;
+    bool skips = skips_empty(pixel, inside);
     n_rays++;
     bool more = true;
     for (; more;) {
         float tj = grid_ahead(t, step, lane);
         bool valid = i + lane < P.max_steps && tj <= t1;
         uint e0 = n_evals, off0 = offscreen_samples;
-        bool leaves = false, across = false;
+        bool leaves = false, across = false, empty = false;
         if (valid) {
             vec3 x = o + d * tj;
             uint p = pixel;
@@ -172,26 +183,29 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
                     leaves = P.offscreen_end != 0u;
                     p = ALL;
                 }
+                empty = !leaves && skips && in_empty_cell(x);
             }
-            if (!leaves) across = (field(x, p) >= T) != inside;
+            if (!leaves && !empty) across = (field(x, p) >= T) != inside;
         }
+        uint passed = lanes_ballot(empty);
         uint f = lanes_first(leaves || across);
         if (f < RAY_LANES) {
             if (lane > f) {
                 n_evals = e0;
                 offscreen_samples = off0;
             }
-            n_steps += i + f + 1u;
+            count_samples(i + f + 1u, skipped + bitCount(passed & lanes_below(f)));
             if (lanes_first(across) != f) return -2.0;
             float pf = f == 0u ? prev : grid_ahead(t, step, f - 1u);
             return bisect(o, d, pf, grid_ahead(t, step, f), inside, pixel);
         }
         uint end = lanes_first(!valid);
         if (end < RAY_LANES) {
-            n_steps += i + end;
+            count_samples(i + end, skipped + bitCount(passed & lanes_below(end)));
             more = false;
         } else {
             i += RAY_LANES;
+            skipped += bitCount(passed);
             prev = grid_ahead(t, step, RAY_LANES - 1u);
             t = grid_ahead(t, step, RAY_LANES);
         }

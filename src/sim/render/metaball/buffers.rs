@@ -25,6 +25,9 @@ pub struct MetaballBuffers {
     pub(super) depths: Buffer,
     /// The opaque layer the caller draws (settings.opaque): W*H RGBA8, then W*H f32 depths.
     pub opaque: Buffer,
+    /// The occupancy grid (glsl/render/metaball/occupancy.glsl): a header and a word per
+    /// cell, for every marched frame (a retune may turn it on).
+    pub(super) occupancy: Buffer,
     /// With the opaque layer: per pixel, the NDC depth of the first surface the primary
     /// ray meets (fluid or opaque layer; 1 = none), for layers drawn over the picture.
     pub scene_depth: Buffer,
@@ -41,6 +44,10 @@ pub struct MetaballBuffers {
     /// The per-tile lists (token sizes unless the frame bins tiles).
     pub tiles: super::tiles::TileBuffers,
 }
+
+/// Bytes of the occupancy grid: its header's 16 words and 64^3 cells (occupancy.glsl's
+/// OCC_CELLS and OCC_DIM).
+pub const OCCUPANCY_BYTES: u64 = (16 + 64 * 64 * 64) * 4;
 
 /// Bytes of one list entry: an S-buffer metaball index, an A-buffer (index, next) node.
 pub fn entry_bytes(list: ListKind) -> u64 {
@@ -108,6 +115,7 @@ impl MetaballBuffers {
             &self.depths,
             &self.opaque,
             &self.scene_depth,
+            &self.occupancy,
         ];
         let readbacks = self.stats_readback.iter().chain(&self.pixels_readback);
         let buffers: u64 = own.into_iter().chain(readbacks).map(|b| b.size).sum();
@@ -129,6 +137,7 @@ impl MetaballBuffers {
             &mut self.depths,
             &mut self.opaque,
             &mut self.scene_depth,
+            &mut self.occupancy,
         ] {
             ctx.destroy_buffer(b);
         }
@@ -195,6 +204,7 @@ impl MetaballBuffers {
         )?;
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
+        let occupancy = buf("occupancy grid", only(s.marches(), OCCUPANCY_BYTES))?;
         let surface = match s.marches() {
             true => None,
             false => {
@@ -252,6 +262,7 @@ impl MetaballBuffers {
                 depths: depths.take(),
                 opaque: opaque.take(),
                 scene_depth: scene_depth.take(),
+                occupancy: occupancy.take(),
                 sky_size: (sky_w, sky_h),
                 bounds: bounds.take(),
                 scan: scan.take(),

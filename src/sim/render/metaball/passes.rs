@@ -195,6 +195,20 @@ impl PassKey for MarchKey {
     }
 }
 
+/// The occupancy grid's build reads the radius and bounds, never the density; common.glsl's
+/// functions need one to compile, so it compiles with Wyvill's: one variant for every frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OccupancyKey;
+
+impl PassKey for OccupancyKey {
+    fn all() -> Vec<Self> {
+        vec![OccupancyKey]
+    }
+    fn defines(&self) -> Defines {
+        DensityFn::Wyvill.define("DENSITY")
+    }
+}
+
 use uses::*;
 crate::gpu::graphics_pass!(
     /// Counts each pixel's metaballs (the S-buffer's first raster pass).
@@ -214,6 +228,10 @@ crate::gpu::graphics_pass!(
 crate::gpu::compute_pass!(pub DEPTHS: MetaballIo, Lists<SORTED_SBUFFER> = "depths", "render/metaball/depths.comp");
 crate::gpu::compute_pass!(pub SORT_LISTS: MetaballIo, Lists<SORTED_SBUFFER> = "sort lists", "render/metaball/sort_lists.comp");
 crate::gpu::compute_pass!(pub MARCH: MetaballIo, MarchKey = "march", "render/metaball/march.comp");
+crate::gpu::compute_pass!(
+    /// Marks the cells of the occupancy grid that a metaball reaches (--occupancy on).
+    pub OCCUPANCY: MetaballIo, OccupancyKey = "occupancy", "render/metaball/occupancy.comp"
+);
 crate::gpu::compute_pass!(pub TILE_BIN: MetaballIo, Lists<TILED> = "tile bin", "render/metaball/tile_bin.comp");
 crate::gpu::compute_pass!(
     pub TILE_COUNT: MetaballIo, Lists<TILED> = "tile count", "render/metaball/tile_pairs.comp", "PASS" = "0"

@@ -5,7 +5,8 @@
 //! does both. Sized buffers live in buffers.rs.
 use super::buffers::MetaballBuffers;
 use super::passes::{
-    ListKey, Lists, MarchKey, ABUFFER_FILL, COUNT, DEPTHS, FILL, MARCH, SORT_LISTS,
+    ListKey, Lists, MarchKey, OccupancyKey, ABUFFER_FILL, COUNT, DEPTHS, FILL, MARCH, OCCUPANCY,
+    SORT_LISTS,
 };
 use super::settings::{MetaballSettings, RenderParams};
 use super::stats::{FrameStats, GpuStats};
@@ -34,7 +35,7 @@ crate::gpu_interface! {
         params = 0, centers = 1, bounds = 2, offsets = 3, list = 4, heads = 5, nodes = 6,
         stats = 7, pixels = 8, debug = 9, sky = 10, depths = 11, opaque = 12,
         scene_depth = 13, rects = 14, ball_keys = 15, ball_ids = 16, pair_counts = 17,
-        pair_keys = 18, pair_ids = 19, tile_balls = 20, tile_ranges = 21,
+        pair_keys = 18, pair_ids = 19, tile_balls = 20, tile_ranges = 21, occupancy = 22,
     }
 }
 
@@ -52,6 +53,8 @@ pub struct FluidRenderer {
     tiles: Option<TilePasses>,
     /// The metaballs' ray march (none for the other surfaces).
     march: Option<Compute>,
+    /// The occupancy grid's build (with the march).
+    occupancy: Option<Compute>,
     /// Screen-space fluid or marching cubes instead of the metaballs.
     surface: Option<Surface>,
     pub(super) scan: ScanPass,
@@ -89,6 +92,11 @@ impl FluidRenderer {
         };
         let march = Guard::new(ctx, march);
         let surface = Guard::new(ctx, surface);
+        let occupancy = match settings.marches() {
+            true => Some(OCCUPANCY.pipeline(ctx, &OccupancyKey, 64, &[])?),
+            false => None,
+        };
+        let occupancy = Guard::new(ctx, occupancy);
         let tiles = match settings.bins_tiles() {
             true => Some(TilePasses::new(ctx, &settings)?),
             false => None,
@@ -111,6 +119,7 @@ impl FluidRenderer {
             sort: sort.map(|(d, s)| (d.take(), s.take())),
             tiles: tiles.take(),
             march: march.take(),
+            occupancy: occupancy.take(),
             surface: surface.take(),
             scan: scan.take(),
             bounds,
@@ -194,6 +203,7 @@ impl FluidRenderer {
             pair_ids: &b.tiles.pair_ids,
             tile_balls: &b.tiles.tile_balls,
             tile_ranges: &b.tiles.tile_ranges,
+            occupancy: &b.occupancy,
         }
     }
 
@@ -366,6 +376,12 @@ impl FluidRenderer {
                 sort.dispatch_groups(ctx, cmd, &bufs, &(), groups);
             }
         }
+        if let (true, Some(occupancy)) = (s.skips_empty(), &self.occupancy) {
+            let _scope = scopes.open(ctx, cmd, OCCUPANCY.scope());
+            ctx.fill(cmd, &b.occupancy, 0);
+            // No metaballs: no header, an empty grid (dims 0), nothing passed over.
+            occupancy.dispatch(ctx, cmd, &bufs, &(), n as u64);
+        }
         {
             let _scope = scopes.open(ctx, cmd, MARCH.scope());
             // One workgroup per 8 x 8 block (tiles: march.comp stages the block's tile).
@@ -512,6 +528,7 @@ impl FluidRenderer {
             p.destroy(ctx);
         }
         self.march.destroy(ctx);
+        self.occupancy.destroy(ctx);
         self.surface.destroy(ctx);
         self.tiles.destroy(ctx);
         if let Some((d, s)) = &mut self.sort {

@@ -37,6 +37,10 @@ pub struct MetaballSettings {
     /// Lanes that march one ray together (1: one invocation per ray; `RAY_LANES`).
     #[serde(default = "thesis_ray_lanes")]
     pub ray_lanes: u32,
+    /// Secondary rays pass over the samples in cells of an occupancy grid no metaball
+    /// reaches (glsl/render/metaball/occupancy.glsl): the same hits from fewer samples.
+    #[serde(default = "thesis_occupancy")]
+    pub occupancy: bool,
     /// How the S-buffer's lists are built: rasterised billboards, or compute from the
     /// per-tile lists (each range then in depth order, no sort pass). Tiles: compute.
     #[serde(default = "thesis_build")]
@@ -100,6 +104,7 @@ impl MetaballSettings {
             counters: Counters::Subgroup,
             lanes: Lanes::Blocks,
             ray_lanes: 1,
+            occupancy: true,
             build: BuildKind::Raster,
             tile: 16,
             offscreen_end: false,
@@ -142,6 +147,10 @@ fn thesis_lanes() -> Lanes {
 
 fn thesis_ray_lanes() -> u32 {
     MetaballSettings::thesis().ray_lanes
+}
+
+fn thesis_occupancy() -> bool {
+    MetaballSettings::thesis().occupancy
 }
 
 fn thesis_build() -> BuildKind {
@@ -199,6 +208,12 @@ impl MetaballSettings {
     /// Whether the frame bins the metaballs into per-tile lists (tiles, compute builds).
     pub fn bins_tiles(&self) -> bool {
         self.marches() && self.build == BuildKind::Compute
+    }
+
+    /// Whether the frame builds the occupancy grid: secondary rays (glass, tinted and the
+    /// metals at depth >= 1) skip its empty cells.
+    pub fn skips_empty(&self) -> bool {
+        self.occupancy && self.marches() && self.material != Material::Phong && self.depth > 0
     }
 
     /// Whether the surface is the ray-marched metaballs (the lists are built).
@@ -390,8 +405,13 @@ pub struct RenderParams {
     pub tiles_x: u32,
     pub rank_bits: u32,
     pub pair_capacity: u32,
+    /// 1: secondary rays pass over the occupancy grid's empty cells.
+    pub occupancy: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 384);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 400);
 
 /// Bits of a pair key's depth rank among `n` metaballs (at least one).
 pub fn rank_bits(n: u32) -> u32 {
@@ -466,6 +486,10 @@ impl RenderParams {
             tiles_x: s.width.div_ceil(s.tile),
             rank_bits: rank_bits(n),
             pair_capacity: pairs.min(u32::MAX as u64) as u32,
+            occupancy: s.skips_empty() as u32,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 }

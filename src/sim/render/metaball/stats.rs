@@ -75,14 +75,16 @@ impl GpuStats {
         std::mem::offset_of!(GpuStats, sbuffer_fragments) as u64;
 }
 
-/// The march's serial chains, summed from the counter slots (words 9..13: the (lo, hi)
-/// total of every invocation's evaluations, the longest chain, the invocations that
-/// evaluated; march_counters.glsl).
+/// The march's serial chains and passed-over samples, summed from the counter slots
+/// (words 9..15: the (lo, hi) total of every invocation's evaluations, the longest chain,
+/// the invocations that evaluated, the (lo, hi) total of samples passed over in empty
+/// cells; march_counters.glsl).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Serial {
     pub max: u32,
     pub invocations: u64,
     pub sum: u64,
+    pub skipped: u64,
 }
 
 impl Serial {
@@ -93,6 +95,7 @@ impl Serial {
             s.sum += wide([word(k, 9), word(k, 10)]);
             s.max = s.max.max(word(k, 11));
             s.invocations += word(k, 12) as u64;
+            s.skipped += wide([word(k, 13), word(k, 14)]);
         }
         s
     }
@@ -141,6 +144,10 @@ pub struct MarchCounts {
     /// Their mean over the invocations that evaluated at all.
     #[serde(default)]
     pub serial_mean: f64,
+    /// Grid samples of secondary rays passed over in cells the occupancy grid proves
+    /// empty, not evaluated (not in `steps`; --occupancy).
+    #[serde(default)]
+    pub skipped: u64,
 }
 
 impl MarchCounts {
@@ -152,6 +159,7 @@ impl MarchCounts {
             candidates: wide(st.candidates),
             serial_max: serial.max as u64,
             serial_mean: serial.sum as f64 / serial.invocations.max(1) as f64,
+            skipped: serial.skipped,
         }
     }
 
