@@ -59,13 +59,18 @@ float threshold() { return P.base.w; }
 const float BLINN_A = 4.0;
 float density2(float r2) {
     float R = radius();
+#if DENSITY == DENSITY_WYVILL
+    // Branch-free, one multiply by the hoisted 1 / R^2: (1 - q^2)^2 (1 - 4/9 q^2) is
+    // Wyvill's polynomial factored, and its first factor is 0 from R on.
+    float q2 = r2 * (1.0 / (R * R));
+    float a = max(1.0 - q2, 0.0);
+    return a * a * (1.0 - 4.0 / 9.0 * q2);
+#else
     float q2 = r2 / (R * R);
     if (q2 >= 1.0) return 0.0;
 #if DENSITY == DENSITY_BLINN
     float fl = exp(-BLINN_A);
     return (exp(-BLINN_A * q2) - fl) / (1.0 - fl);
-#elif DENSITY == DENSITY_WYVILL
-    return 1.0 - 4.0 / 9.0 * q2 * q2 * q2 + 17.0 / 9.0 * q2 * q2 - 22.0 / 9.0 * q2;
 #elif DENSITY == DENSITY_NISHIMURA
     float q = sqrt(q2);
     return q <= 1.0 / 3.0 ? 1.0 - 3.0 * q2 : 1.5 * (1.0 - q) * (1.0 - q);
@@ -76,6 +81,7 @@ float density2(float r2) {
     return u * u * u * u * (4.0 * q + 1.0);
 #else
 #error "DENSITY names no density function"
+#endif
 #endif
 }
 

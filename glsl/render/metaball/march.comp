@@ -152,6 +152,38 @@ float field(vec3 x, uint p) {
     return f;
 }
 
+#if LIST == LIST_NONE && RAY_LANES == 1
+// --list none, one invocation a ray: the field at BLOCK consecutive grid samples of a ray
+// in one pass over the metaballs, each centre loaded once for all of them (register
+// blocking: every sample sums every metaball, so the load, not the term, set the cost).
+// Each sample's sum adds the same terms in the same order as field(): the same bits. One
+// serial evaluation; the terms a sample takes are counted by the march (`terms`: the
+// metaballs summed, per sample).
+const uint BLOCK = 4u;
+vec4 field_block(vec3 x0, vec3 x1, vec3 x2, vec3 x3, out uint terms) {
+    vec4 f = vec4(0.0);
+    uint m = 0u, b_ = 0u;
+    n_serial++;
+    for (; b_ < P.n; b_ += ALL_UNROLL) {
+        [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) {
+            uint j_ = b_ + u_;
+            vec4 c_ = j_ < P.n ? centers[j_] : vec4(-1.0);
+            if (c_.w >= 0.0) {
+                vec3 d0 = x0 - c_.xyz, d1 = x1 - c_.xyz, d2 = x2 - c_.xyz, d3 = x3 - c_.xyz;
+                f.x += density2(dot(d0, d0));
+                f.y += density2(dot(d1, d1));
+                f.z += density2(dot(d2, d2));
+                f.w += density2(dot(d3, d3));
+                m++;
+            }
+        }
+    }
+    CUT_UNLESS(!(b_ < P.n))
+    terms = m;
+    return f;
+}
+#endif
+
 // The field at x and how many metaballs lie within R + reach of x: only those can be
 // nonzero anywhere on the next `reach` of a ray through x.
 vec2 field_reach(vec3 x, uint p, float reach) {

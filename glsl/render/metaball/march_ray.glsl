@@ -24,6 +24,77 @@ float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
     return b;
 }
 
+#if LIST == LIST_NONE
+// `march` below, BLOCK grid samples at a time (field_block: every metaball loaded once
+// for all of them). Each sample's projection, off-screen end and empty cell are taken in
+// the order the one-sample march takes them, and the first sample across T is its first:
+// the same hits, with its counts (rays, samples, terms, off-screen samples; the samples
+// past the exit are speculation, not counted) and one serial evaluation a block.
+float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+    float T = threshold(), step = P.sun.w;
+    float t = ceil(t0 / step) * step;
+    float prev = max(t - step, 0.0);
+    uint i = 0u, skipped = 0u;
+    bool skips = skips_empty(pixel, inside);
+    n_rays++;
+    bool more = true;
+    for (; more;) {
+        float tk[BLOCK];
+        vec3 xk[BLOCK];
+        bool off[BLOCK], empty[BLOCK];
+        uint valid = 0u;
+        bool any = false;
+        float tj = t;
+        [[unroll]] for (uint k = 0u; k < BLOCK; ++k) {
+            tk[k] = tj;
+            xk[k] = o + d * tj;
+            tj += step;
+            bool in_ray = i + k < P.max_steps && tk[k] <= t1;
+            valid += in_ray ? 1u : 0u;
+            off[k] = in_ray && pixel == NIL && project(xk[k]) == NIL;
+            empty[k] = in_ray && !(off[k] && P.offscreen_end != 0u) && skips && in_empty_cell(xk[k]);
+            any = any || (in_ray && !empty[k] && !(off[k] && P.offscreen_end != 0u));
+        }
+        uint m = 0u;
+        vec4 f = vec4(0.0);
+        if (any) f = field_block(xk[0], xk[1], xk[2], xk[3], m);
+        uint used = 0u;  // samples evaluated up to the exit
+        [[unroll]] for (uint k = 0u; k < BLOCK; ++k) {
+            if (more && k < valid) {
+                if (off[k]) {
+                    offscreen_samples++;
+                    if (P.offscreen_end != 0u) {
+                        n_evals += m * used;
+                        count_samples(i + k + 1u, skipped);
+                        return -2.0;
+                    }
+                }
+                if (empty[k]) {
+                    skipped++;
+                } else {
+                    used++;
+                    if ((f[k] >= T) != inside) {
+                        n_evals += m * used;
+                        count_samples(i + k + 1u, skipped);
+                        return bisect(o, d, k == 0u ? prev : tk[k - 1u], tk[k], inside, pixel);
+                    }
+                }
+            }
+        }
+        n_evals += m * used;
+        if (valid < BLOCK) {
+            count_samples(i + valid, skipped);
+            more = false;
+        } else {
+            i += BLOCK;
+            prev = tk[BLOCK - 1u];
+            t = tj;
+        }
+    }
+    CUT_UNLESS(!more)
+    return -1.0;
+}
+#elif LIST == LIST_ABUFFER || LIST == LIST_SBUFFER || LIST == LIST_TILES
 // March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
 // ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
 // -2 when a secondary sample left the screen and paths end there. Samples sit on the
@@ -69,6 +140,9 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     count_samples(i, skipped);
     return -1.0;
 }
+#else
+#error "LIST names no list mode"
+#endif
 
 #if MARCH == MARCH_LIPSCHITZ
 // `march` on the same grid for a primary ray, whose pixel's list holds every metaball the
