@@ -152,36 +152,80 @@ float field(vec3 x, uint p) {
     return f;
 }
 
-#if LIST == LIST_NONE && RAY_LANES == 1
-// --list none, one invocation a ray: the field at BLOCK consecutive grid samples of a ray
-// in one pass over the metaballs, each centre loaded once for all of them (register
-// blocking: every sample sums every metaball, so the load, not the term, set the cost).
-// Each sample's sum adds the same terms in the same order as field(): the same bits. One
-// serial evaluation; the terms a sample takes are counted by the march (`terms`: the
-// metaballs summed, per sample).
+#if RAY_LANES == 1
+// One invocation a ray: the field at BLOCK consecutive grid samples of a ray that all sum
+// the same metaballs (every one under --list none; a primary ray's pixel list under the
+// A-buffer and the unsorted S-buffer) in one pass, each centre loaded once for all of
+// them (register blocking: the loads, not the terms, set the cost). Each sample's sum
+// adds the same terms in the same order as field(): the same bits. One serial
+// evaluation; `terms`: the metaballs each sample summed.
 const uint BLOCK = 4u;
-vec4 field_block(vec3 x0, vec3 x1, vec3 x2, vec3 x3, out uint terms) {
+#if LIST == LIST_NONE || LIST == LIST_ABUFFER || (LIST == LIST_SBUFFER && SORTED == 0)
+#define BLOCKED 1
+#elif LIST == LIST_TILES || (LIST == LIST_SBUFFER && SORTED == 1)
+#define BLOCKED 0
+#else
+#error "LIST names no list mode"
+#endif
+#define TERMS4(C) { \
+    vec3 c4_ = (C), d0 = x0 - c4_, d1 = x1 - c4_, d2 = x2 - c4_, d3 = x3 - c4_; \
+    f.x += density2(dot(d0, d0)); \
+    f.y += density2(dot(d1, d1)); \
+    f.z += density2(dot(d2, d2)); \
+    f.w += density2(dot(d3, d3)); }
+#if BLOCKED
+vec4 field_block(vec3 x0, vec3 x1, vec3 x2, vec3 x3, uint p, out uint terms) {
     vec4 f = vec4(0.0);
-    uint m = 0u, b_ = 0u;
+    uint m = 0u;
     n_serial++;
-    for (; b_ < P.n; b_ += ALL_UNROLL) {
-        [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) {
-            uint j_ = b_ + u_;
-            vec4 c_ = j_ < P.n ? centers[j_] : vec4(-1.0);
-            if (c_.w >= 0.0) {
-                vec3 d0 = x0 - c_.xyz, d1 = x1 - c_.xyz, d2 = x2 - c_.xyz, d3 = x3 - c_.xyz;
-                f.x += density2(dot(d0, d0));
-                f.y += density2(dot(d1, d1));
-                f.z += density2(dot(d2, d2));
-                f.w += density2(dot(d3, d3));
-                m++;
+#if LIST == LIST_NONE
+    p = ALL;
+#endif
+    if (p == ALL) {
+        uint b_ = 0u;
+        for (; b_ < P.n; b_ += ALL_UNROLL) {
+            [[unroll]] for (uint u_ = 0u; u_ < ALL_UNROLL; ++u_) {
+                uint j_ = b_ + u_;
+                vec4 c_ = j_ < P.n ? centers[j_] : vec4(-1.0);
+                if (c_.w >= 0.0) {
+                    TERMS4(c_.xyz)
+                    m++;
+                }
             }
         }
+        CUT_UNLESS(!(b_ < P.n))
+    } else {
+#if LIST == LIST_ABUFFER
+        uint n_ = heads[p];
+        for (; n_ != NIL;) {
+            [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) {
+                if (n_ != NIL) {
+                    uvec2 e_ = nodes[n_];
+                    TERMS4(centers[e_.x].xyz)
+                    m++;
+                    n_ = e_.y;
+                }
+            }
+        }
+        CUT_UNLESS(n_ == NIL)
+#elif LIST == LIST_SBUFFER
+        uint e_ = min(offsets[p], P.list_capacity), b_ = range_start(p);
+        m = e_ - min(b_, e_);
+        for (; b_ < e_; b_ += 8u) {
+            [[unroll]] for (uint u_ = 0u; u_ < 8u; ++u_) {
+                uint s_ = b_ + u_;
+                if (s_ < e_) TERMS4(centers[list[s_]].xyz)
+            }
+        }
+        CUT_UNLESS(!(b_ < e_))
+#elif LIST != LIST_NONE
+#error "LIST names no blocked list"
+#endif
     }
-    CUT_UNLESS(!(b_ < P.n))
     terms = m;
     return f;
 }
+#endif
 #endif
 
 // The field at x and how many metaballs lie within R + reach of x: only those can be

@@ -24,13 +24,15 @@ float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
     return b;
 }
 
-#if LIST == LIST_NONE
-// `march` below, BLOCK grid samples at a time (field_block: every metaball loaded once
-// for all of them). Each sample's projection, off-screen end and empty cell are taken in
-// the order the one-sample march takes them, and the first sample across T is its first:
-// the same hits, with its counts (rays, samples, terms, off-screen samples; the samples
-// past the exit are speculation, not counted) and one serial evaluation a block.
-float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+#if BLOCKED
+// `march_one` below, BLOCK grid samples at a time (field_block: each metaball loaded once
+// for all of them), where every sample sums the same metaballs: every ray under --list
+// none, primary rays (their pixel's list) under the A-buffer and unsorted S-buffer. Each
+// sample's projection, off-screen end and empty cell are taken in the order the
+// one-sample march takes them, and the first sample across T is its first: the same
+// hits, with its counts (rays, samples, terms, off-screen samples; the samples past the
+// exit are speculation, not counted) and one serial evaluation a block.
+float march_block(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float T = threshold(), step = P.sun.w;
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
@@ -57,7 +59,7 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
         }
         uint m = 0u;
         vec4 f = vec4(0.0);
-        if (any) f = field_block(xk[0], xk[1], xk[2], xk[3], m);
+        if (any) f = field_block(xk[0], xk[1], xk[2], xk[3], pixel == NIL ? ALL : pixel, m);
         uint used = 0u;  // samples evaluated up to the exit
         [[unroll]] for (uint k = 0u; k < BLOCK; ++k) {
             if (more && k < valid) {
@@ -94,13 +96,14 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     CUT_UNLESS(!more)
     return -1.0;
 }
-#elif LIST == LIST_ABUFFER || LIST == LIST_SBUFFER || LIST == LIST_TILES
+#endif
+
 // March [t0, t1]: entering (inside = false) or leaving the fluid. pixel: the primary
 // ray's list, or NIL for secondary rays (each sample projects). Returns the hit t or -1;
 // -2 when a secondary sample left the screen and paths end there. Samples sit on the
 // grid t = k * step from the ray's origin, so every list variant (whose intervals start
 // at different t0) takes the same samples and bisects the same steps.
-float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+float march_one(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     float T = threshold(), step = P.sun.w;
     float t = ceil(t0 / step) * step;
     float prev = max(t - step, 0.0);
@@ -140,9 +143,18 @@ float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
     count_samples(i, skipped);
     return -1.0;
 }
+
+// A ray's march: a block of samples at a time where they all sum the same metaballs.
+float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
+#if LIST == LIST_NONE
+    return march_block(o, d, t0, t1, inside, pixel);
+#elif BLOCKED
+    return pixel != NIL ? march_block(o, d, t0, t1, inside, pixel)
+                        : march_one(o, d, t0, t1, inside, pixel);
 #else
-#error "LIST names no list mode"
+    return march_one(o, d, t0, t1, inside, pixel);
 #endif
+}
 
 #if MARCH == MARCH_LIPSCHITZ
 // `march` on the same grid for a primary ray, whose pixel's list holds every metaball the
