@@ -13,6 +13,15 @@ const H: u32 = 70;
 const N: usize = 160;
 const SPACING: f32 = 0.0271;
 
+/// Every list, the S-buffer unsorted and sorted.
+const LISTS: [(ListKind, bool); 5] = [
+    (ListKind::None, false),
+    (ListKind::Abuffer, false),
+    (ListKind::Sbuffer, false),
+    (ListKind::Sbuffer, true),
+    (ListKind::Tiles, false),
+];
+
 fn settings(list: ListKind, sorted: bool, material: Material, depth: u32) -> MetaballSettings {
     let mut s = MetaballSettings::thesis();
     (s.list, s.sorted, s.material, s.depth) = (list, sorted, material, depth);
@@ -68,13 +77,7 @@ fn ray_lanes_give_the_serial_pictures_hits_and_counts() {
     let lanes = lane_counts(&ctx);
     assert!(!lanes.is_empty(), "lavapipe's subgroup holds 8 lanes");
     let mut cases = Vec::new();
-    for (list, sorted) in [
-        (ListKind::None, false),
-        (ListKind::Abuffer, false),
-        (ListKind::Sbuffer, false),
-        (ListKind::Sbuffer, true),
-        (ListKind::Tiles, false),
-    ] {
+    for (list, sorted) in LISTS {
         cases.push(settings(list, sorted, Material::Phong, 1));
         for material in [Material::Glass, Material::Tinted, Material::Gold] {
             for depth in 0..=3 {
@@ -356,13 +359,7 @@ fn occupancy_passes_over_empty_cells_with_the_same_hits() {
     let ctx = common::ctx();
     let (pts, cam) = two_blobs();
     let mut cases = Vec::new();
-    for (list, sorted) in [
-        (ListKind::None, false),
-        (ListKind::Abuffer, false),
-        (ListKind::Sbuffer, false),
-        (ListKind::Sbuffer, true),
-        (ListKind::Tiles, false),
-    ] {
+    for (list, sorted) in LISTS {
         cases.push(settings(list, sorted, Material::Glass, 3));
     }
     // The other paths read the grid through the same march: on one list.

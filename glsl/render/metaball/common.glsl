@@ -61,7 +61,9 @@ float density2(float r2) {
     float R = radius();
 #if DENSITY == DENSITY_WYVILL
     // Branch-free, one multiply by the hoisted 1 / R^2: (1 - q^2)^2 (1 - 4/9 q^2) is
-    // Wyvill's polynomial factored, and its first factor is 0 from R on.
+    // Wyvill's polynomial factored, and its first factor is 0 from R on. (1 / R^2 read
+    // from the parameters per term instead marched glass 1.3x slower on lavapipe: its
+    // LLVM does not hoist that load out of the sums.)
     float q2 = r2 * (1.0 / (R * R));
     float a = max(1.0 - q2, 0.0);
     return a * a * (1.0 - 4.0 / 9.0 * q2);
