@@ -26,10 +26,11 @@ OccGrid occ_header() {
         uvec3(occupancy[8], occupancy[9], occupancy[10]));
 }
 
-// The cell holding x, NIL outside the grid (or before a grid was built: dims 0).
+// The cell holding x, NIL outside the grid (or before a grid was built: dims 0, or where
+// a coordinate is not a number: both tests fail on NaN).
 uint occ_cell(OccGrid g, vec3 x) {
     vec3 c = floor((x - g.lo) * g.inv);
-    if (any(lessThan(c, vec3(0.0))) || any(greaterThanEqual(c, vec3(g.dims)))) return NIL;
+    if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(g.dims))))) return NIL;
     uvec3 u = uvec3(c);
     return (u.z * g.dims.y + u.y) * g.dims.x + u.x;
 }

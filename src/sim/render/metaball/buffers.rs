@@ -204,7 +204,8 @@ impl MetaballBuffers {
         )?;
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
-        let occupancy = buf("occupancy grid", only(s.marches(), OCCUPANCY_BYTES))?;
+        // "render ...": the renderer's own fixed-size buffers (neither per particle nor per pixel).
+        let occupancy = buf("render occupancy grid", only(s.marches(), OCCUPANCY_BYTES))?;
         let surface = match s.marches() {
             true => None,
             false => {

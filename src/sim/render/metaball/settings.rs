@@ -238,9 +238,10 @@ impl MetaballSettings {
     }
 
     pub fn validate(&self) -> Result<()> {
-        if !(self.radius > 0.0 && self.radius.is_finite()) {
+        // Positive, and far from float's ends: the march squares it and takes 1 / R^2.
+        if !(self.radius >= 1e-6 && self.radius <= 1e6) {
             return Err(Error::Param(format!(
-                "--radius must be positive, got {}",
+                "--radius must be positive, from 1e-6 to 1e6 m, got {}",
                 self.radius
             )));
         }
