@@ -173,7 +173,7 @@ const uint BLOCK = 4u;
     f.y += density2(dot(d1, d1)); \
     f.z += density2(dot(d2, d2)); \
     f.w += density2(dot(d3, d3)); }
-#if BLOCKED
+#if BLOCKED == 1
 vec4 field_block(vec3 x0, vec3 x1, vec3 x2, vec3 x3, uint p, out uint terms) {
     vec4 f = vec4(0.0);
     uint m = 0u;

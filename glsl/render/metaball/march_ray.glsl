@@ -24,7 +24,7 @@ float bisect(vec3 o, vec3 d, float a, float b, bool inside, uint pixel) {
     return b;
 }
 
-#if BLOCKED
+#if BLOCKED == 1
 // `march_one` below, BLOCK grid samples at a time (field_block: each metaball loaded once
 // for all of them), where every sample sums the same metaballs: every ray under --list
 // none, primary rays (their pixel's list) under the A-buffer and unsorted S-buffer. Each
@@ -148,11 +148,13 @@ float march_one(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
 float march(vec3 o, vec3 d, float t0, float t1, bool inside, uint pixel) {
 #if LIST == LIST_NONE
     return march_block(o, d, t0, t1, inside, pixel);
-#elif BLOCKED
+#elif BLOCKED == 1
     return pixel != NIL ? march_block(o, d, t0, t1, inside, pixel)
                         : march_one(o, d, t0, t1, inside, pixel);
-#else
+#elif BLOCKED == 0
     return march_one(o, d, t0, t1, inside, pixel);
+#else
+#error "BLOCKED is 0 or 1"
 #endif
 }
 
