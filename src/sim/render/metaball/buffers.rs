@@ -26,7 +26,7 @@ pub struct MetaballBuffers {
     /// The opaque layer the caller draws (settings.opaque): W*H RGBA8, then W*H f32 depths.
     pub opaque: Buffer,
     /// The occupancy grid (glsl/render/metaball/occupancy.glsl): a header and a word per
-    /// cell, for every marched frame (a retune may turn it on).
+    /// cell, where the march has secondary rays (a retune may turn `occupancy` on).
     pub(super) occupancy: Buffer,
     /// With the opaque layer: per pixel, the NDC depth of the first surface the primary
     /// ray meets (fluid or opaque layer; 1 = none), for layers drawn over the picture.
@@ -205,7 +205,10 @@ impl MetaballBuffers {
         let opaque = buf("opaque layer", only(s.opaque, px * 8))?;
         let scene_depth = buf("scene depth", only(s.opaque, px * 4))?;
         // "render ...": the renderer's own fixed-size buffers (neither per particle nor per pixel).
-        let occupancy = buf("render occupancy grid", only(s.marches(), OCCUPANCY_BYTES))?;
+        let occupancy = buf(
+            "render occupancy grid",
+            only(s.has_secondary_rays(), OCCUPANCY_BYTES),
+        )?;
         let surface = match s.marches() {
             true => None,
             false => {

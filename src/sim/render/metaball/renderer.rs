@@ -53,7 +53,7 @@ pub struct FluidRenderer {
     tiles: Option<TilePasses>,
     /// The metaballs' ray march (none for the other surfaces).
     march: Option<Compute>,
-    /// The occupancy grid's build (with the march).
+    /// The occupancy grid's build (where the march has secondary rays).
     occupancy: Option<Compute>,
     /// Screen-space fluid or marching cubes instead of the metaballs.
     surface: Option<Surface>,
@@ -92,7 +92,7 @@ impl FluidRenderer {
         };
         let march = Guard::new(ctx, march);
         let surface = Guard::new(ctx, surface);
-        let occupancy = match settings.marches() {
+        let occupancy = match settings.has_secondary_rays() {
             true => Some(OCCUPANCY.pipeline(ctx, &OccupancyKey, 64, &[])?),
             false => None,
         };

@@ -210,10 +210,15 @@ impl MetaballSettings {
         self.marches() && self.build == BuildKind::Compute
     }
 
-    /// Whether the frame builds the occupancy grid: secondary rays (glass, tinted and the
-    /// metals at depth >= 1) skip its empty cells.
+    /// Whether the march sends secondary rays (glass, tinted and the metals at depth >= 1).
+    /// Material and depth are shader defines, so a renderer keeps this through `retune`.
+    pub fn has_secondary_rays(&self) -> bool {
+        self.marches() && self.material != Material::Phong && self.depth > 0
+    }
+
+    /// Whether the frame builds the occupancy grid: secondary rays skip its empty cells.
     pub fn skips_empty(&self) -> bool {
-        self.occupancy && self.marches() && self.material != Material::Phong && self.depth > 0
+        self.occupancy && self.has_secondary_rays()
     }
 
     /// Whether the surface is the ray-marched metaballs (the lists are built).
