@@ -41,9 +41,12 @@ pub const DRIFT: f64 = 0.10;
 const SETTLED: f64 = 0.03;
 /// Frames of one warm-up batch.
 const BATCH: u64 = 5;
-/// The test hook: `FLUIDFORM_PERTURB=label@round,...` slows the sentinel threefold in
+/// The test hook: `FLUIDFORM_PERTURB=label@round,...` slows the sentinel `PERTURB_TIMES`-fold in
 /// those rounds of those cases (label `<variant>-<n>`), reruns included.
 pub const PERTURB_ENV: &str = "FLUIDFORM_PERTURB";
+/// Sentinel dispatches in a perturbed frame: tenfold, since lavapipe's sentinel alone
+/// was seen to switch between two speeds 1.9x apart within one run.
+const PERTURB_TIMES: u32 = 10;
 /// Iterations per invocation of the sentinel (bench/fma.comp, 64 FLOPs each).
 const SENTINEL_ITERS: u32 = 256;
 
@@ -498,7 +501,7 @@ fn play(
     let mut work = RecordOnly(|prof: &mut Profiler, cmd| {
         let s = slots[next];
         next += 1;
-        sentinel.record(ctx, prof, cmd, if s.perturbed { 3 } else { 1 });
+        sentinel.record(ctx, prof, cmd, if s.perturbed { PERTURB_TIMES } else { 1 });
         (cases[s.case].record)(prof, cmd)
     });
     crate::run::common::play(ctx, slots.len() as u64, &mut work, what, quiet)
