@@ -1,6 +1,8 @@
 //! Characters on ../shared/assets: loading, mesh checks, clip sampling, the CPU skinning
 //! reference against hand-computed values, built-in shapes, and bad input.
 mod common;
+#[path = "character_files/compressed.rs"]
+mod compressed;
 use common::asset;
 use fluidform::character::anim::{clip_time, slerp};
 use fluidform::character::Skinning;

@@ -50,17 +50,18 @@ pub(super) fn check_accessor(
 
 /// Every attribute the loader reads has POSITION's count and an allowed type; the index
 /// accessor too.
-fn check_primitive(path: &Path, what: &str, prim: &gltf::Primitive) -> Result<()> {
+fn check_primitive(path: &Path, what: &str, prim: &gltf::Primitive, quantized: bool) -> Result<()> {
     use gltf::Semantic as S;
     use DataType::{F32, U16, U32, U8};
     let n = prim.get(&S::Positions).map(|a| a.count());
     for (sem, a) in prim.attributes() {
         let allowed: &[(Dimensions, &[DataType])] = match &sem {
-            S::Positions | S::Normals => &[(Dimensions::Vec3, &[F32])],
-            S::TexCoords(0) => &[(Dimensions::Vec2, &[F32, U8, U16])],
             S::Joints(_) => &[(Dimensions::Vec4, &[U8, U16])],
             S::Weights(_) => &[(Dimensions::Vec4, &[F32, U8, U16])],
-            _ => continue,
+            s => match super::gltf_quantized::allowed(s, quantized) {
+                Some(types) => &[(super::gltf_quantized::dims(s), types)],
+                None => continue,
+            },
         };
         let label = format!("{what} {sem:?}");
         check_accessor(path, &label, &a, allowed)?;
@@ -110,14 +111,12 @@ struct Part {
 }
 
 pub fn load(path: &Path) -> Result<Character> {
-    std::fs::metadata(path).map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        source: e,
-    })?;
-    let gltf =
-        gltf::Gltf::open(path).map_err(|e| err(path, format!("not a valid glTF 2.0 file: {e}")))?;
-    let doc = &gltf.document;
-    let buffers = read_buffers(path, &gltf)?;
+    let opened = super::gltf_files::open(path)?;
+    let doc = &opened.doc;
+    let buffers = super::gltf_quantized::Buffers {
+        data: opened.buffers,
+        quantized: opened.quantized,
+    };
     let mut warnings = Vec::new();
     let nodes = read_nodes(doc);
     let order =
@@ -223,30 +222,6 @@ fn part_info(node: &gltf::Node, mesh: &gltf::Mesh, parts: &[Part], skinned: bool
         nonmanifold_edges: c.nonmanifold_edges,
         components: c.components,
     }
-}
-
-/// The file's buffers; a missing external buffer file is named before the reader fails.
-fn read_buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<gltf::buffer::Data>> {
-    let base = path.parent().unwrap_or(Path::new("."));
-    for b in gltf.document.buffers() {
-        if let gltf::buffer::Source::Uri(uri) = b.source() {
-            if !uri.starts_with("data:") {
-                let file = base.join(urlencoding_decode(uri));
-                if !file.exists() {
-                    return Err(err(
-                        path,
-                        format!(
-                            "buffer {} names '{uri}', which is missing ({})",
-                            b.index(),
-                            file.display()
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    gltf::import_buffers(&gltf.document, Some(base), gltf.blob.clone())
-        .map_err(|e| err(path, format!("cannot read its buffers: {e}")))
 }
 
 /// Every node with its rest transform and parent.
@@ -372,16 +347,19 @@ fn read_part(
     path: &Path,
     what: &str,
     prim: &gltf::Primitive,
-    buffers: &[gltf::buffer::Data],
+    buffers: &super::gltf_quantized::Buffers,
     offset: usize,
     skin_joints: Option<usize>,
     warnings: &mut Vec<String>,
 ) -> Result<(Part, bool)> {
-    check_primitive(path, what, prim)?;
+    use super::gltf_quantized::floats;
+    check_primitive(path, what, prim, buffers.quantized)?;
     let reader = prim.reader(|b| Some(&buffers[b.index()]));
-    let positions: Vec<Vec3> = reader
-        .read_positions()
-        .ok_or_else(|| err(path, format!("{what} has no POSITION")))?
+    let attr = |s: gltf::Semantic| prim.get(&s);
+    let a = attr(gltf::Semantic::Positions)
+        .ok_or_else(|| err(path, format!("{what} has no POSITION")))?;
+    let positions: Vec<Vec3> = floats::<3>(path, what, &a, buffers)?
+        .into_iter()
         .map(Vec3::from)
         .collect();
     let n = positions.len();
@@ -398,12 +376,31 @@ fn read_part(
     let indices = triangles(prim.mode(), &list).ok_or_else(|| {
         err(path, format!("{what} draws {:?}; only triangle primitives (triangles, strips, fans) can be loaded", prim.mode()))
     })?;
-    let normals = reader
-        .read_normals()
-        .map(|it| it.map(Vec3::from).collect::<Vec<_>>());
-    let uvs = reader
-        .read_tex_coords(0)
-        .map(|it| it.into_f32().map(Vec2::from).collect());
+    // Quantized normals are unit only to their precision.
+    let normals = match attr(gltf::Semantic::Normals) {
+        Some(a) => {
+            let unit = a.data_type() != DataType::F32;
+            let v = floats::<3>(path, what, &a, buffers)?
+                .into_iter()
+                .map(Vec3::from);
+            Some(match unit {
+                true => v.map(Vec3::normalize_or_zero).collect::<Vec<_>>(),
+                false => v.collect(),
+            })
+        }
+        None => None,
+    };
+    let uvs = match attr(gltf::Semantic::TexCoords(0)) {
+        Some(a) => {
+            let mut uv: Vec<Vec2> = floats::<2>(path, what, &a, buffers)?
+                .into_iter()
+                .map(Vec2::from)
+                .collect();
+            super::gltf_quantized::transform_uvs(prim, &mut uv);
+            Some(uv)
+        }
+        None => None,
+    };
     let influences = match skin_joints {
         Some(count) => read_influences(path, what, &reader, n, offset, count, warnings)?,
         None => vec![vec![(offset as u16, 1.0)]; n],
@@ -566,7 +563,7 @@ fn merge(
 }
 
 /// Percent-decoding of a relative URI (spaces and the like in file names).
-fn urlencoding_decode(uri: &str) -> String {
+pub(super) fn urlencoding_decode(uri: &str) -> String {
     urlencoding::decode(uri)
         .map(|c| c.into_owned())
         .unwrap_or_else(|_| uri.to_string())

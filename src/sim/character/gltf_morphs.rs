@@ -5,7 +5,7 @@ use super::gltf_load::{check_accessor, err};
 use super::model::{MorphDelta, MorphTarget, Morphs};
 use crate::error::Result;
 use glam::Vec3;
-use gltf::accessor::{DataType, Dimensions};
+use gltf::accessor::Dimensions;
 use std::path::Path;
 
 /// One primitive's target: its weight slot, position and normal offsets per vertex.
@@ -46,7 +46,7 @@ pub(super) fn read(
     path: &Path,
     what: &str,
     prim: &gltf::Primitive,
-    buffers: &[gltf::buffer::Data],
+    buffers: &super::gltf_quantized::Buffers,
     first: u32,
 ) -> Result<Vec<PartTarget>> {
     let n = prim
@@ -56,7 +56,8 @@ pub(super) fn read(
         for (attr, a) in [("POSITION", t.positions()), ("NORMAL", t.normals())] {
             let Some(a) = a else { continue };
             let label = format!("{what} morph target {k} {attr}");
-            check_accessor(path, &label, &a, &[(Dimensions::Vec3, &[DataType::F32])])?;
+            let types = super::gltf_quantized::morph_allowed(buffers.quantized);
+            check_accessor(path, &label, &a, &[(Dimensions::Vec3, types)])?;
             if a.count() != n {
                 return Err(err(
                     path,
@@ -65,16 +66,26 @@ pub(super) fn read(
             }
         }
     }
-    let reader = prim.reader(|b| Some(&buffers[b.index()]));
-    Ok(reader
-        .read_morph_targets()
+    let offsets = |a: Option<gltf::Accessor>, label: String| -> Result<Vec<Vec3>> {
+        match a {
+            Some(a) => Ok(
+                super::gltf_quantized::floats::<3>(path, &label, &a, buffers)?
+                    .into_iter()
+                    .map(Vec3::from)
+                    .collect(),
+            ),
+            None => Ok(vec![Vec3::ZERO; n]),
+        }
+    };
+    prim.morph_targets()
         .enumerate()
-        .map(|(k, (p, nrm, _))| {
-            let p: Vec<Vec3> = p.map_or(vec![Vec3::ZERO; n], |it| it.map(Vec3::from).collect());
-            let nrm = nrm.map_or(vec![Vec3::ZERO; n], |it| it.map(Vec3::from).collect());
-            (first + k as u32, p, nrm)
+        .map(|(k, t)| {
+            let label = format!("{what} morph target {k}");
+            let p = offsets(t.positions(), format!("{label} POSITION"))?;
+            let nrm = offsets(t.normals(), format!("{label} NORMAL"))?;
+            Ok((first + k as u32, p, nrm))
         })
-        .collect())
+        .collect()
 }
 
 /// Append a part's `n` vertices' offsets (its nonzero ones) to the merged CSR.
