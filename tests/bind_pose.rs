@@ -118,7 +118,7 @@ fn a_bind_pose_wider_than_its_clip_plays_inside_its_fitted_domain() {
     for k in 0..s.frames {
         let t = k as f64 * frame_s;
         let mats = placed_matrices(&ch, &anim, desc.speed, desc.path().as_ref(), t);
-        for p in bound.at(&ch, &mats, Skinning::Lbs).unwrap() {
+        for p in bound.at(&ch, (&mats, &[]), Skinning::Lbs).unwrap() {
             assert!(
                 p.cmpge(lo - ulps).all() && p.cmple(hi + ulps).all(),
                 "frame {k}: {p} outside {lo}..{hi}"

@@ -192,13 +192,15 @@ fn compare(settings: ControlSettings, velocity: Vec3) -> (f64, f64) {
     let frame_dt = 1.0 / 30.0;
     let ahead = (velocity != Vec3::ZERO).then(|| {
         let m = Mat4::from_translation(velocity * frame_dt);
-        fluidform::character::pose::gpu_joints(&[m], Skinning::Lbs, &|_| "j".into()).unwrap()
+        let j = fluidform::character::pose::gpu_joints(&[m], Skinning::Lbs, &|_| "j".into());
+        (j.unwrap(), Vec::new())
     });
     let mut accs = Vec::new();
     for with in [false, true] {
         if with {
             control.set_pose(Pose {
                 joints: joints.clone(),
+                weights: Vec::new(),
                 frame_dt,
                 next: ahead.clone(),
             });
@@ -443,6 +445,7 @@ fn stored_control_sums_follow_the_particles_through_the_sort() {
             .unwrap();
     control.set_pose(Pose {
         joints,
+        weights: Vec::new(),
         frame_dt: 1.0 / 30.0,
         next: None,
     });

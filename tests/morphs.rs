@@ -2,6 +2,8 @@
 //! against hand-computed values, the GPU skinning pass against the CPU reference, what
 //! `inspect` lists, and bad morph accessors refused.
 mod common;
+#[path = "morphs_files/control.rs"]
+mod control;
 use common::gltf::{cube, write, Doc};
 use fluidform::character::skin::Skinner;
 use fluidform::character::{self, inspect, Animator, Character, Skinning};

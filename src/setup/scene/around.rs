@@ -131,7 +131,8 @@ fn swept(
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     for t in played_times(scene, desc, ch, anim) {
         let mats = placed_matrices(ch, anim, desc.speed, path.as_ref(), t);
-        let (a, b) = bounds(&ch.skinned_at(&mats, Skinning::Lbs)?.0);
+        let weights = anim.morph_weights(ch, (t * desc.speed as f64) as f32);
+        let (a, b) = bounds(&ch.skinned_with(&mats, &weights, Skinning::Lbs)?.0);
         lo = lo.min(a);
         hi = hi.max(b);
     }

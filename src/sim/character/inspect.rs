@@ -11,6 +11,9 @@ pub struct ClipInfo {
     pub name: String,
     pub duration: f32,
     pub channels: usize,
+    /// Every channel animates morph target weights: no joint or node moves, the water
+    /// follows the morphs alone.
+    pub morphs_only: bool,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -142,6 +145,10 @@ pub fn inspect(ch: &Character, up: Up, up_given: bool) -> Result<Inspection> {
                 name: a.name.clone(),
                 duration: a.duration,
                 channels: a.channels.len(),
+                morphs_only: !a.channels.is_empty()
+                    && a.channels
+                        .iter()
+                        .all(|c| matches!(c.property, super::Property::Weight(_))),
             })
             .collect(),
         bounds_min: lo.into(),
@@ -196,8 +203,14 @@ impl Inspection {
             line(
                 if i == 0 { "animations" } else { "" },
                 format!(
-                    "{i}: '{}' {:.3} s, {} channels",
-                    a.name, a.duration, a.channels
+                    "{i}: '{}' {:.3} s, {} channels{}",
+                    a.name,
+                    a.duration,
+                    a.channels,
+                    match a.morphs_only {
+                        true => ", morph target weights only",
+                        false => "",
+                    }
                 ),
             );
         }

@@ -20,19 +20,20 @@ pub struct Plays<'a> {
     /// character's height, as the scene's first-pose check lets a foot dip into the floor
     /// and a hand into a wall.
     pub slack: f32,
-    pub poses: &'a [(f64, Vec<Mat4>)],
+    /// With each pose's morph weights (the character's targets').
+    pub poses: &'a [(f64, Vec<Mat4>, Vec<f32>)],
     /// Seconds a frame advances (to name the frame of a pose that does not fit).
     pub frame_s: f64,
 }
 
 /// `mesh` (control particles bound to `ch`'s joints, or `ch`'s own mesh when `rest_inv`
-/// is empty) skinned by `method` to placed joint matrices `mats` (its morph targets at
-/// their default weights), as the GPU skins it.
+/// is empty) skinned by `method` to placed joint matrices `mats` with morph weights
+/// `weights` (empty: the targets' defaults), as the GPU skins it.
 pub fn skin(
     ch: &Character,
     mesh: &Mesh,
     rest_inv: &[Mat4],
-    mats: &[Mat4],
+    (mats, weights): (&[Mat4], &[f32]),
     method: Skinning,
 ) -> Result<Vec<Vec3>> {
     let rel: Vec<Mat4> = match rest_inv.is_empty() {
@@ -40,7 +41,11 @@ pub fn skin(
         false => mats.iter().zip(rest_inv).map(|(m, r)| *m * *r).collect(),
     };
     let joints = pose::gpu_joints(&rel, method, &|j| ch.joint_name(j))?;
-    Ok(cpu::skin(method, &joints, mesh, &mesh.morphs.defaults()).0)
+    let weights = match weights.len() == mesh.morphs.targets.len() {
+        true => weights.to_vec(),
+        false => mesh.morphs.defaults(),
+    };
+    Ok(cpu::skin(method, &joints, mesh, &weights).0)
 }
 
 /// `mesh` (control particles bound to `ch`'s joints, or `ch`'s own mesh when `rest_inv`
@@ -57,8 +62,8 @@ pub fn check(
 ) -> Result<()> {
     let (lo, hi) = (Vec3::from(plays.domain.0), Vec3::from(plays.domain.1));
     let slack = plays.slack.max(0.0);
-    for (t, mats) in plays.poses {
-        let points = skin(ch, mesh, rest_inv, mats, method)?;
+    for (t, mats, weights) in plays.poses {
+        let points = skin(ch, mesh, rest_inv, (mats, weights), method)?;
         let out = |p: &Vec3| (lo - *p).max(*p - hi).max_element();
         let Some((v, p)) = points
             .iter()

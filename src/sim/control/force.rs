@@ -70,10 +70,12 @@ pub const ALL_GROUPS: u32 = u32::MAX;
 /// time (for their velocity).
 pub struct Pose {
     pub joints: Vec<GpuJoint>,
+    /// The morph targets' weights (empty where the set has none).
+    pub weights: Vec<f32>,
     pub frame_dt: f32,
-    /// `--control-motion skin`: the joints a frame ahead (the velocity is the skin's motion
-    /// over the frame the steps cover, not the last frame's).
-    pub next: Option<Vec<GpuJoint>>,
+    /// `--control-motion skin`: the joints and weights a frame ahead (the velocity is the
+    /// skin's motion over the frame the steps cover, not the last frame's).
+    pub next: Option<(Vec<GpuJoint>, Vec<f32>)>,
 }
 
 /// How a control set is placed and skinned: `--placement rays` (spacing, capacity), the
@@ -388,13 +390,21 @@ impl ControlForce {
             }
             let params = self.gpu_params(g, pose.frame_dt, ahead.is_some());
             ctx.update(cmd, &g.params, 0, &[params]);
-            if let Some(next) = ahead {
+            // Morph weights where the set carries targets (the rays' surface, or particles
+            // bound to a morphing mesh).
+            let weights = |w: &[f32]| match g.mesh.targets > 0 && !w.is_empty() {
+                true => g.mesh.set_weights(ctx, cmd, w),
+                false => Ok(()),
+            };
+            if let Some((next, w)) = ahead {
                 // The pose a frame ahead, skinned into `prev`, then the frame's own.
                 g.mesh.set_pose(ctx, cmd, next)?;
+                weights(w)?;
                 g.skin.record(ctx, cmd, &g.mesh)?;
                 ctx.copy(cmd, &g.mesh.pos, 0, &g.prev, 0, bytes);
             }
             g.mesh.set_pose(ctx, cmd, &pose.joints)?;
+            weights(&pose.weights)?;
             g.skin.record(ctx, cmd, &g.mesh)?;
             // Re-placed particles have no previous pose: both are the new set.
             if g.rays.is_none() && first && ahead.is_none() {

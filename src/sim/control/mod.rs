@@ -12,6 +12,7 @@ pub mod grid;
 pub mod mesh_distance;
 pub mod metrics;
 mod metrics_worker;
+pub mod morph_bind;
 pub mod passes;
 pub mod placement;
 pub mod rays;

@@ -288,6 +288,8 @@ impl Bound {
             .collect();
         let bones = binding::bones(ch, &globals);
         let (joints, weights) = binding::bind(ch, &bones, &points, desc.bone_weights, &rest_mesh);
+        let (morphs, points) =
+            super::morph_bind::bind(ch, &placed_rest, &rest_mesh, points, spacing)?;
         let sets = match desc.bone_weights {
             BoneWeights::Skin => ch.mesh.influence_sets,
             _ => 1,
@@ -302,7 +304,7 @@ impl Bound {
             weights,
             influence_sets: sets.min(MAX_INFLUENCES / 4),
             uv_parts: Vec::new(),
-            morphs: Default::default(),
+            morphs,
         };
         let rest_inv = rest_inverses(ch, &placed_rest)?;
         Ok(Some(Self {
@@ -313,9 +315,15 @@ impl Bound {
         }))
     }
 
-    /// The particles skinned by `method` to placed joint matrices `mats`.
-    pub fn at(&self, ch: &Character, mats: &[Mat4], method: Skinning) -> Result<Vec<Vec3>> {
-        fits::skin(ch, &self.mesh, &self.rest_inv, mats, method)
+    /// The particles skinned by `method` to placed joint matrices `mats` and morph
+    /// weights `weights` (the character's targets').
+    pub fn at(
+        &self,
+        ch: &Character,
+        (mats, weights): (&[Mat4], &[f32]),
+        method: Skinning,
+    ) -> Result<Vec<Vec3>> {
+        fits::skin(ch, &self.mesh, &self.rest_inv, (mats, weights), method)
     }
 }
 
@@ -411,14 +419,14 @@ impl ControlTarget {
         })
     }
 
-    /// Set the pose of scene time `t` (the animator's joint matrices, placed) for the next
-    /// frame's steps, `frame_dt` seconds after the previous pose; `next`: the pose a frame
-    /// ahead (`--control-motion skin`).
+    /// Set the pose of scene time `t` (the animator's joint matrices, placed, and morph
+    /// weights) for the next frame's steps, `frame_dt` seconds after the previous pose;
+    /// `next`: the pose a frame ahead (`--control-motion skin`).
     pub fn set_pose(
         &mut self,
         ch: &Character,
-        mats: &[Mat4],
-        next: Option<&[Mat4]>,
+        (mats, weights): (&[Mat4], &[f32]),
+        next: Option<(&[Mat4], &[f32])>,
         frame_dt: f32,
     ) -> Result<()> {
         let name = |j: usize| ch.joint_name(j);
@@ -431,11 +439,14 @@ impl ControlTarget {
             pose::gpu_joints(&rel, self.skinning, &name)
         };
         let next = match next {
-            Some(n) if self.desc.placement != Placement::Rays => Some(joints(n)?),
+            Some((n, w)) if self.desc.placement != Placement::Rays => {
+                Some((joints(n)?, w.to_vec()))
+            }
             _ => None,
         };
         self.force.set_pose(Pose {
             joints: joints(mats)?,
+            weights: weights.to_vec(),
             frame_dt,
             next,
         });

@@ -136,7 +136,10 @@ impl SceneTargets {
                 Some(d) => {
                     // What must fit: the poses that play, by the fitted domain's rule.
                     let times = played_times(scene, cdesc, &character.ch, &character.anim);
-                    let poses: Vec<_> = times.iter().map(|&t| (t, character.matrices(t))).collect();
+                    let poses: Vec<_> = times
+                        .iter()
+                        .map(|&t| (t, character.matrices(t), character.morph_weights(t)))
+                        .collect();
                     let (lo, hi) = placed_rest_bounds(&character.ch, &character.anim)?;
                     let plays = Plays {
                         domain: (scene.domain.min, scene.domain.max),
@@ -299,17 +302,19 @@ impl SceneTargets {
                 continue;
             };
             let ch = &l.character;
-            let mats = ch.matrices(t);
+            let (mats, weights) = (ch.matrices(t), ch.morph_weights(t));
+            let ahead = t + frame_dt as f64;
             let next = (c.force.settings.motion == ControlMotion::Skin)
-                .then(|| ch.matrices(t + frame_dt as f64));
-            c.set_pose(&ch.ch, &mats, next.as_deref(), frame_dt)?;
+                .then(|| (ch.matrices(ahead), ch.morph_weights(ahead)));
+            let next = next.as_ref().map(|(m, w)| (&m[..], &w[..]));
+            c.set_pose(&ch.ch, (&mats, &weights), next, frame_dt)?;
             // (Ahead of the clip's start rather than across a loop's seam into its end.)
             let moment = match t >= SKIN_SPEED_DT {
                 true => t - SKIN_SPEED_DT,
                 false => t + SKIN_SPEED_DT,
             };
             let before = (ch.matrices(moment), ch.morph_weights(moment));
-            l.poses[slot] = Some(((mats, ch.morph_weights(t)), before, t));
+            l.poses[slot] = Some(((mats, weights), before, t));
         }
         Ok(())
     }
