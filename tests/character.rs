@@ -3,6 +3,8 @@
 mod common;
 #[path = "character_files/compressed.rs"]
 mod compressed;
+#[path = "character_files/solid.rs"]
+mod solid;
 use common::asset;
 use fluidform::character::anim::{clip_time, slerp};
 use fluidform::character::Skinning;

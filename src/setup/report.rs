@@ -135,6 +135,10 @@ pub struct Summary<C, S> {
     pub frames: usize,
     pub pass_ms: PassTimes,
     pub frame_ms: Option<Stat>,
+    /// Wall-clock ms from one frame's start of recording to the next's: the pace the run
+    /// kept, host work and waits included (`frame_ms` is the GPU's alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_ms: Option<Stat>,
     /// 1000 / median GPU frame time.
     pub fps: Option<f64>,
     pub memory_bytes: BTreeMap<String, u64>,
@@ -180,12 +184,22 @@ impl<C: Serialize + Clone, S: Serialize + Clone> Report<'_, C, S> {
     pub fn summary(&self) -> Summary<C, S> {
         let frame: Vec<f64> = self.timings.iter().map(|t| t.frame_ms).collect();
         let frame_ms = stat(&frame);
+        let mut begins: Vec<(u64, f64)> = (self.timings.iter())
+            .filter_map(|t| Some((t.frame, t.cpu_ns?.0)))
+            .collect();
+        begins.sort_by_key(|b| b.0);
+        let paces: Vec<f64> = begins
+            .windows(2)
+            .filter(|w| w[1].0 == w[0].0 + 1)
+            .map(|w| (w[1].1 - w[0].1) * 1e-6)
+            .collect();
         Summary {
             device: DeviceSummary::of(self.device),
             config: self.config.clone(),
             frames: self.timings.len(),
             pass_ms: PassTimes(pass_stats(self.timings)),
             frame_ms,
+            wall_ms: stat(&paces),
             fps: frame_ms
                 .filter(|s| s.median > 0.0)
                 .map(|s| 1000.0 / s.median),

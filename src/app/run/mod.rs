@@ -359,4 +359,20 @@ pub fn print_summary(s: &RunSummary) {
     if let Some(v) = &s.validation {
         println!("validation: {} errors, {} warnings", v.errors, v.warnings);
     }
+    if let Some(line) = host_paced(s) {
+        println!("{line}");
+    }
+}
+
+/// Where the wall clock's frame (`wall_ms`) is more than 1.25x the GPU's (`frame_ms`):
+/// the host, not the GPU, set the run's pace.
+pub fn host_paced(s: &RunSummary) -> Option<String> {
+    let (wall, gpu) = (s.wall_ms?.median, s.frame_ms?.median);
+    (wall > 1.25 * gpu).then(|| {
+        format!(
+            "the host set the pace: {wall:.3} ms a frame of wall time against {gpu:.3} ms of GPU \
+             time ({:.2}x; per-frame CPU work such as the fidelity metrics)",
+            wall / gpu
+        )
+    })
 }

@@ -1,6 +1,8 @@
 //! Local thickness measured on the surface: from every vertex of the rest pose, the
 //! distance along its inward normal to the opposite surface (rays through a uniform grid
-//! of the triangles), gathered per region and taken at a low percentile, so that a few
+//! of the triangles; on an open mesh, the far side of the solid its winding number fills:
+//! clothes over a body are shells a few millimetres apart, and the next shell is not the
+//! far side of the leg), gathered per region and taken at a low percentile, so that a few
 //! thin details (an ear, a tail's tip) do not set the particle spacing while a leg does.
 //! A region is a joint (the vertex's heaviest) of a skinned mesh; a static mesh has one
 //! joint, so its regions are the cells of a coarse grid over its placed rest pose, named
@@ -94,8 +96,10 @@ fn cells(pos: &[Vec3], orient: Mat3) -> (Vec<usize>, Vec<String>) {
 
 /// Each vertex's thickness: the distance along -normal to the nearest other triangle
 /// (None where the ray leaves the mesh without a hit: an open part). With `open` (an open
-/// mesh's winding number), the ray goes to whichever side of the vertex is inside, and a
-/// vertex with neither side inside (a sheet) has none.
+/// mesh's winding number), the ray goes to whichever side of the vertex is inside, to the
+/// first surface past which the winding number calls the ray's point outside (layers it
+/// crosses inside the solid do not stop it), and a vertex with neither side inside (a
+/// sheet) has none.
 pub fn per_vertex(
     pos: &[Vec3],
     nrm: &[Vec3],
@@ -105,6 +109,8 @@ pub fn per_vertex(
     let grid = Grid::new(pos, idx);
     let eps = 1e-4 * grid.diag;
     let probe = 1e-3 * grid.diag;
+    // Just past a surface, to ask the winding number which side the ray is on.
+    let past = 1e-4 * grid.diag;
     pos.iter()
         .zip(nrm)
         .map(|(p, n)| {
@@ -116,9 +122,13 @@ pub fn per_vertex(
                     (false, false) => Vec3::ZERO,
                 };
             }
-            (d != Vec3::ZERO)
-                .then(|| grid.cast(pos, idx, *p, d, eps))
-                .flatten()
+            if d == Vec3::ZERO {
+                return None;
+            }
+            match open {
+                None => grid.cast(pos, idx, *p, d, eps, |_| true),
+                Some(w) => grid.cast(pos, idx, *p, d, eps, |h| !w.inside(*p + d * (h + past))),
+            }
         })
         .collect()
 }
@@ -174,9 +184,18 @@ impl Grid {
         c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
     }
 
-    /// The nearest hit beyond `eps` along the ray, walking the cells in order
-    /// (Amanatides & Woo) until a hit lies within the cell being walked.
-    fn cast(&self, pos: &[Vec3], idx: &[u32], o: Vec3, d: Vec3, eps: f32) -> Option<f32> {
+    /// The nearest hit beyond `eps` along the ray that `stop` accepts, hits offered in
+    /// order of distance: the cells are walked in order (Amanatides & Woo) and a hit is
+    /// offered once the walk has passed it (no nearer one can be met later).
+    fn cast(
+        &self,
+        pos: &[Vec3],
+        idx: &[u32],
+        o: Vec3,
+        d: Vec3,
+        eps: f32,
+        mut stop: impl FnMut(f32) -> bool,
+    ) -> Option<f32> {
         let mut c = self.coord(o).map(|v| v as i64);
         let step = [0, 1, 2].map(|k| if d[k] >= 0.0 { 1i64 } else { -1 });
         let next = |k: usize, c: i64| {
@@ -188,24 +207,37 @@ impl Grid {
         };
         let mut t_max = [0, 1, 2].map(|k| next(k, c[k]));
         let t_delta = [0, 1, 2].map(|k| (self.cell[k] / d[k].abs()).min(f32::INFINITY));
-        let mut best = f32::INFINITY;
+        // Hits met and not yet offered, farthest first; triangles already tested.
+        let mut pending: Vec<f32> = Vec::new();
+        let mut seen = std::collections::HashSet::new();
         loop {
             let cell = self.index(c.map(|v| v as usize));
             for &t in &self.bins[cell] {
+                if !seen.insert(t) {
+                    continue;
+                }
                 let v = [0, 1, 2].map(|j| pos[idx[3 * t as usize + j] as usize]);
                 if let Some(h) = hit(o, d, v).filter(|h| *h > eps) {
-                    best = best.min(h);
+                    pending.push(h);
                 }
             }
+            pending.sort_by(|a, b| b.total_cmp(a));
             let k = (0..3)
                 .min_by(|a, b| t_max[*a].total_cmp(&t_max[*b]))
                 .unwrap_or(0);
-            if best <= t_max[k] {
-                return Some(best);
-            }
             c[k] += step[k];
-            if c[k] < 0 || c[k] >= self.dims[k] as i64 {
-                return best.is_finite().then_some(best);
+            let out = c[k] < 0 || c[k] >= self.dims[k] as i64;
+            while let Some(&h) = pending.last() {
+                if h > t_max[k] && !out {
+                    break;
+                }
+                pending.pop();
+                if stop(h) {
+                    return Some(h);
+                }
+            }
+            if out {
+                return None;
             }
             t_max[k] += t_delta[k];
         }
