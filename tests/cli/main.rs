@@ -97,6 +97,15 @@ fn run_writes_frames_timings_and_summary() {
     }
     let fm = s["frame_ms"]["median"].as_f64().unwrap();
     assert!((s["fps"].as_f64().unwrap() - 1000.0 / fm).abs() < 1e-6);
+    // The wall clock's pace beside the GPU's, and the log names the host where it led.
+    let wall = s["wall_ms"]["median"].as_f64().unwrap();
+    assert!(wall > 0.0 && wall.is_finite(), "{}", s["wall_ms"]);
+    assert_eq!(
+        text(&o).contains("the host set the pace"),
+        wall > 1.25 * fm,
+        "wall {wall} ms, GPU {fm} ms: {}",
+        text(&o)
+    );
     assert!(s["memory_bytes"]["particle positions"].as_u64().unwrap() >= 500 * 16);
     assert_eq!(s["validation"]["errors"], 0);
     assert_eq!(s["validation"]["warnings"], 0);
