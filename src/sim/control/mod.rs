@@ -9,6 +9,7 @@ pub mod fidelity;
 pub mod fits;
 pub mod force;
 pub mod grid;
+pub mod interface;
 pub mod mesh_distance;
 pub mod metrics;
 mod metrics_worker;

@@ -1,5 +1,5 @@
 //! The control passes as declarations, with the key they are built with.
-use super::force::ControlIo;
+use super::interface::ControlIo;
 use super::settings::ControlSettings;
 use crate::gpu::pass::{Defines, PassKey};
 use crate::primitives::neighbors::NbKey;
