@@ -96,7 +96,7 @@ fn morph_weights_move_the_control_particles_gpu_as_cpu() {
     let mut sk = Skinner::new(&ctx, &probe, Skinning::Lbs).unwrap();
     let rest = bound.at(
         &ch,
-        (&placed_matrices(&ch, &anim, 1.0, None, 0.0), &[0.0]),
+        (&placed_matrices(&ch, &anim, desc.speed, None, 0.0), &[0.0]),
         Skinning::Lbs,
     );
     let rest = rest.unwrap();

@@ -207,15 +207,13 @@ impl Grid {
         };
         let mut t_max = [0, 1, 2].map(|k| next(k, c[k]));
         let t_delta = [0, 1, 2].map(|k| (self.cell[k] / d[k].abs()).min(f32::INFINITY));
-        // Hits met and not yet offered, farthest first; triangles already tested.
+        // Hits met and not yet offered, farthest first; the last one offered (a triangle
+        // binned in several cells is met again at the same distance, and not offered twice).
         let mut pending: Vec<f32> = Vec::new();
-        let mut seen = std::collections::HashSet::new();
+        let mut offered = f32::NAN;
         loop {
             let cell = self.index(c.map(|v| v as usize));
             for &t in &self.bins[cell] {
-                if !seen.insert(t) {
-                    continue;
-                }
                 let v = [0, 1, 2].map(|j| pos[idx[3 * t as usize + j] as usize]);
                 if let Some(h) = hit(o, d, v).filter(|h| *h > eps) {
                     pending.push(h);
@@ -232,9 +230,10 @@ impl Grid {
                     break;
                 }
                 pending.pop();
-                if stop(h) {
+                if h != offered && stop(h) {
                     return Some(h);
                 }
+                offered = h;
             }
             if out {
                 return None;

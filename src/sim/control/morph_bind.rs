@@ -1,17 +1,18 @@
 //! Morph targets carried by control particles (issue 68): each particle takes the offsets of
 //! the mesh's nearest point, interpolated over its triangle's corners by the point's
 //! barycentric coordinates, moved into the placed rest pose the particles are bound in (a
-//! particle deep in a stretching limb moves as the nearest skin does, not as one corner). The skinning pass then adds the
-//! frame's weighted offsets before skinning, on the GPU and in the CPU reference, so morph
-//! weights move the water as joints do (a bird's wings, a face).
+//! particle deep in a stretching limb moves as the nearest skin does, not as one corner).
+//! The skinning pass then adds the frame's weighted offsets before skinning, on the GPU and
+//! in the CPU reference, so morph weights move the water as joints do (a bird's wings, a
+//! face).
 use crate::character::{Character, MorphDelta, Morphs, Skinning};
 use crate::error::Result;
 use glam::{Mat4, Vec3};
 
 /// `points` (placed in the placed rest pose `placed_rest` at the default weights) with the
 /// offsets of their nearest point of `rest_mesh` (the character's mesh in that pose; its
-/// triangles binned in cells of `cell` metres),
-/// and the points less their default offsets, so the default weights give them back.
+/// triangles binned in cells of `cell` metres), and the points less their default
+/// offsets, so the default weights give them back.
 /// Without targets: no offsets and the points as they are.
 pub fn bind(
     ch: &Character,
