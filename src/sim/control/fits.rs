@@ -41,9 +41,16 @@ pub fn skin(
         false => mats.iter().zip(rest_inv).map(|(m, r)| *m * *r).collect(),
     };
     let joints = pose::gpu_joints(&rel, method, &|j| ch.joint_name(j))?;
-    let weights = match weights.len() == mesh.morphs.targets.len() {
-        true => weights.to_vec(),
-        false => mesh.morphs.defaults(),
+    let targets = mesh.morphs.targets.len();
+    let weights = match weights.len() {
+        0 => mesh.morphs.defaults(),
+        n if n == targets => weights.to_vec(),
+        n => {
+            return Err(Error::Param(format!(
+                "{n} morph weights for {targets} morph targets of {}",
+                ch.source
+            )))
+        }
     };
     Ok(cpu::skin(method, &joints, mesh, &weights).0)
 }
